@@ -1,0 +1,144 @@
+// The C ABI of the core: handles, methods, state, stepping, diagnostics.
+// Functions here validate and forward; the System does the work.
+#include <cmath>
+#include <limits>
+
+#include "../core/methods.hpp"
+#include "../models/models.hpp"
+#include "handle.hpp"
+
+using lpi::capi::create;
+using lpi::capi::guarded;
+using lpi::capi::require;
+
+namespace lpi::capi {
+std::string &thread_error() {
+    static thread_local std::string message;
+    return message;
+}
+}  // namespace lpi::capi
+
+#define LPI_STRINGIFY2(x) #x
+#define LPI_STRINGIFY(x) LPI_STRINGIFY2(x)
+
+extern "C" {
+
+LPI_API const char *lpi_version_string(void) {
+    return LPI_STRINGIFY(LPI_VERSION_MAJOR) "." LPI_STRINGIFY(LPI_VERSION_MINOR) "." LPI_STRINGIFY(
+        LPI_VERSION_PATCH);
+}
+
+LPI_API const char *lpi_status_name(int status) {
+    switch (status) {
+#define LPI_STATUS_NAME_CASE(name, value, message) \
+    case value:                                    \
+        return #name;
+        LPI_STATUS_LIST(LPI_STATUS_NAME_CASE)
+#undef LPI_STATUS_NAME_CASE
+    }
+    return "LPI_UNKNOWN_STATUS";
+}
+
+LPI_API const char *lpi_status_message(int status) {
+    switch (status) {
+#define LPI_STATUS_MESSAGE_CASE(name, value, message) \
+    case value:                                       \
+        return message;
+        LPI_STATUS_LIST(LPI_STATUS_MESSAGE_CASE)
+#undef LPI_STATUS_MESSAGE_CASE
+    }
+    return "unknown status code";
+}
+
+LPI_API int lpi_method_count(void) { return static_cast<int>(lpi::method_table().size()); }
+
+LPI_API const char *lpi_method_name(int i) {
+    const auto &table = lpi::method_table();
+    return i >= 0 && static_cast<std::size_t>(i) < table.size() ? table[i].name.c_str() : nullptr;
+}
+
+LPI_API int lpi_method_order(int i) {
+    const auto &table = lpi::method_table();
+    return i >= 0 && static_cast<std::size_t>(i) < table.size() ? table[i].order : -1;
+}
+
+LPI_API int lpi_rigid_body_create(lpi_system **out, double I1, double I2, double I3) {
+    return create(out, "lpi_rigid_body_create", [&] { return lpi::make_rigid_body(I1, I2, I3); });
+}
+
+LPI_API int lpi_pendulum_create(lpi_system **out) {
+    return create(out, "lpi_pendulum_create", [] { return lpi::make_pendulum(); });
+}
+
+LPI_API void lpi_destroy(lpi_system *sys) { delete sys; }
+
+LPI_API int lpi_set_method(lpi_system *sys, const char *name) {
+    return guarded(sys, "lpi_set_method", [&] {
+        require(sys, "system");
+        require(name, "method name");
+        sys->system.set_method(name);
+    });
+}
+
+LPI_API int lpi_set_split(lpi_system *sys, const char *name) {
+    return guarded(sys, "lpi_set_split", [&] {
+        require(sys, "system");
+        require(name, "split name");
+        sys->system.set_split(name);
+    });
+}
+
+LPI_API size_t lpi_dim(const lpi_system *sys) { return sys ? sys->system.dim() : 0; }
+
+LPI_API int lpi_set_state(lpi_system *sys, const double *x, size_t n) {
+    return guarded(sys, "lpi_set_state", [&] {
+        require(sys, "system");
+        require(x, "state");
+        sys->system.set_state(x, n);
+    });
+}
+
+LPI_API int lpi_get_state(const lpi_system *sys, double *x, size_t n) {
+    return guarded(sys, "lpi_get_state", [&] {
+        require(sys, "system");
+        require(x, "state buffer");
+        sys->system.get_state(x, n);
+    });
+}
+
+LPI_API int lpi_step(lpi_system *sys, double dt, int64_t nsteps) {
+    return guarded(sys, "lpi_step", [&] {
+        require(sys, "system");
+        sys->system.step(dt, nsteps);
+    });
+}
+
+LPI_API double lpi_time(const lpi_system *sys) {
+    return sys ? sys->system.time() : std::numeric_limits<double>::quiet_NaN();
+}
+
+LPI_API int lpi_energy(const lpi_system *sys, double *out) {
+    return guarded(sys, "lpi_energy", [&] {
+        require(sys, "system");
+        require(out, "out");
+        *out = sys->system.energy();
+    });
+}
+
+LPI_API size_t lpi_casimir_count(const lpi_system *sys) {
+    return sys ? sys->system.casimir_count() : 0;
+}
+
+LPI_API int lpi_casimirs(const lpi_system *sys, double *out, size_t n) {
+    return guarded(sys, "lpi_casimirs", [&] {
+        require(sys, "system");
+        require(out, "out");
+        sys->system.casimirs(out, n);
+    });
+}
+
+LPI_API const char *lpi_last_error(const lpi_system *sys) {
+    return sys ? sys->last_error.c_str() : lpi::capi::thread_error().c_str();
+}
+
+}  // extern "C"

@@ -1,0 +1,26 @@
+// The one exception type of the core. The C API (src/capi) turns it into a
+// status code and a per-handle message; nothing else crosses the ABI.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include "liepoisson.h"
+
+namespace lpi {
+
+class Error : public std::runtime_error {
+public:
+    Error(lpi_status status, const std::string &message)
+        : std::runtime_error(message), status_(status) {}
+    lpi_status status() const noexcept { return status_; }
+
+private:
+    lpi_status status_;
+};
+
+[[noreturn]] inline void fail(lpi_status status, const std::string &message) {
+    throw Error(status, message);
+}
+
+}  // namespace lpi

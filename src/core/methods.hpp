@@ -1,0 +1,46 @@
+// The method registry: every integration method the library offers, chosen by
+// name. Splitting methods are described as data (a sequence of piece flows or
+// a symmetric composition of leapfrog); adding a composition is adding a row.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace lpi {
+
+enum class MethodKind {
+    Sequence,            // each piece once per step, in order (Lie-Trotter)
+    SequenceAdjoint,     // each piece once per step, in reverse order
+    SymmetricComposition,// leapfrog stages with weights gammas (sum 1, symmetric)
+    RungeKutta4,         // classical RK4 on the full vector field (not Poisson)
+};
+
+struct Method {
+    std::string name;
+    int order = 0;
+    int stages = 0;  // leapfrog stages per step (1 for sequences and RK4)
+    std::string reference;
+    bool poisson = true;  // preserves the Poisson structure and every Casimir
+    MethodKind kind = MethodKind::Sequence;
+    std::vector<double> gammas;  // SymmetricComposition only
+};
+
+// The registered methods, in the order lpi_method_name(i) lists them.
+const std::vector<Method> &method_table();
+
+// Looks a method up by name or alias; throws lpi::Error(LPI_ERR_INVALID)
+// naming the known methods when there is none.
+Method find_method(const std::string &name);
+
+// One exact piece flow of a splitting step: piece `piece` for weight * dt.
+struct Flow {
+    std::size_t piece;
+    double weight;
+};
+
+// The flows of one step for `pieces` pieces, with adjacent flows of the same
+// piece merged (first-same-as-last at the seams between leapfrog stages).
+std::vector<Flow> build_flow_program(const Method &method, std::size_t pieces);
+
+}  // namespace lpi

@@ -1,0 +1,38 @@
+#include "model.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "error.hpp"
+
+namespace lpi {
+
+void Model::to_public(const double *state, double *x) const {
+    std::copy(state, state + dim(), x);
+}
+
+void Model::from_public(const double *x, double *state) const {
+    for (std::size_t i = 0; i < dim(); ++i) {
+        if (!std::isfinite(x[i]))
+            fail(LPI_ERR_NONFINITE, "state entry " + std::to_string(i) + " is not finite");
+    }
+    std::copy(x, x + dim(), state);
+}
+
+}  // namespace lpi
+
+namespace lpi {
+
+void SplitChoice::select(const std::string &name, const char *model_kind) {
+    for (std::size_t i = 0; i < names_.size(); ++i) {
+        if (names_[i] == name) {
+            index_ = i;
+            return;
+        }
+    }
+    std::string known;
+    for (const std::string &n : names_) known += (known.empty() ? "" : ", ") + n;
+    fail(LPI_ERR_INVALID, "unknown split '" + name + "' for " + model_kind + " (known: " + known + ")");
+}
+
+}  // namespace lpi

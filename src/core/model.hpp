@@ -1,0 +1,66 @@
+// A Model is one Lie-Poisson system together with a choice of Hamiltonian
+// split: it knows its pieces' exact flows, its energy and its Casimirs. It
+// never owns the state; the System does (so rollback is one copy).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace lpi {
+
+class Model {
+public:
+    virtual ~Model() = default;
+
+    // Short kind name ("rigid-body"), used in messages and checkpoints.
+    virtual const char *kind() const = 0;
+
+    // Public coordinates (what lpi_get_state returns).
+    virtual std::size_t dim() const = 0;
+
+    // Working layout that the flows act on. Models whose natural layout
+    // differs from the public coordinates (sine-Euler keeps full complex
+    // modes) override these; the default is the identity.
+    virtual std::size_t state_size() const { return dim(); }
+    virtual void to_public(const double *state, double *x) const;
+    // Validates x (throws lpi::Error) and writes the working layout.
+    virtual void from_public(const double *x, double *state) const;
+
+    // Hamiltonian split currently in use.
+    virtual std::vector<std::string> split_names() const = 0;  // first = default
+    virtual void set_split(const std::string &name) = 0;        // throws if unknown
+    virtual std::string split() const = 0;
+    virtual std::size_t piece_count() const = 0;
+
+    // Exact flow of piece k for time t, in place on the working layout.
+    virtual void flow(std::size_t piece, double t, double *state) = 0;
+
+    virtual double energy(const double *state) const = 0;
+    virtual std::size_t casimir_count() const = 0;
+    virtual void casimirs(const double *state, double *out) const = 0;
+
+    // The full vector field J(x) grad H(x) in the working layout: what the
+    // non-splitting reference methods integrate.
+    virtual void vector_field(const double *state, double *rate) const = 0;
+};
+
+}  // namespace lpi
+
+namespace lpi {
+
+// The named Hamiltonian splits a model offers and which one is in use.
+class SplitChoice {
+public:
+    explicit SplitChoice(std::vector<std::string> names) : names_(std::move(names)) {}
+    const std::vector<std::string> &names() const { return names_; }
+    const std::string &current() const { return names_[index_]; }
+    std::size_t index() const { return index_; }
+    void select(const std::string &name, const char *model_kind);  // throws if unknown
+
+private:
+    std::vector<std::string> names_;
+    std::size_t index_ = 0;
+};
+
+}  // namespace lpi

@@ -1,0 +1,86 @@
+#include "system.hpp"
+
+#include <cmath>
+
+#include "error.hpp"
+
+namespace lpi {
+
+void require_length(const char *what, std::size_t given, std::size_t expected) {
+    if (given != expected)
+        fail(LPI_ERR_SIZE, std::string(what) + " has length " + std::to_string(given) +
+                               ", expected " + std::to_string(expected));
+}
+
+System::System(std::unique_ptr<Model> model)
+    : model_(std::move(model)), method_(find_method("leapfrog")),
+      state_(model_->state_size(), 0.0), saved_(model_->state_size(), 0.0) {
+    rebuild_integrator();
+}
+
+void System::rebuild_integrator() { integrator_ = make_integrator(method_, *model_); }
+
+void System::set_method(const std::string &name) {
+    Method method = find_method(name);
+    auto integrator = make_integrator(method, *model_);
+    method_ = std::move(method);
+    integrator_ = std::move(integrator);
+}
+
+void System::set_split(const std::string &name) {
+    const std::string previous = model_->split();
+    model_->set_split(name);  // throws, unchanged, if unknown
+    try {
+        rebuild_integrator();
+    } catch (...) {
+        model_->set_split(previous);
+        throw;
+    }
+}
+
+void System::set_state(const double *x, std::size_t n) {
+    require_length("state", n, model_->dim());
+    std::vector<double> next(model_->state_size());
+    model_->from_public(x, next.data());
+    state_.swap(next);
+    time_ = 0.0;
+}
+
+void System::get_state(double *x, std::size_t n) const {
+    require_length("state buffer", n, model_->dim());
+    model_->to_public(state_.data(), x);
+}
+
+void System::step(double dt, std::int64_t nsteps) {
+    if (!std::isfinite(dt)) fail(LPI_ERR_NONFINITE, "dt is not finite");
+    if (dt == 0.0) fail(LPI_ERR_INVALID, "dt must be nonzero");
+    if (nsteps < 0) fail(LPI_ERR_INVALID, "nsteps must be >= 0, got " + std::to_string(nsteps));
+    if (nsteps == 0) return;
+    const double end_time = time_ + dt * static_cast<double>(nsteps);
+    if (!std::isfinite(end_time))
+        fail(LPI_ERR_INVALID, "dt * nsteps overflows the time variable");
+
+    saved_ = state_;
+    bool finite = false;
+    try {
+        finite = integrator_->advance(*model_, state_.data(), dt, nsteps);
+    } catch (...) {
+        state_.swap(saved_);
+        throw;
+    }
+    if (!finite) {
+        state_.swap(saved_);
+        fail(LPI_ERR_NONFINITE, "method '" + method_.name + "' produced a non-finite state "
+                                "with dt = " + std::to_string(dt) + "; state rolled back");
+    }
+    time_ = end_time;
+}
+
+double System::energy() const { return model_->energy(state_.data()); }
+
+void System::casimirs(double *out, std::size_t n) const {
+    require_length("Casimir buffer", n, model_->casimir_count());
+    model_->casimirs(state_.data(), out);
+}
+
+}  // namespace lpi

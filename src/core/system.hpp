@@ -1,0 +1,54 @@
+// A System owns a Model (algebra + split), a Method and its Integrator, the
+// state and the time. Every mutating operation either succeeds or throws
+// lpi::Error with the state exactly as it was.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "integrator.hpp"
+#include "methods.hpp"
+#include "model.hpp"
+
+namespace lpi {
+
+class System {
+public:
+    explicit System(std::unique_ptr<Model> model);
+
+    Model &model() { return *model_; }
+    const Model &model() const { return *model_; }
+    const Method &method() const { return method_; }
+
+    void set_method(const std::string &name);
+    void set_split(const std::string &name);
+
+    std::size_t dim() const { return model_->dim(); }
+    void set_state(const double *x, std::size_t n);  // also resets time to 0
+    void get_state(double *x, std::size_t n) const;
+    const std::vector<double> &working_state() const { return state_; }
+
+    void step(double dt, std::int64_t nsteps);
+    double time() const { return time_; }
+
+    double energy() const;
+    std::size_t casimir_count() const { return model_->casimir_count(); }
+    void casimirs(double *out, std::size_t n) const;
+
+private:
+    void rebuild_integrator();
+
+    std::unique_ptr<Model> model_;
+    Method method_;
+    std::unique_ptr<Integrator> integrator_;
+    std::vector<double> state_;
+    std::vector<double> saved_;  // the state before the step in progress
+    double time_ = 0.0;
+};
+
+// Throws LPI_ERR_SIZE unless given == expected, naming what was expected.
+void require_length(const char *what, std::size_t given, std::size_t expected);
+
+}  // namespace lpi

@@ -1,0 +1,50 @@
+#include <algorithm>
+#include <cmath>
+
+#include "models.hpp"
+
+namespace lpi {
+
+void compensated_add(double &x, double &carry, double increment) {
+    // Kahan: x + carry holds the exact running sum to about u^2 |x|.
+    const double y = increment + carry;
+    const double t = x + y;
+    carry = (x - t) + y;
+    x = t;
+}
+
+void rotate_pair(double *x, double *carry, int i, int j, double angle) {
+    // The increment (c - 1) x + s y, with c - 1 = -2 sin^2(a/2), is small for
+    // small angles, so its own rounding errors are scaled down by the angle.
+    const double h = std::sin(0.5 * angle);
+    const double c_minus_1 = -2.0 * h * h;
+    const double s = std::sin(angle);
+    const double xi = x[i] + carry[i], xj = x[j] + carry[j];
+    compensated_add(x[i], carry[i], c_minus_1 * xi + s * xj);
+    compensated_add(x[j], carry[j], c_minus_1 * xj - s * xi);
+}
+
+}  // namespace lpi
+
+namespace lpi {
+
+void CompensatedModel::value(const double *state, double *x) const {
+    const std::size_t n = dim();
+    for (std::size_t i = 0; i < n; ++i) x[i] = state[i] + state[n + i];
+}
+
+void CompensatedModel::to_public(const double *state, double *x) const { value(state, x); }
+
+void CompensatedModel::from_public(const double *x, double *state) const {
+    Model::from_public(x, state);  // validates and copies x
+    std::fill(state + dim(), state + 2 * dim(), 0.0);
+}
+
+void CompensatedModel::vector_field(const double *state, double *rate) const {
+    double x[kMaxCompensatedDim];
+    value(state, x);
+    public_vector_field(x, rate);
+    std::fill(rate + dim(), rate + 2 * dim(), 0.0);
+}
+
+}  // namespace lpi
