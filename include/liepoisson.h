@@ -45,7 +45,8 @@ extern "C" {
     X(LPI_ERR_NOT_ABELIAN, -5, "a piece's index set is not abelian")                \
     X(LPI_ERR_UNSUPPORTED, -6, "not built in, or not defined for this system")      \
     X(LPI_ERR_NO_MEMORY, -7, "out of memory")                                       \
-    X(LPI_ERR_INTERNAL, -8, "internal error (please report it)")
+    X(LPI_ERR_INTERNAL, -8, "internal error (please report it)")                   \
+    X(LPI_ERR_CALLBACK, -9, "a user callback reported failure")
 
 typedef enum lpi_status {
 #define LPI_STATUS_ENUM_ENTRY(name, value, message) name = value,

@@ -1,0 +1,104 @@
+/* Helpers shared by the cmocka tests: status checks with message and
+ * unchanged-state assertions, an independent RK4 reference, order fitting. */
+#ifndef LPI_TEST_H
+#define LPI_TEST_H
+
+#include <liepoisson.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+/* State and time of a handle, to compare bit for bit. */
+typedef struct {
+    double x[4096];
+    size_t n;
+    double time;
+} lpi_snapshot;
+
+static inline void lpi_take_snapshot(const lpi_system *sys, lpi_snapshot *s) {
+    s->n = lpi_dim(sys);
+    assert_true(s->n <= sizeof s->x / sizeof s->x[0]);
+    assert_int_equal(lpi_get_state(sys, s->x, s->n), LPI_OK);
+    s->time = lpi_time(sys);
+}
+
+static inline void lpi_assert_unchanged(const lpi_system *sys, const lpi_snapshot *before) {
+    lpi_snapshot after;
+    lpi_take_snapshot(sys, &after);
+    assert_int_equal(after.n, before->n);
+    assert_memory_equal(after.x, before->x, before->n * sizeof(double));
+    assert_memory_equal(&after.time, &before->time, sizeof(double));
+}
+
+/* Asserts that `call` returns `expected`, that the handle's (or the thread's)
+ * last error names `function`, and that the state did not change. */
+#define LPI_ASSERT_FAILS(sys, call, expected, function)                                   \
+    do {                                                                                  \
+        lpi_snapshot lpi_before_;                                                         \
+        if (sys) lpi_take_snapshot(sys, &lpi_before_);                                    \
+        int lpi_status_ = (call);                                                         \
+        if (lpi_status_ != (expected))                                                    \
+            fail_msg("%s returned %s, expected %s (%s)", #call, lpi_status_name(lpi_status_), \
+                     lpi_status_name(expected), lpi_last_error(sys));                     \
+        const char *lpi_msg_ = lpi_last_error(sys);                                       \
+        if (strstr(lpi_msg_, function) == NULL)                                           \
+            fail_msg("message '%s' does not name %s", lpi_msg_, function);                \
+        if (sys) lpi_assert_unchanged(sys, &lpi_before_);                                 \
+    } while (0)
+
+/* Classical RK4 written independently of the library, for references. */
+typedef void (*lpi_test_field)(const double *x, double *dx, const void *ctx);
+
+static inline void lpi_test_rk4(lpi_test_field f, const void *ctx, size_t n, double *x,
+                                double T, int64_t steps) {
+    double k1[64], k2[64], k3[64], k4[64], y[64];
+    const double h = T / (double)steps;
+    assert_true(n <= 64);
+    for (int64_t s = 0; s < steps; ++s) {
+        f(x, k1, ctx);
+        for (size_t i = 0; i < n; ++i) y[i] = x[i] + 0.5 * h * k1[i];
+        f(y, k2, ctx);
+        for (size_t i = 0; i < n; ++i) y[i] = x[i] + 0.5 * h * k2[i];
+        f(y, k3, ctx);
+        for (size_t i = 0; i < n; ++i) y[i] = x[i] + h * k3[i];
+        f(y, k4, ctx);
+        for (size_t i = 0; i < n; ++i) x[i] += h / 6.0 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+    }
+}
+
+/* Least-squares slope of log(error) against log(step). */
+static inline double lpi_fit_order(const double *steps, const double *errors, int count) {
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int i = 0; i < count; ++i) {
+        const double lx = log(steps[i]), ly = log(errors[i]);
+        sx += lx; sy += ly; sxx += lx * lx; sxy += lx * ly;
+    }
+    return (count * sxy - sx * sy) / (count * sxx - sx * sx);
+}
+
+static inline double lpi_test_distance(const double *a, const double *b, size_t n) {
+    double s = 0;
+    for (size_t i = 0; i < n; ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
+    return sqrt(s);
+}
+
+/* Integrates sys from x0 to T with `steps` steps of `method` and returns the
+ * distance of the end state from `reference`. */
+static inline double lpi_test_error(lpi_system *sys, const char *method, const double *x0,
+                                    double T, int64_t steps, const double *reference) {
+    const size_t n = lpi_dim(sys);
+    double x[4096];
+    assert_int_equal(lpi_set_method(sys, method), LPI_OK);
+    assert_int_equal(lpi_set_state(sys, x0, n), LPI_OK);
+    assert_int_equal(lpi_step(sys, T / (double)steps, steps), LPI_OK);
+    assert_int_equal(lpi_get_state(sys, x, n), LPI_OK);
+    return lpi_test_distance(x, reference, n);
+}
+
+#endif

@@ -1,0 +1,204 @@
+/* The contract of every public function of the foundation: exact status codes
+ * for bad input, a message naming the function, and an unchanged state. */
+#include "lpi_test.h"
+
+static lpi_system *rigid_body(void) {
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_rigid_body_create(&sys, 1.0, 2.0, 3.0), LPI_OK);
+    const double m[3] = {1.0, 0.5, -0.3};
+    assert_int_equal(lpi_set_state(sys, m, 3), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.1, 3), LPI_OK); /* a nonzero time to keep */
+    return sys;
+}
+
+static void test_version_and_status_names(void **state) {
+    (void)state;
+    char expected[64];
+    snprintf(expected, sizeof expected, "%d.%d.%d", LPI_VERSION_MAJOR, LPI_VERSION_MINOR,
+             LPI_VERSION_PATCH);
+    assert_string_equal(lpi_version_string(), expected);
+    assert_string_equal(lpi_status_name(LPI_OK), "LPI_OK");
+    assert_string_equal(lpi_status_name(LPI_ERR_NULL), "LPI_ERR_NULL");
+    assert_string_equal(lpi_status_name(LPI_ERR_SIZE), "LPI_ERR_SIZE");
+    assert_string_equal(lpi_status_name(LPI_ERR_NOT_ABELIAN), "LPI_ERR_NOT_ABELIAN");
+    assert_string_equal(lpi_status_name(12345), "LPI_UNKNOWN_STATUS");
+    assert_string_equal(lpi_status_message(12345), "unknown status code");
+    /* Every code has a distinct name and a non-empty message. */
+    const int codes[] = {LPI_OK, LPI_ERR_NULL, LPI_ERR_INVALID, LPI_ERR_SIZE, LPI_ERR_NONFINITE,
+                         LPI_ERR_NOT_ABELIAN, LPI_ERR_UNSUPPORTED, LPI_ERR_NO_MEMORY,
+                         LPI_ERR_INTERNAL, LPI_ERR_CALLBACK};
+    const size_t count = sizeof codes / sizeof codes[0];
+    for (size_t i = 0; i < count; ++i) {
+        assert_true(strlen(lpi_status_message(codes[i])) > 0);
+        assert_true(codes[i] == LPI_OK || codes[i] < 0);
+        for (size_t j = 0; j < i; ++j)
+            assert_string_not_equal(lpi_status_name(codes[i]), lpi_status_name(codes[j]));
+    }
+}
+
+static void test_method_registry(void **state) {
+    (void)state;
+    const int count = lpi_method_count();
+    assert_true(count >= 3);
+    int found_leapfrog = 0, found_lie_trotter = 0;
+    for (int i = 0; i < count; ++i) {
+        assert_non_null(lpi_method_name(i));
+        assert_true(lpi_method_order(i) >= 1);
+        if (strcmp(lpi_method_name(i), "leapfrog") == 0) {
+            found_leapfrog = 1;
+            assert_int_equal(lpi_method_order(i), 2);
+        }
+        if (strcmp(lpi_method_name(i), "lie-trotter") == 0) {
+            found_lie_trotter = 1;
+            assert_int_equal(lpi_method_order(i), 1);
+        }
+    }
+    assert_true(found_leapfrog && found_lie_trotter);
+    assert_null(lpi_method_name(-1));
+    assert_null(lpi_method_name(count));
+    assert_int_equal(lpi_method_order(-1), -1);
+    assert_int_equal(lpi_method_order(count), -1);
+}
+
+static void test_create_rejects_bad_inertia(void **state) {
+    (void)state;
+    lpi_system *sys = (lpi_system *)0x1; /* must be reset to NULL on failure */
+    const struct {
+        double I[3];
+        int status;
+    } cases[] = {
+        {{NAN, 1, 1}, LPI_ERR_NONFINITE},      {{1, INFINITY, 1}, LPI_ERR_NONFINITE},
+        {{1, 1, -INFINITY}, LPI_ERR_NONFINITE}, {{0, 1, 1}, LPI_ERR_INVALID},
+        {{1, -2, 1}, LPI_ERR_INVALID},          {{1, 1, -0.0}, LPI_ERR_INVALID},
+        {{1, 1, 1e-320}, LPI_ERR_INVALID}, /* 1/I overflows */
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        sys = (lpi_system *)0x1;
+        LPI_ASSERT_FAILS(NULL, lpi_rigid_body_create(&sys, cases[i].I[0], cases[i].I[1], cases[i].I[2]),
+                         cases[i].status, "lpi_rigid_body_create");
+        assert_null(sys);
+    }
+    LPI_ASSERT_FAILS(NULL, lpi_rigid_body_create(NULL, 1, 2, 3), LPI_ERR_NULL, "lpi_rigid_body_create");
+    LPI_ASSERT_FAILS(NULL, lpi_pendulum_create(NULL), LPI_ERR_NULL, "lpi_pendulum_create");
+    assert_true(strstr(lpi_last_error(NULL), "out") != NULL);
+}
+
+static void test_null_handle(void **state) {
+    (void)state;
+    double x[3] = {0}, e;
+    LPI_ASSERT_FAILS(NULL, lpi_set_method(NULL, "leapfrog"), LPI_ERR_NULL, "lpi_set_method");
+    LPI_ASSERT_FAILS(NULL, lpi_set_split(NULL, "axes"), LPI_ERR_NULL, "lpi_set_split");
+    LPI_ASSERT_FAILS(NULL, lpi_set_state(NULL, x, 3), LPI_ERR_NULL, "lpi_set_state");
+    LPI_ASSERT_FAILS(NULL, lpi_get_state(NULL, x, 3), LPI_ERR_NULL, "lpi_get_state");
+    LPI_ASSERT_FAILS(NULL, lpi_step(NULL, 0.1, 1), LPI_ERR_NULL, "lpi_step");
+    LPI_ASSERT_FAILS(NULL, lpi_energy(NULL, &e), LPI_ERR_NULL, "lpi_energy");
+    LPI_ASSERT_FAILS(NULL, lpi_casimirs(NULL, x, 1), LPI_ERR_NULL, "lpi_casimirs");
+    assert_int_equal(lpi_dim(NULL), 0);
+    assert_int_equal(lpi_casimir_count(NULL), 0);
+    assert_true(isnan(lpi_time(NULL)));
+    lpi_destroy(NULL);
+}
+
+static void test_bad_arguments_leave_state_unchanged(void **state) {
+    (void)state;
+    lpi_system *sys = rigid_body();
+    double x[4] = {1, 2, 3, 4}, e, c[2];
+    const double nan_state[3] = {1, NAN, 0}, inf_state[3] = {INFINITY, 0, 0};
+
+    LPI_ASSERT_FAILS(sys, lpi_set_method(sys, NULL), LPI_ERR_NULL, "lpi_set_method");
+    LPI_ASSERT_FAILS(sys, lpi_set_method(sys, "no-such-method"), LPI_ERR_INVALID, "lpi_set_method");
+    assert_non_null(strstr(lpi_last_error(sys), "no-such-method"));
+    assert_non_null(strstr(lpi_last_error(sys), "leapfrog")); /* lists the known ones */
+    LPI_ASSERT_FAILS(sys, lpi_set_method(sys, ""), LPI_ERR_INVALID, "lpi_set_method");
+    LPI_ASSERT_FAILS(sys, lpi_set_split(sys, NULL), LPI_ERR_NULL, "lpi_set_split");
+    LPI_ASSERT_FAILS(sys, lpi_set_split(sys, "standard-map"), LPI_ERR_INVALID, "lpi_set_split");
+    assert_non_null(strstr(lpi_last_error(sys), "casimir-shift"));
+
+    LPI_ASSERT_FAILS(sys, lpi_set_state(sys, NULL, 3), LPI_ERR_NULL, "lpi_set_state");
+    LPI_ASSERT_FAILS(sys, lpi_set_state(sys, x, 2), LPI_ERR_SIZE, "lpi_set_state");
+    LPI_ASSERT_FAILS(sys, lpi_set_state(sys, x, 4), LPI_ERR_SIZE, "lpi_set_state");
+    LPI_ASSERT_FAILS(sys, lpi_set_state(sys, nan_state, 3), LPI_ERR_NONFINITE, "lpi_set_state");
+    LPI_ASSERT_FAILS(sys, lpi_set_state(sys, inf_state, 3), LPI_ERR_NONFINITE, "lpi_set_state");
+
+    LPI_ASSERT_FAILS(sys, lpi_get_state(sys, NULL, 3), LPI_ERR_NULL, "lpi_get_state");
+    LPI_ASSERT_FAILS(sys, lpi_get_state(sys, x, 0), LPI_ERR_SIZE, "lpi_get_state");
+    LPI_ASSERT_FAILS(sys, lpi_get_state(sys, x, 4), LPI_ERR_SIZE, "lpi_get_state");
+
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, NAN, 1), LPI_ERR_NONFINITE, "lpi_step");
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, INFINITY, 1), LPI_ERR_NONFINITE, "lpi_step");
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, -INFINITY, 1), LPI_ERR_NONFINITE, "lpi_step");
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.0, 1), LPI_ERR_INVALID, "lpi_step");
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.1, -1), LPI_ERR_INVALID, "lpi_step");
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 1e308, INT64_MAX), LPI_ERR_INVALID, "lpi_step");
+
+    LPI_ASSERT_FAILS(sys, lpi_energy(sys, NULL), LPI_ERR_NULL, "lpi_energy");
+    LPI_ASSERT_FAILS(sys, lpi_casimirs(sys, NULL, 1), LPI_ERR_NULL, "lpi_casimirs");
+    LPI_ASSERT_FAILS(sys, lpi_casimirs(sys, c, 0), LPI_ERR_SIZE, "lpi_casimirs");
+    LPI_ASSERT_FAILS(sys, lpi_casimirs(sys, c, 2), LPI_ERR_SIZE, "lpi_casimirs");
+
+    /* Valid calls still work afterwards, and zero steps is a no-op. */
+    lpi_snapshot before;
+    lpi_take_snapshot(sys, &before);
+    assert_int_equal(lpi_step(sys, 0.1, 0), LPI_OK);
+    lpi_assert_unchanged(sys, &before);
+    assert_int_equal(lpi_energy(sys, &e), LPI_OK);
+    assert_true(e > 0);
+    lpi_destroy(sys);
+}
+
+/* A step whose result overflows is rolled back: RK4 with an absurd step. */
+static void test_nonfinite_step_is_rolled_back(void **state) {
+    (void)state;
+    lpi_system *sys = rigid_body();
+    assert_int_equal(lpi_set_method(sys, "rk4"), LPI_OK);
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 1e200, 3), LPI_ERR_NONFINITE, "lpi_step");
+    assert_non_null(strstr(lpi_last_error(sys), "rolled back"));
+    /* A long run that blows up part way is rolled back to its start too. */
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 50.0, 100000), LPI_ERR_NONFINITE, "lpi_step");
+    /* The splitting methods stay finite at any step size: rotations only. */
+    assert_int_equal(lpi_set_method(sys, "leapfrog"), LPI_OK);
+    assert_int_equal(lpi_step(sys, 1e200, 3), LPI_OK);
+    double m[3];
+    assert_int_equal(lpi_get_state(sys, m, 3), LPI_OK);
+    for (int i = 0; i < 3; ++i) assert_true(isfinite(m[i]));
+    lpi_destroy(sys);
+}
+
+static void test_successful_calls(void **state) {
+    (void)state;
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_pendulum_create(&sys), LPI_OK);
+    assert_int_equal(lpi_dim(sys), 3);
+    assert_int_equal(lpi_casimir_count(sys), 1);
+    assert_string_equal(lpi_last_error(sys), "");
+    assert_int_equal(lpi_set_split(sys, "standard-map"), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "strang"), LPI_OK); /* alias of leapfrog */
+    const double x0[3] = {0.6, -0.8, 0.25};
+    assert_int_equal(lpi_set_state(sys, x0, 3), LPI_OK);
+    assert_true(lpi_time(sys) == 0.0);
+    double h, c;
+    assert_int_equal(lpi_energy(sys, &h), LPI_OK);
+    assert_true(fabs(h - (0.5 * 0.25 * 0.25 - 0.8)) < 1e-15);
+    assert_int_equal(lpi_casimirs(sys, &c, 1), LPI_OK);
+    assert_true(fabs(c - 1.0) < 1e-15);
+    assert_int_equal(lpi_step(sys, -0.01, 100), LPI_OK); /* backwards in time */
+    assert_true(fabs(lpi_time(sys) + 1.0) < 1e-12);
+    assert_int_equal(lpi_step(sys, 0.01, 100), LPI_OK); /* and back: symmetric method */
+    double x[3];
+    assert_int_equal(lpi_get_state(sys, x, 3), LPI_OK);
+    assert_true(lpi_test_distance(x, x0, 3) < 1e-13);
+    lpi_destroy(sys);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_version_and_status_names),
+        cmocka_unit_test(test_method_registry),
+        cmocka_unit_test(test_create_rejects_bad_inertia),
+        cmocka_unit_test(test_null_handle),
+        cmocka_unit_test(test_bad_arguments_leave_state_unchanged),
+        cmocka_unit_test(test_nonfinite_step_is_rolled_back),
+        cmocka_unit_test(test_successful_calls),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
