@@ -1,5 +1,7 @@
 #include "methods.hpp"
 
+#include <cmath>
+
 #include "error.hpp"
 
 namespace lpi {
@@ -36,6 +38,13 @@ std::vector<Method> make_table() {
                              "adjoint of lie-trotter (pieces in reverse order)"));
     table.push_back(composition("leapfrog", 2, {1.0},
                                 "G. Strang, SIAM J. Numer. Anal. 5 (1968) 506; McLachlan 1993"));
+    {
+        const double cube_root_2 = std::cbrt(2.0);
+        const double outer = 1.0 / (2.0 - cube_root_2);
+        table.push_back(composition("triple-jump-4", 4, {outer, 1.0 - 2.0 * outer, outer},
+                                    "H. Yoshida, Phys. Lett. A 150 (1990) 262; M. Creutz and "
+                                    "A. Gocksch, Phys. Rev. Lett. 63 (1989) 9"));
+    }
     Method rk4;
     rk4.name = "rk4";
     rk4.order = 4;
