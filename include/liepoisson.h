@@ -46,7 +46,8 @@ extern "C" {
     X(LPI_ERR_UNSUPPORTED, -6, "not built in, or not defined for this system")      \
     X(LPI_ERR_NO_MEMORY, -7, "out of memory")                                       \
     X(LPI_ERR_INTERNAL, -8, "internal error (please report it)")                   \
-    X(LPI_ERR_CALLBACK, -9, "a user callback reported failure")
+    X(LPI_ERR_CALLBACK, -9, "a user callback reported failure")                     \
+    X(LPI_ERR_NO_CONVERGENCE, -10, "an implicit method's iteration did not converge")
 
 typedef enum lpi_status {
 #define LPI_STATUS_ENUM_ENTRY(name, value, message) name = value,
