@@ -77,6 +77,12 @@ LPI_API int lpi_method_order(int i);
  * rotations, the paper's), "axes" (three rotations, one per axis). */
 LPI_API int lpi_rigid_body_create(lpi_system **out, double I1, double I2, double I3);
 
+/* The exact free rigid-body solution (Jacobi elliptic functions): out = m at
+ * time lpi_time(sys) + t, starting from the current state, which is not
+ * changed. Every case: either side of the separatrix, the separatrix,
+ * symmetric bodies, steady rotation. LPI_ERR_UNSUPPORTED for other systems. */
+LPI_API int lpi_rigid_body_exact(const lpi_system *sys, double t, double *out);
+
 /* Planar pendulum on e(2): H = x3^2/2 + x2, Casimir x1^2 + x2^2.
  * Split: "standard-map" (the only one). */
 LPI_API int lpi_pendulum_create(lpi_system **out);

@@ -11,6 +11,9 @@ namespace lpi {
 std::unique_ptr<Model> make_rigid_body(double I1, double I2, double I3);
 std::unique_ptr<Model> make_pendulum();
 
+// The inertias of a rigid-body model; false when `model` is another kind.
+bool rigid_body_inertia(const Model &model, double inertia[3]);
+
 // The small built-in models keep their state compensated: the working layout
 // is [x, carry], the value is x + carry, and every flow adds an increment with
 // Kahan summation. Round-off in the Casimirs then stays O(u) instead of

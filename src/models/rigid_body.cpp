@@ -12,7 +12,8 @@ namespace {
 
 class RigidBody final : public CompensatedModel {
 public:
-    RigidBody(double I1, double I2, double I3) : inverse_{1.0 / I1, 1.0 / I2, 1.0 / I3} {}
+    RigidBody(double I1, double I2, double I3)
+        : inertia_{I1, I2, I3}, inverse_{1.0 / I1, 1.0 / I2, 1.0 / I3} {}
 
     const char *kind() const override { return "rigid-body"; }
     std::size_t dim() const override { return 3; }
@@ -20,6 +21,7 @@ public:
     std::vector<std::string> split_names() const override { return split_.names(); }
     void set_split(const std::string &name) override { split_.select(name, kind()); }
     std::string split() const override { return split_.current(); }
+    double inertia(int axis) const { return inertia_[axis]; }
     std::size_t piece_count() const override { return split_.index() == kCasimirShift ? 2 : 3; }
 
     void flow(std::size_t piece, double t, double *state) override {
@@ -56,6 +58,7 @@ public:
 
 private:
     static constexpr std::size_t kCasimirShift = 0;
+    double inertia_[3];
     double inverse_[3];
     SplitChoice split_{{"casimir-shift", "axes"}};
 };
@@ -69,6 +72,13 @@ void check_inertia(const char *name, double I) {
 }
 
 }  // namespace
+
+bool rigid_body_inertia(const Model &model, double inertia[3]) {
+    const auto *body = dynamic_cast<const RigidBody *>(&model);
+    if (!body) return false;
+    for (int k = 0; k < 3; ++k) inertia[k] = body->inertia(k);
+    return true;
+}
 
 std::unique_ptr<Model> make_rigid_body(double I1, double I2, double I3) {
     check_inertia("I1", I1);

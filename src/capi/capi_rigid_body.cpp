@@ -1,0 +1,32 @@
+// The C ABI of the rigid body's exact solution (a reference, beside the
+// integrators, never inside them).
+#include <cmath>
+
+#include "../models/models.hpp"
+#include "../reference/rigid_body_exact.hpp"
+#include "handle.hpp"
+
+using lpi::capi::guarded;
+using lpi::capi::require;
+
+extern "C" {
+
+LPI_API int lpi_rigid_body_exact(const lpi_system *sys, double t, double *out) {
+    return guarded(sys, "lpi_rigid_body_exact", [&] {
+        require(sys, "system");
+        require(out, "out");
+        if (!std::isfinite(t)) lpi::fail(LPI_ERR_NONFINITE, "t is not finite");
+        double inertia[3], m0[3], m[3];
+        if (!lpi::rigid_body_inertia(sys->system.model(), inertia))
+            lpi::fail(LPI_ERR_UNSUPPORTED, std::string("the exact solution is defined for the "
+                                                       "rigid body, not for ") +
+                                               sys->system.model().kind());
+        sys->system.get_state(m0, 3);
+        lpi::rigid_body_exact(inertia, m0, t, m);
+        if (!std::isfinite(m[0]) || !std::isfinite(m[1]) || !std::isfinite(m[2]))
+            lpi::fail(LPI_ERR_NONFINITE, "the exact solution is not finite at this t");
+        out[0] = m[0], out[1] = m[1], out[2] = m[2];
+    });
+}
+
+}  // extern "C"
