@@ -27,7 +27,7 @@ check: build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
 run: build
-	@$(BUILD)/lpi report
+	@$(BUILD)/lpi report --out $(BUILD)/report
 
 bench: build
 	@cmake --build $(BUILD) -j $(JOBS) --target benchmarks

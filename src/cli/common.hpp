@@ -1,0 +1,63 @@
+// Small helpers shared by the lpi subcommands. The command uses only the
+// public C API, as any user program would.
+#pragma once
+
+#include <liepoisson.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <string>
+#include <vector>
+
+namespace lpi_cli {
+
+inline double cpu_seconds() {
+    timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// Exits with the library's message: the command (never the library) stops.
+inline void check(int status, const lpi_system *sys, const char *what) {
+    if (status == LPI_OK) return;
+    std::fprintf(stderr, "lpi: %s failed: %s (%s)\n", what, lpi_last_error(sys),
+                 lpi_status_name(status));
+    std::exit(1);
+}
+
+// Owns one handle.
+class Handle {
+public:
+    Handle() = default;
+    explicit Handle(lpi_system *sys) : sys_(sys) {}
+    Handle(const Handle &) = delete;
+    Handle &operator=(const Handle &) = delete;
+    Handle(Handle &&other) noexcept : sys_(other.sys_) { other.sys_ = nullptr; }
+    ~Handle() { lpi_destroy(sys_); }
+    lpi_system *get() const { return sys_; }
+    lpi_system **out() { return &sys_; }
+
+private:
+    lpi_system *sys_ = nullptr;
+};
+
+inline std::vector<double> state_of(const lpi_system *sys) {
+    std::vector<double> x(lpi_dim(sys));
+    check(lpi_get_state(sys, x.data(), x.size()), sys, "get state");
+    return x;
+}
+
+inline std::vector<double> casimirs_of(const lpi_system *sys) {
+    std::vector<double> c(lpi_casimir_count(sys));
+    check(lpi_casimirs(sys, c.data(), c.size()), sys, "casimirs");
+    return c;
+}
+
+inline double energy_of(const lpi_system *sys) {
+    double h = 0.0;
+    check(lpi_energy(sys, &h), sys, "energy");
+    return h;
+}
+
+}  // namespace lpi_cli

@@ -1,0 +1,19 @@
+// `lpi report`: a work-precision table (error against CPU time) for every
+// applicable method over a sweep of step sizes, written as text, CSV and PNG.
+#pragma once
+
+#include <string>
+
+#include "scenes.hpp"
+
+namespace lpi_cli {
+
+struct ReportOptions {
+    std::string out_dir = "lpi-report";
+    double min_timing_seconds = 0.05;  // repeat a timed run until it lasts this long
+    int samples = 200;                 // energy/Casimir samples per diagnostic run
+};
+
+void run_report(const Scene &scene, const ReportOptions &options);
+
+}  // namespace lpi_cli
