@@ -120,6 +120,28 @@ LPI_API int lpi_casimirs(const lpi_system *sys, double *out, size_t n);
  * valid until the next call on the same handle (or thread). */
 LPI_API const char *lpi_last_error(const lpi_system *sys);
 
+/* ---- Composition methods ------------------------------------------------- */
+
+/* Leapfrog stages per step of method i (1 for the sequences and rk4) and the
+ * publication it comes from; -1 / NULL for i out of range. Besides the listed
+ * methods, lpi_set_method accepts "triple-jump-<p>" and "suzuki-<p>" for even
+ * p from 2 to 16 (recursive compositions with 3^(p/2-1) and 5^(p/2-1) stages). */
+LPI_API int lpi_method_stages(int i);
+LPI_API const char *lpi_method_reference(int i);
+
+/* Makes the method a symmetric composition of leapfrog with the n >= 1 weights
+ * gammas (step i takes gammas[i] * dt), named "custom". The weights must be
+ * finite (else LPI_ERR_NONFINITE), sum to 1 within 1e-14 times the sum of
+ * their absolute values and be symmetric, gammas[i] = gammas[n-1-i] within a
+ * relative 1e-14 (else LPI_ERR_INVALID). Mirrored pairs are replaced by their
+ * mean, so the composition is exactly symmetric. The array is copied. */
+LPI_API int lpi_set_composition(lpi_system *sys, size_t n, const double *gammas);
+
+/* Exact piece flows per step in a long run of the current method, after the
+ * flows of the same piece that meet at stage seams and across steps are
+ * merged (for rk4: vector-field evaluations per step). */
+LPI_API int lpi_flows_per_step(const lpi_system *sys, size_t *out);
+
 #ifdef __cplusplus
 }
 #endif

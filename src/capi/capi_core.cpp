@@ -50,18 +50,6 @@ LPI_API const char *lpi_status_message(int status) {
     return "unknown status code";
 }
 
-LPI_API int lpi_method_count(void) { return static_cast<int>(lpi::method_table().size()); }
-
-LPI_API const char *lpi_method_name(int i) {
-    const auto &table = lpi::method_table();
-    return i >= 0 && static_cast<std::size_t>(i) < table.size() ? table[i].name.c_str() : nullptr;
-}
-
-LPI_API int lpi_method_order(int i) {
-    const auto &table = lpi::method_table();
-    return i >= 0 && static_cast<std::size_t>(i) < table.size() ? table[i].order : -1;
-}
-
 LPI_API int lpi_rigid_body_create(lpi_system **out, double I1, double I2, double I3) {
     return create(out, "lpi_rigid_body_create", [&] { return lpi::make_rigid_body(I1, I2, I3); });
 }

@@ -29,9 +29,27 @@ struct Method {
 // The registered methods, in the order lpi_method_name(i) lists them.
 const std::vector<Method> &method_table();
 
-// Looks a method up by name or alias; throws lpi::Error(LPI_ERR_INVALID)
-// naming the known methods when there is none.
+// Looks a method up by name or alias; also builds the recursive compositions
+// "triple-jump-<p>" and "suzuki-<p>" for even p in 2..kMaxRecursiveOrder.
+// Throws lpi::Error(LPI_ERR_INVALID) naming the known methods when there is none.
 Method find_method(const std::string &name);
+
+// Highest order p accepted in "triple-jump-<p>" / "suzuki-<p>" (suzuki-16
+// already has 5^7 = 78125 stages).
+constexpr int kMaxRecursiveOrder = 16;
+
+// Weights of the recursive compositions of leapfrog for even order >= 2:
+// Yoshida's triple jump (3^(p/2-1) stages) and Suzuki's fractal
+// (5^(p/2-1) stages). Order 2 is leapfrog itself.
+std::vector<double> triple_jump_gammas(int order);
+std::vector<double> suzuki_gammas(int order);
+
+// A user-supplied symmetric composition of leapfrog, named "custom" (order
+// reported as 2, the least it has). Requires n >= 1 finite weights summing to
+// 1 and symmetric, both to a relative 1e-14; mirrored pairs are replaced by
+// their mean so the stored composition is exactly symmetric. Throws
+// lpi::Error naming the offending weight otherwise.
+Method custom_composition(const double *gammas, std::size_t n);
 
 // One exact piece flow of a splitting step: piece `piece` for weight * dt.
 struct Flow {

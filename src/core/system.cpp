@@ -27,6 +27,13 @@ void System::set_method(const std::string &name) {
     integrator_ = std::move(integrator);
 }
 
+void System::set_composition(const double *gammas, std::size_t n) {
+    Method method = custom_composition(gammas, n);
+    auto integrator = make_integrator(method, *model_);
+    method_ = std::move(method);
+    integrator_ = std::move(integrator);
+}
+
 void System::set_split(const std::string &name) {
     const std::string previous = model_->split();
     model_->set_split(name);  // throws, unchanged, if unknown

@@ -23,6 +23,10 @@ public:
     const Method &method() const { return method_; }
 
     void set_method(const std::string &name);
+    // A user-supplied symmetric composition of leapfrog (see custom_composition).
+    void set_composition(const double *gammas, std::size_t n);
+    // Piece flows (RK4: vector-field evaluations) per step in a long run.
+    std::size_t flows_per_step() const { return integrator_->evaluations_per_step(); }
     void set_split(const std::string &name);
 
     std::size_t dim() const { return model_->dim(); }
