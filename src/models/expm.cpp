@@ -131,12 +131,12 @@ void pade13(std::size_t n, const double *A, double *U, double *V) {
 
 }  // namespace
 
-void expm_dense(std::size_t n, const double *A, double *E) {
+void expm1_dense(std::size_t n, const double *A, double *W) {
     if (n == 0) return;
     const std::size_t nn = n * n;
     const double norm = norm1(n, A);
     if (!std::isfinite(norm)) {
-        std::fill(E, E + nn, std::numeric_limits<double>::quiet_NaN());
+        std::fill(W, W + nn, std::numeric_limits<double>::quiet_NaN());
         return;
     }
     Matrix U(nn), V(nn), Q(nn);
@@ -157,15 +157,23 @@ void expm_dense(std::size_t n, const double *A, double *E) {
         for (double &a : scaled) a = std::ldexp(a, -squarings);
         pade13(n, scaled.data(), U.data(), V.data());
     }
+    // r - I = (V - U)^{-1} (V + U) - I = (V - U)^{-1} (2U): no cancellation, so
+    // the result is accurate relative to ||A|| even when exp(A) is close to I.
     for (std::size_t e = 0; e < nn; ++e) {
         Q[e] = V[e] - U[e];
-        E[e] = V[e] + U[e];
+        W[e] = 2.0 * U[e];
     }
-    solve(n, Q.data(), E);
+    solve(n, Q.data(), W);
+    // (I + W)^2 - I = W W + 2 W.
     for (int s = 0; s < squarings; ++s) {
-        multiply(n, E, E, Q.data());
-        std::copy(Q.begin(), Q.end(), E);
+        multiply(n, W, W, Q.data());
+        for (std::size_t e = 0; e < nn; ++e) W[e] = Q[e] + 2.0 * W[e];
     }
+}
+
+void expm_dense(std::size_t n, const double *A, double *E) {
+    expm1_dense(n, A, E);
+    for (std::size_t i = 0; i < n; ++i) E[i * n + i] += 1.0;
 }
 
 long ExpmWorkspace::topological_depth() {
@@ -244,13 +252,15 @@ ExpmPath ExpmWorkspace::apply(std::size_t n, const std::vector<SparseEntry> &ent
     dense_.assign(m * m, 0.0);
     for (const SparseEntry &e : local_) dense_[e.row * m + e.col] += e.value;
     exp_.resize(m * m);
-    expm_dense(m, dense_.data(), exp_.data());
+    expm1_dense(m, dense_.data(), exp_.data());
+    // x += (exp(tA) - I) x: the increment carries its own small rounding
+    // errors, and x is rounded once (as in the nilpotent branch).
     term_.resize(m);
     for (std::size_t v = 0; v < m; ++v) term_[v] = x[active_[v]];
     for (std::size_t r = 0; r < m; ++r) {
         double s = 0.0;
         for (std::size_t c = 0; c < m; ++c) s += exp_[r * m + c] * term_[c];
-        x[active_[r]] = s;
+        x[active_[r]] += s;
     }
     return ExpmPath::Pade;
 }

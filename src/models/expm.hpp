@@ -19,6 +19,9 @@ namespace lpi {
 // Dense exponential E = exp(A), both n x n row-major. Accurate to round-off
 // relative to the conditioning of exp at A (Higham 2005).
 void expm_dense(std::size_t n, const double *A, double *E);
+// W = exp(A) - I, computed without cancellation: accurate relative to ||A||
+// when exp(A) is close to I (what the increment form of a flow needs).
+void expm1_dense(std::size_t n, const double *A, double *W);
 
 // A sparse n x n matrix in coordinate form; repeated (row, col) pairs add.
 struct SparseEntry {

@@ -16,6 +16,7 @@
 // F = diag(e^{lambda t/2}, e^{-lambda t/2}) exp(tM), det F = 1: elementary
 // functions only, and I, K (invariants of binary quartics under SL(2)) are
 // kept to round-off.
+#include <algorithm>
 #include <cmath>
 
 #include "../core/error.hpp"
@@ -58,42 +59,59 @@ public:
         const double b = x[0], a = x[2];
         const double mu = derivative(a * b);
         const double lambda = 4.0 * x[1] * mu;
-        const double grow = std::exp(0.5 * lambda * t), shrink = std::exp(-0.5 * lambda * t);
 
         // exp(tM) = c I + s M with M^2 = delta I, delta = -det M = 4 mu^2 (x2^2 - ab).
+        // Everything is formed as a difference from the identity (c - 1 from
+        // half-angle formulas, expm1 for the scalings) so that the map is
+        // applied as x + increment with errors relative to the increment:
+        // rounding F itself would bias det F away from 1 by the same amount
+        // every step, and I, K (weights 4 and 6 in det F) would drift.
         const double delta = 4.0 * mu * mu * (x[1] * x[1] - a * b);
-        double c = 1.0, s = t;
+        double c_minus_1 = 0.0, s = t;
         if (delta > 0.0) {
-            const double r = std::sqrt(delta);
-            c = std::cosh(r * t);
+            const double r = std::sqrt(delta), h = std::sinh(0.5 * r * t);
+            c_minus_1 = 2.0 * h * h;
             s = std::sinh(r * t) / r;
         } else if (delta < 0.0) {
-            const double r = std::sqrt(-delta);
-            c = std::cos(r * t);
+            const double r = std::sqrt(-delta), h = std::sin(0.5 * r * t);
+            c_minus_1 = -2.0 * h * h;
             s = std::sin(r * t) / r;
         }
-        const double F[2][2] = {{grow * (c - s * 0.5 * lambda), grow * s * 2.0 * mu * b},
-                                {shrink * s * (-2.0 * mu * a), shrink * (c + s * 0.5 * lambda)}};
+        const double grow_minus_1 = std::expm1(0.5 * lambda * t);
+        const double shrink_minus_1 = std::expm1(-0.5 * lambda * t);
+        // D = F - I, F = diag(e^{lambda t/2}, e^{-lambda t/2}) (c I + s M).
+        const double D[2][2] = {
+            {grow_minus_1 + (1.0 + grow_minus_1) * (c_minus_1 - 0.5 * s * lambda),
+             (1.0 + grow_minus_1) * s * 2.0 * mu * b},
+            {(1.0 + shrink_minus_1) * s * (-2.0 * mu * a),
+             shrink_minus_1 + (1.0 + shrink_minus_1) * (c_minus_1 + 0.5 * s * lambda)}};
 
-        // Row r of Sym^4(F): coefficients on q^(4-c) p^c of
-        // (F11 q + F12 p)^(4-r) (F21 q + F22 p)^r.
-        double y[5];
+        // Row r of Sym^4(F) - I: coefficients on q^(4-k) p^k of
+        // (q + D0.(q,p))^(4-r) (p + D1.(q,p))^r minus the monomial q^(4-r) p^r,
+        // expanded as (monomial + E)(unit + d) = monomial*unit + (monomial*d + E*unit + E*d).
+        double increment[5];
         for (int r = 0; r < 5; ++r) {
-            double poly[5] = {1, 0, 0, 0, 0};
-            int degree = 0;
+            double E[6] = {0, 0, 0, 0, 0, 0}, next[6];
+            int exponent = 0;  // of p in the exact monomial part
             for (int f = 0; f < 4; ++f) {
-                const double *row = f < 4 - r ? F[0] : F[1];
-                for (int k = degree + 1; k > 0; --k) poly[k] = poly[k] * row[0] + poly[k - 1] * row[1];
-                poly[0] *= row[0];
-                ++degree;
+                const bool unit_p = f >= 4 - r;
+                const double *d = D[unit_p ? 1 : 0];
+                for (int k = 0; k < 6; ++k) {
+                    const double shifted = k > 0 ? E[k - 1] : 0.0;
+                    next[k] = (unit_p ? shifted : E[k]) + E[k] * d[0] + shifted * d[1];
+                }
+                next[exponent] += d[0];
+                next[exponent + 1] += d[1];
+                exponent += unit_p ? 1 : 0;
+                std::copy(next, next + 6, E);
             }
             double sum = 0.0;
-            for (int k = 0; k < 5; ++k) sum += poly[k] * x[3 + k];
-            y[r] = sum;
+            for (int k = 0; k < 5; ++k) sum += E[k] * x[3 + k];
+            increment[r] = sum;
         }
-        for (int r = 0; r < 5; ++r) x[3 + r] = y[r];
-        x[0] = grow * grow * b;
-        x[2] = shrink * shrink * a;
+        for (int r = 0; r < 5; ++r) x[3 + r] += increment[r];
+        x[0] = b + b * std::expm1(lambda * t);
+        x[2] = a + a * std::expm1(-lambda * t);
     }
 
     double energy(const double *x) const override {
