@@ -129,33 +129,61 @@ void pade13(std::size_t n, const double *A, double *U, double *V) {
     for (std::size_t i = 0; i < n; ++i) V[i * n + i] += b[0];
 }
 
+// U, V of the Pade approximant chosen for A (Higham 2005, Algorithm 2.3) and
+// the number of squarings s: exp(A) ~ r(A / 2^s)^(2^s), r = (V - U)^{-1} (V + U).
+// Returns false for a non-finite A.
+bool pade_terms(std::size_t n, const double *A, Matrix &U, Matrix &V, int &squarings) {
+    const std::size_t nn = n * n;
+    const double norm = norm1(n, A);
+    if (!std::isfinite(norm)) return false;
+    U.resize(nn);
+    V.resize(nn);
+    squarings = 0;
+    for (const Degree &d : kDegrees) {
+        if (d.m < 13 && norm <= d.theta) {
+            pade_low(n, A, d.m, U.data(), V.data());
+            return true;
+        }
+    }
+    // Scale A by 2^-s so that ||A / 2^s||_1 <= theta_13 (exact: a power of 2).
+    if (norm > kDegrees[4].theta)
+        squarings = std::max(0, static_cast<int>(std::ceil(std::log2(norm / kDegrees[4].theta))));
+    Matrix scaled(A, A + nn);
+    for (double &a : scaled) a = std::ldexp(a, -squarings);
+    pade13(n, scaled.data(), U.data(), V.data());
+    return true;
+}
+
 }  // namespace
+
+void expm_dense(std::size_t n, const double *A, double *E) {
+    if (n == 0) return;
+    const std::size_t nn = n * n;
+    Matrix U, V, Q(nn);
+    int squarings = 0;
+    if (!pade_terms(n, A, U, V, squarings)) {
+        std::fill(E, E + nn, std::numeric_limits<double>::quiet_NaN());
+        return;
+    }
+    for (std::size_t e = 0; e < nn; ++e) {
+        Q[e] = V[e] - U[e];
+        E[e] = V[e] + U[e];
+    }
+    solve(n, Q.data(), E);
+    for (int s = 0; s < squarings; ++s) {
+        multiply(n, E, E, Q.data());
+        std::copy(Q.begin(), Q.end(), E);
+    }
+}
 
 void expm1_dense(std::size_t n, const double *A, double *W) {
     if (n == 0) return;
     const std::size_t nn = n * n;
-    const double norm = norm1(n, A);
-    if (!std::isfinite(norm)) {
+    Matrix U, V, Q(nn);
+    int squarings = 0;
+    if (!pade_terms(n, A, U, V, squarings)) {
         std::fill(W, W + nn, std::numeric_limits<double>::quiet_NaN());
         return;
-    }
-    Matrix U(nn), V(nn), Q(nn);
-    int squarings = 0;
-    bool done = false;
-    for (const Degree &d : kDegrees) {
-        if (d.m < 13 && norm <= d.theta) {
-            pade_low(n, A, d.m, U.data(), V.data());
-            done = true;
-            break;
-        }
-    }
-    if (!done) {
-        // Scale A by 2^-s so that ||A / 2^s||_1 <= theta_13 (exact: a power of 2).
-        if (norm > kDegrees[4].theta)
-            squarings = std::max(0, static_cast<int>(std::ceil(std::log2(norm / kDegrees[4].theta))));
-        Matrix scaled(A, A + nn);
-        for (double &a : scaled) a = std::ldexp(a, -squarings);
-        pade13(n, scaled.data(), U.data(), V.data());
     }
     // r - I = (V - U)^{-1} (V + U) - I = (V - U)^{-1} (2U): no cancellation, so
     // the result is accurate relative to ||A|| even when exp(A) is close to I.
@@ -169,11 +197,6 @@ void expm1_dense(std::size_t n, const double *A, double *W) {
         multiply(n, W, W, Q.data());
         for (std::size_t e = 0; e < nn; ++e) W[e] = Q[e] + 2.0 * W[e];
     }
-}
-
-void expm_dense(std::size_t n, const double *A, double *E) {
-    expm1_dense(n, A, E);
-    for (std::size_t i = 0; i < n; ++i) E[i * n + i] += 1.0;
 }
 
 long ExpmWorkspace::topological_depth() {
