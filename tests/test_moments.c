@@ -314,6 +314,12 @@ static void test_separable_case(void **state) {
     lpi_destroy(sys);
 }
 
+static int nan_dh(double u, double *out, void *user) {
+    (void)u; (void)user;
+    *out = NAN;
+    return 0;
+}
+
 static void test_product_piece_errors(void **state) {
     (void)state;
     lpi_system *sys = full_system();
@@ -339,6 +345,16 @@ static void test_product_piece_errors(void **state) {
                      LPI_ERR_UNSUPPORTED, "lpi_moments_add_product_piece");
     lpi_destroy(generic);
     LPI_ASSERT_FAILS(NULL, lpi_moments_create(NULL), LPI_ERR_NULL, "lpi_moments_create");
+
+    /* A non-finite H' fails the step cleanly, naming the piece. */
+    lpi_system *bad = NULL;
+    assert_int_equal(lpi_moments_create(&bad), LPI_OK);
+    assert_int_equal(lpi_add_piece(bad, 2, kSet1, grad1, energy1, NULL), LPI_OK);
+    assert_int_equal(lpi_moments_add_product_piece(bad, product_h, nan_dh, NULL), LPI_OK);
+    assert_int_equal(lpi_set_state(bad, kX0, 8), LPI_OK);
+    LPI_ASSERT_FAILS(bad, lpi_step(bad, 0.1, 5), LPI_ERR_CALLBACK, "lpi_step");
+    assert_non_null(strstr(lpi_last_error(bad), "H' callback of piece 1 (product H(x1 x3))"));
+    lpi_destroy(bad);
 }
 
 int main(void) {
