@@ -141,6 +141,59 @@ LPI_API int lpi_set_composition(lpi_system *sys, size_t n, const double *gammas)
  * flows of the same piece that meet at stage seams and across steps are
  * merged (for rk4: vector-field evaluations per step). */
 LPI_API int lpi_flows_per_step(const lpi_system *sys, size_t *out);
+/* ---- Generic Lie-Poisson systems and the moment algebra ------------------ */
+
+/* Callbacks of user-defined systems. Each returns 0 on success; any other
+ * value (or a non-finite result) makes the calling function fail with
+ * LPI_ERR_CALLBACK, a message naming the piece or Casimir, and - for a step -
+ * the state rolled back. x_sigma and grad are in the order of the piece's
+ * indices; n is their count. */
+typedef int (*lpi_gradient_fn)(size_t n, const double *x_sigma, double *grad, void *user);
+typedef int (*lpi_energy_fn)(size_t n, const double *x_sigma, double *h, void *user);
+/* One Casimir C(x) of the full state x (length dim), written to *out. */
+typedef int (*lpi_casimir_fn)(size_t dim, const double *x, double *out, void *user);
+/* A scalar function of one variable (H(u) or H'(u) of the moment product piece). */
+typedef int (*lpi_scalar_fn)(double u, double *out, void *user);
+
+/* A Lie-Poisson system with {x_i, x_j} = sum c * x_k over the nnz entries
+ * (i[e], j[e], k[e], c[e]), 0-based indices below dim. Either order of i, j
+ * may be given; {x_j, x_i} = -{x_i, x_j} is implied, and entries that
+ * contradict it (or each other) are refused, as are constants violating the
+ * Jacobi identity (the message names the failing triple). The arrays may be
+ * NULL when nnz is 0. The system starts with no pieces and no Casimirs. */
+LPI_API int lpi_generic_create(lpi_system **out, size_t dim, size_t nnz, const int32_t *i,
+                               const int32_t *j, const int32_t *k, const double *c);
+
+/* Appends the piece H_k(x_sigma), sigma = indices[0..n-1] (distinct, 0-based,
+ * abelian: every bracket within sigma is zero, else LPI_ERR_NOT_ABELIAN naming
+ * the pair). Its flow is exact: x' = A x with A_il = sum_{j in sigma} c_ij^l
+ * g_j, g = grad H_k, solved by a finite series when A is nilpotent and a
+ * scaling-and-squaring Pade exponential otherwise. Pieces are composed in the
+ * order added. grad and energy are required; user is passed through. Works on
+ * systems from lpi_generic_create and lpi_moments_create. */
+LPI_API int lpi_add_piece(lpi_system *sys, size_t n, const int32_t *indices,
+                          lpi_gradient_fn grad, lpi_energy_fn energy, void *user);
+
+/* Declares one more Casimir, reported by lpi_casimirs after those already
+ * declared (lpi_casimir_count grows by one). */
+LPI_API int lpi_add_casimir(lpi_system *sys, lpi_casimir_fn fn, void *user);
+
+/* Numerical rank of the Poisson matrix J(x) (n = dim): singular values above
+ * dim * DBL_EPSILON * the largest. dim - rank is the number of independent
+ * Casimirs to expect near a generic x. */
+LPI_API int lpi_poisson_rank(const lpi_system *sys, const double *x, size_t n, size_t *rank);
+
+/* The 8-dimensional algebra of second and fourth moments (McLachlan 1993):
+ * x = (<q^2>, <qp>, <p^2>, <q^4>, <q^3 p>, <q^2 p^2>, <q p^3>, <p^4>), indices
+ * 0..7. Casimirs built in: I = x4 x8 - 4 x5 x7 + 3 x6^2 and
+ * K = det [[x4,x5,x6],[x5,x6,x7],[x6,x7,x8]] (1-based names as in the paper).
+ * Abelian index sets for lpi_add_piece: {0,3}, {1,5}, {2,7}, {3,4,5,6,7}. */
+LPI_API int lpi_moments_create(lpi_system **out);
+
+/* Appends the piece H(x1 x3) (indices 0 and 2, not abelian) with its closed-form
+ * flow; h and dh give H(u) and H'(u) at u = x1 x3. */
+LPI_API int lpi_moments_add_product_piece(lpi_system *sys, lpi_scalar_fn h, lpi_scalar_fn dh,
+                                          void *user);
 
 #ifdef __cplusplus
 }

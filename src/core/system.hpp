@@ -41,9 +41,11 @@ public:
     std::size_t casimir_count() const { return model_->casimir_count(); }
     void casimirs(double *out, std::size_t n) const;
 
-private:
+    // Rebuilds the integrator after the model's pieces changed (generic
+    // systems gain pieces after creation); throws, unchanged, on failure.
     void rebuild_integrator();
 
+private:
     std::unique_ptr<Model> model_;
     Method method_;
     std::unique_ptr<Integrator> integrator_;

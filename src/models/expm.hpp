@@ -1,0 +1,58 @@
+// The matrix exponential behind every exact linear piece flow x' = A x.
+// Self-contained (no LAPACK): the matrices of generic systems are small.
+//  - A structurally nilpotent (its nonzero pattern is an acyclic graph, which
+//    covers the triangular-after-permutation systems of the paper) is applied
+//    as the finite series sum_k (tA)^k x / k!, exactly, with work
+//    O(nnz * depth) where depth is the longest path in the pattern;
+//  - otherwise a dense scaling-and-squaring Pade exponential (N. J. Higham,
+//    "The scaling and squaring method for the matrix exponential revisited",
+//    SIAM J. Matrix Anal. Appl. 26 (2005) 1179-1193, Algorithm 2.3) of the
+//    block of indices the nonzeros touch.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace lpi {
+
+// Dense exponential E = exp(A), both n x n row-major. Accurate to round-off
+// relative to the conditioning of exp at A (Higham 2005).
+void expm_dense(std::size_t n, const double *A, double *E);
+// W = exp(A) - I, computed without cancellation: accurate relative to ||A||
+// when exp(A) is close to I (what the increment form of a flow needs).
+void expm1_dense(std::size_t n, const double *A, double *W);
+
+// A sparse n x n matrix in coordinate form; repeated (row, col) pairs add.
+struct SparseEntry {
+    std::uint32_t row;
+    std::uint32_t col;
+    double value;
+};
+
+enum class ExpmPath { Nilpotent, Pade };
+
+// Scratch space reused between calls, so a flow allocates nothing once warm.
+class ExpmWorkspace {
+public:
+    // Applies x <- exp(t A) x in place for A given by `entries` (dimension n).
+    // Exact zeros in entries are ignored. Returns the path taken.
+    ExpmPath apply(std::size_t n, const std::vector<SparseEntry> &entries, double t, double *x);
+
+    // Longest path in the nonzero pattern of the last apply() when it was
+    // nilpotent (A^(depth+1) = 0), otherwise -1. For tests and diagnostics.
+    long last_depth() const { return last_depth_; }
+
+private:
+    long topological_depth();  // on local_ (active indices); -1 if cyclic
+
+    std::vector<std::int64_t> local_of_;  // global index -> local, -1 if inactive
+    std::vector<std::uint32_t> active_;   // local -> global
+    std::vector<SparseEntry> local_;      // nonzero entries in local indices
+    std::vector<std::uint32_t> start_, cursor_, adjacency_, indegree_, queue_;
+    std::vector<long> depth_;
+    std::vector<double> term_, next_, increment_, dense_, exp_;
+    long last_depth_ = -1;
+};
+
+}  // namespace lpi

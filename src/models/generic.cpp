@@ -1,0 +1,427 @@
+#include "generic.hpp"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <tuple>
+
+#include "../core/error.hpp"
+
+namespace lpi {
+
+namespace {
+
+std::string number(double v) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.17g", v);
+    return buffer;
+}
+
+std::string short_number(double v) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.3g", v);
+    return buffer;
+}
+
+std::string x_name(std::uint32_t i) { return "x_" + std::to_string(i); }
+
+std::string bracket_text(std::uint32_t i, std::uint32_t j,
+                         const std::vector<StructureConstants::Output> &terms) {
+    std::string s = "{" + x_name(i) + ", " + x_name(j) + "} = ";
+    for (std::size_t t = 0; t < terms.size(); ++t)
+        s += (t ? " + " : "") + number(terms[t].c) + " " + x_name(terms[t].l);
+    return s;
+}
+
+// Relative size below which a Jacobiator component counts as round-off.
+constexpr double kJacobiTolerance = 1e-10;
+
+}  // namespace
+
+// ---- structure constants ------------------------------------------------------
+
+StructureConstants::StructureConstants(std::size_t dim, std::size_t nnz, const std::int32_t *i,
+                                       const std::int32_t *j, const std::int32_t *k,
+                                       const double *c)
+    : dim_(dim) {
+    if (dim == 0) fail(LPI_ERR_INVALID, "dim must be >= 1");
+    if (dim > static_cast<std::size_t>(INT32_MAX) + 1)
+        fail(LPI_ERR_INVALID, "dim = " + std::to_string(dim) +
+                                  " exceeds 2^31 (indices are int32_t)");
+    if (nnz > 0 && (!i || !j || !k || !c))
+        fail(LPI_ERR_NULL, "an index or coefficient array is NULL while nnz = " +
+                               std::to_string(nnz));
+
+    // Canonical entries (a < b, l) -> (coefficient, entry that set it).
+    std::map<std::tuple<std::uint32_t, std::uint32_t, std::uint32_t>, std::pair<double, std::size_t>>
+        canonical;
+    const std::string range = " is outside 0.." + std::to_string(dim - 1);
+    for (std::size_t e = 0; e < nnz; ++e) {
+        const std::string entry = "entry " + std::to_string(e) + ": ";
+        const std::int32_t idx[3] = {i[e], j[e], k[e]};
+        const char *names[3] = {"i", "j", "k"};
+        for (int q = 0; q < 3; ++q)
+            if (idx[q] < 0 || static_cast<std::size_t>(idx[q]) >= dim)
+                fail(LPI_ERR_INVALID, entry + names[q] + " = " + std::to_string(idx[q]) + range);
+        if (!std::isfinite(c[e]))
+            fail(LPI_ERR_NONFINITE, entry + "c = " + number(c[e]) + " is not finite");
+        const auto a = static_cast<std::uint32_t>(idx[0]), b = static_cast<std::uint32_t>(idx[1]),
+                   l = static_cast<std::uint32_t>(idx[2]);
+        if (a == b) {
+            if (c[e] != 0.0)
+                fail(LPI_ERR_INVALID, entry + "{" + x_name(a) + ", " + x_name(a) + "} must be 0 "
+                                      "(antisymmetry), got coefficient " + number(c[e]) +
+                                      " on " + x_name(l));
+            continue;
+        }
+        const auto key = std::make_tuple(std::min(a, b), std::max(a, b), l);
+        const double value = a < b ? c[e] : -c[e];
+        auto [it, inserted] = canonical.emplace(key, std::make_pair(value, e));
+        if (!inserted && it->second.first != value) {
+            const double implied = a < b ? it->second.first : -it->second.first;
+            fail(LPI_ERR_INVALID,
+                 entry + "gives {" + x_name(a) + ", " + x_name(b) + "} the coefficient " +
+                     number(c[e]) + " on " + x_name(l) + ", but entry " +
+                     std::to_string(it->second.second) + " implies " + number(implied) +
+                     " (entries must agree, with {x_j, x_i} = -{x_i, x_j})");
+        }
+    }
+
+    columns_.resize(dim);
+    for (const auto &[key, entry] : canonical) {
+        const auto [a, b, l] = key;
+        const double value = entry.first;
+        if (value == 0.0) continue;
+        brackets_[static_cast<std::uint64_t>(a) * dim + b].push_back({l, value});
+        brackets_[static_cast<std::uint64_t>(b) * dim + a].push_back({l, -value});
+        columns_[b].push_back({a, l, value});   // c_ab^l, second index b
+        columns_[a].push_back({b, l, -value});  // c_ba^l = -c_ab^l
+    }
+    check_jacobi();
+}
+
+const std::vector<StructureConstants::Output> &StructureConstants::bracket(std::uint32_t i,
+                                                                           std::uint32_t j) const {
+    auto it = brackets_.find(static_cast<std::uint64_t>(i) * dim_ + j);
+    return it == brackets_.end() ? none_ : it->second;
+}
+
+void StructureConstants::check_jacobi() const {
+    // Jac(p,q,r) = {{x_p,x_q},x_r} + {{x_q,x_r},x_p} + {{x_r,x_p},x_q}, linear
+    // in x: component m is sum_l c_pq^l c_lr^m + c_qr^l c_lp^m + c_rp^l c_lq^m.
+    // It vanishes unless one of the three brackets does not, so each triple
+    // is visited from its first nonzero pair only, with r among the indices
+    // that some involved bracket can reach.
+    std::vector<double> value(dim_, 0.0), size(dim_, 0.0);
+    std::vector<std::uint32_t> touched;
+    std::vector<std::size_t> stamp(dim_, 0);
+    std::size_t pass = 0;
+    auto accumulate = [&](std::uint32_t a, std::uint32_t b, std::uint32_t d) {
+        for (const Output &first : bracket(a, b))
+            for (const Output &second : bracket(first.l, d)) {
+                const double product = first.c * second.c;
+                if (size[second.l] == 0.0) touched.push_back(second.l);
+                value[second.l] += product;
+                size[second.l] += std::fabs(product);
+            }
+    };
+    auto nonzero = [&](std::uint32_t a, std::uint32_t b) { return !bracket(a, b).empty(); };
+
+    for (const auto &[key, outputs] : brackets_) {
+        const auto i = static_cast<std::uint32_t>(key / dim_), j = static_cast<std::uint32_t>(key % dim_);
+        if (i > j) continue;
+        ++pass;
+        std::vector<std::uint32_t> candidates;
+        auto consider = [&](std::uint32_t from) {
+            for (const Term &t : columns_[from])
+                if (stamp[t.i] != pass) {
+                    stamp[t.i] = pass;
+                    candidates.push_back(t.i);
+                }
+        };
+        consider(i);
+        consider(j);
+        for (const Output &o : outputs) consider(o.l);
+        for (std::uint32_t r : candidates) {
+            if (r == i || r == j) continue;
+            std::uint32_t t[3] = {i, j, r};
+            std::sort(t, t + 3);
+            std::pair<std::uint32_t, std::uint32_t> first =
+                nonzero(t[0], t[1]) ? std::make_pair(t[0], t[1])
+                : nonzero(t[0], t[2]) ? std::make_pair(t[0], t[2])
+                                      : std::make_pair(t[1], t[2]);
+            if (first != std::make_pair(i, j)) continue;
+            accumulate(t[0], t[1], t[2]);
+            accumulate(t[1], t[2], t[0]);
+            accumulate(t[2], t[0], t[1]);
+            for (std::uint32_t m : touched) {
+                if (std::fabs(value[m]) > kJacobiTolerance * size[m])
+                    fail(LPI_ERR_INVALID,
+                         "the structure constants violate the Jacobi identity at (i, j, k) = (" +
+                             std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " +
+                             std::to_string(t[2]) + "): {{x_i, x_j}, x_k} + {{x_j, x_k}, x_i} + "
+                             "{{x_k, x_i}, x_j} has coefficient " + short_number(value[m]) +
+                             " on " + x_name(m) + " (must be 0)");
+            }
+            for (std::uint32_t m : touched) value[m] = size[m] = 0.0;
+            touched.clear();
+        }
+    }
+}
+
+void StructureConstants::poisson_matrix(const double *x, double *J) const {
+    std::fill(J, J + dim_ * dim_, 0.0);
+    for (const auto &[key, outputs] : brackets_) {
+        double s = 0.0;
+        for (const Output &o : outputs) s += o.c * x[o.l];
+        J[key] = s;  // key = i * dim + j is the row-major position
+    }
+}
+
+void add_poisson_times(const StructureConstants &c, const std::uint32_t *sigma, std::size_t n,
+                       const double *g, const double *x, double *rate) {
+    for (std::size_t p = 0; p < n; ++p)
+        for (const StructureConstants::Term &t : c.column(sigma[p]))
+            rate[t.i] += t.c * g[p] * x[t.l];
+}
+
+// ---- abelian pieces -----------------------------------------------------------
+
+namespace {
+
+class AbelianPiece final : public Piece {
+public:
+    AbelianPiece(std::string label, const StructureConstants &constants,
+                 std::vector<std::uint32_t> sigma, lpi_gradient_fn grad, lpi_energy_fn energy,
+                 void *user)
+        : Piece(std::move(label)), constants_(constants), sigma_(std::move(sigma)), grad_(grad),
+          energy_(energy), user_(user), x_sigma_(sigma_.size()), g_(sigma_.size()) {
+        // A_il = sum_p c_{i sigma_p}^l g_p: one matrix entry per distinct
+        // (i, l), fed by the contributions (p, c) that land on it.
+        struct Raw {
+            std::uint32_t row, col, p;
+            double c;
+        };
+        std::vector<Raw> raw;
+        for (std::uint32_t p = 0; p < sigma_.size(); ++p)
+            for (const StructureConstants::Term &t : constants_.column(sigma_[p]))
+                raw.push_back({t.i, t.l, p, t.c});
+        std::sort(raw.begin(), raw.end(), [](const Raw &a, const Raw &b) {
+            return std::tie(a.row, a.col, a.p) < std::tie(b.row, b.col, b.p);
+        });
+        for (const Raw &r : raw) {
+            if (entries_.empty() || entries_.back().row != r.row || entries_.back().col != r.col)
+                entries_.push_back({r.row, r.col, 0.0});
+            contributions_.push_back({entries_.size() - 1, r.p, r.c});
+        }
+    }
+
+    void flow(double t, double *x) override {
+        gradient(x);
+        for (SparseEntry &e : entries_) e.value = 0.0;
+        for (const Contribution &k : contributions_) entries_[k.entry].value += k.c * g_[k.p];
+        workspace_.apply(constants_.dim(), entries_, t, x);
+    }
+
+    double energy(const double *x) const override {
+        gather(x);
+        double h = 0.0;
+        const int rc = energy_(sigma_.size(), x_sigma_.data(), &h, user_);
+        if (rc != 0)
+            fail(LPI_ERR_CALLBACK, "the energy callback of " + label() + " returned " +
+                                       std::to_string(rc));
+        if (!std::isfinite(h))
+            fail(LPI_ERR_CALLBACK, "the energy callback of " + label() + " gave a non-finite value");
+        return h;
+    }
+
+    void add_vector_field(const double *x, double *rate) const override {
+        gradient(x);
+        add_poisson_times(constants_, sigma_.data(), sigma_.size(), g_.data(), x, rate);
+    }
+
+private:
+    struct Contribution {
+        std::size_t entry;
+        std::uint32_t p;
+        double c;
+    };
+
+    void gather(const double *x) const {
+        for (std::size_t p = 0; p < sigma_.size(); ++p) x_sigma_[p] = x[sigma_[p]];
+    }
+
+    void gradient(const double *x) const {
+        gather(x);
+        const int rc = grad_(sigma_.size(), x_sigma_.data(), g_.data(), user_);
+        if (rc != 0)
+            fail(LPI_ERR_CALLBACK, "the gradient callback of " + label() + " returned " +
+                                       std::to_string(rc));
+        for (std::size_t p = 0; p < g_.size(); ++p)
+            if (!std::isfinite(g_[p]))
+                fail(LPI_ERR_CALLBACK, "the gradient callback of " + label() +
+                                           " gave a non-finite component " + std::to_string(p));
+    }
+
+    const StructureConstants &constants_;
+    std::vector<std::uint32_t> sigma_;
+    lpi_gradient_fn grad_;
+    lpi_energy_fn energy_;
+    void *user_;
+    mutable std::vector<double> x_sigma_, g_;
+    std::vector<SparseEntry> entries_;
+    std::vector<Contribution> contributions_;
+    ExpmWorkspace workspace_;
+};
+
+}  // namespace
+
+// ---- the model ------------------------------------------------------------------
+
+GenericModel::GenericModel(std::unique_ptr<StructureConstants> constants, const char *kind)
+    : kind_(kind), constants_(std::move(constants)) {}
+
+void GenericModel::flow(std::size_t piece, double t, double *state) {
+    if (pieces_.empty())
+        fail(LPI_ERR_INVALID, std::string("the ") + kind_ +
+                                  " system has no Hamiltonian pieces yet (add them with "
+                                  "lpi_add_piece)");
+    pieces_[piece]->flow(t, state);
+}
+
+double GenericModel::energy(const double *state) const {
+    double h = 0.0;
+    for (const auto &p : pieces_) h += p->energy(state);
+    return h;
+}
+
+void GenericModel::casimirs(const double *state, double *out) const {
+    for (std::size_t q = 0; q < casimirs_.size(); ++q) {
+        double value = 0.0;
+        const int rc = casimirs_[q].fn(dim(), state, &value, casimirs_[q].user);
+        if (rc != 0)
+            fail(LPI_ERR_CALLBACK, "the callback of Casimir " + std::to_string(q) + " returned " +
+                                       std::to_string(rc));
+        if (!std::isfinite(value))
+            fail(LPI_ERR_CALLBACK, "the callback of Casimir " + std::to_string(q) +
+                                       " gave a non-finite value");
+        out[q] = value;
+    }
+}
+
+void GenericModel::vector_field(const double *state, double *rate) const {
+    if (pieces_.empty())
+        fail(LPI_ERR_INVALID, std::string("the ") + kind_ +
+                                  " system has no Hamiltonian pieces yet (add them with "
+                                  "lpi_add_piece)");
+    std::fill(rate, rate + dim(), 0.0);
+    for (const auto &p : pieces_) p->add_vector_field(state, rate);
+}
+
+void GenericModel::add_piece(std::size_t n, const std::int32_t *indices, lpi_gradient_fn grad,
+                             lpi_energy_fn energy, void *user) {
+    if (!grad) fail(LPI_ERR_NULL, "the gradient callback is NULL");
+    if (!energy) fail(LPI_ERR_NULL, "the energy callback is NULL");
+    if (n == 0) fail(LPI_ERR_INVALID, "a piece needs at least one index (n = 0)");
+    if (!indices) fail(LPI_ERR_NULL, "indices is NULL");
+    const std::size_t d = dim();
+    if (n > d)
+        fail(LPI_ERR_INVALID, "n = " + std::to_string(n) + " indices exceed dim = " +
+                                  std::to_string(d) + " (indices must be distinct)");
+    std::vector<std::uint32_t> sigma(n);
+    std::unordered_map<std::uint32_t, std::size_t> seen;
+    for (std::size_t p = 0; p < n; ++p) {
+        if (indices[p] < 0 || static_cast<std::size_t>(indices[p]) >= d)
+            fail(LPI_ERR_INVALID, "indices[" + std::to_string(p) + "] = " +
+                                      std::to_string(indices[p]) + " is outside 0.." +
+                                      std::to_string(d - 1));
+        sigma[p] = static_cast<std::uint32_t>(indices[p]);
+        auto [it, inserted] = seen.emplace(sigma[p], p);
+        if (!inserted)
+            fail(LPI_ERR_INVALID, "indices[" + std::to_string(it->second) + "] and indices[" +
+                                      std::to_string(p) + "] are both " +
+                                      std::to_string(sigma[p]) + " (indices must be distinct)");
+    }
+    for (std::size_t p = 0; p < n; ++p)
+        for (std::size_t q = p + 1; q < n; ++q) {
+            const auto &terms = constants_->bracket(sigma[p], sigma[q]);
+            if (!terms.empty())
+                fail(LPI_ERR_NOT_ABELIAN, "the index set is not abelian: indices " +
+                                              std::to_string(sigma[p]) + " and " +
+                                              std::to_string(sigma[q]) + " do not commute, " +
+                                              bracket_text(sigma[p], sigma[q], terms));
+        }
+    std::string label = next_piece_name() + " (indices {";
+    for (std::size_t p = 0; p < n; ++p) label += (p ? ", " : "") + std::to_string(sigma[p]);
+    label += "})";
+    pieces_.push_back(std::make_unique<AbelianPiece>(std::move(label), *constants_,
+                                                     std::move(sigma), grad, energy, user));
+}
+
+void GenericModel::add_casimir(lpi_casimir_fn fn, void *user) {
+    if (!fn) fail(LPI_ERR_NULL, "the Casimir callback is NULL");
+    casimirs_.push_back({fn, user});
+}
+
+std::vector<double> singular_values(std::size_t n, std::vector<double> M) {
+    // One-sided Jacobi (Hestenes 1958): rotate pairs of columns until they are
+    // mutually orthogonal; the column norms are then the singular values.
+    std::vector<double> col(n * n);  // column-major copy
+    for (std::size_t r = 0; r < n; ++r)
+        for (std::size_t c = 0; c < n; ++c) col[c * n + r] = M[r * n + c];
+    for (int sweep = 0; sweep < 100; ++sweep) {
+        bool rotated = false;
+        for (std::size_t p = 0; p + 1 < n; ++p)
+            for (std::size_t q = p + 1; q < n; ++q) {
+                double *a = &col[p * n], *b = &col[q * n];
+                double alpha = 0.0, beta = 0.0, gamma = 0.0;
+                for (std::size_t r = 0; r < n; ++r) {
+                    alpha += a[r] * a[r];
+                    beta += b[r] * b[r];
+                    gamma += a[r] * b[r];
+                }
+                if (gamma == 0.0 || std::fabs(gamma) <= DBL_EPSILON * std::sqrt(alpha * beta))
+                    continue;
+                rotated = true;
+                const double zeta = (beta - alpha) / (2.0 * gamma);
+                const double t = std::copysign(1.0, zeta) / (std::fabs(zeta) + std::hypot(1.0, zeta));
+                const double cs = 1.0 / std::hypot(1.0, t), sn = cs * t;
+                for (std::size_t r = 0; r < n; ++r) {
+                    const double u = a[r], v = b[r];
+                    a[r] = cs * u - sn * v;
+                    b[r] = sn * u + cs * v;
+                }
+            }
+        if (!rotated) break;
+    }
+    std::vector<double> sigma(n);
+    for (std::size_t c = 0; c < n; ++c) {
+        double s = 0.0;
+        for (std::size_t r = 0; r < n; ++r) s += col[c * n + r] * col[c * n + r];
+        sigma[c] = std::sqrt(s);
+    }
+    return sigma;
+}
+
+std::size_t GenericModel::poisson_rank(const double *x) const {
+    const std::size_t n = dim();
+    std::vector<double> J(n * n);
+    constants_->poisson_matrix(x, J.data());
+    const std::vector<double> sigma = singular_values(n, std::move(J));
+    const double largest = sigma.empty() ? 0.0 : *std::max_element(sigma.begin(), sigma.end());
+    const double tolerance = static_cast<double>(n) * DBL_EPSILON * largest;
+    std::size_t rank = 0;
+    for (double s : sigma)
+        if (s > tolerance) ++rank;
+    return rank;
+}
+
+std::unique_ptr<GenericModel> make_generic(std::size_t dim, std::size_t nnz, const std::int32_t *i,
+                                           const std::int32_t *j, const std::int32_t *k,
+                                           const double *c) {
+    return std::make_unique<GenericModel>(std::make_unique<StructureConstants>(dim, nnz, i, j, k, c));
+}
+
+}  // namespace lpi

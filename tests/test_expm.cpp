@@ -1,0 +1,273 @@
+// White-box tests of the matrix exponential (src/models/expm.hpp) against
+// independent computations: a finite long-double series for nilpotent A,
+// closed-form rotations (2x2 and Rodrigues' formula) for skew A, and a
+// long-double Taylor series with scaling and squaring for general A.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+extern "C" {
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+}
+
+#include "models/expm.hpp"
+
+namespace {
+
+using LongMatrix = std::vector<long double>;
+
+LongMatrix long_multiply(std::size_t n, const LongMatrix &A, const LongMatrix &B) {
+    LongMatrix C(n * n, 0.0L);
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t k = 0; k < n; ++k)
+            for (std::size_t j = 0; j < n; ++j) C[i * n + j] += A[i * n + k] * B[k * n + j];
+    return C;
+}
+
+// exp(A) - I in long double: Taylor on A / 2^s (norm <= 1/4, 40 terms), then
+// (I + W)^2 - I = W^2 + 2W, s times. Independent of the Pade code.
+LongMatrix reference_expm1(std::size_t n, const std::vector<double> &A) {
+    long double norm = 0.0L;
+    for (std::size_t j = 0; j < n; ++j) {
+        long double s = 0.0L;
+        for (std::size_t i = 0; i < n; ++i) s += std::fabs(static_cast<long double>(A[i * n + j]));
+        norm = std::max(norm, s);
+    }
+    int squarings = 0;
+    while (norm > 0.25L) {
+        norm /= 2;
+        ++squarings;
+    }
+    LongMatrix X(n * n), term(n * n), W(n * n, 0.0L);
+    for (std::size_t e = 0; e < n * n; ++e) X[e] = std::ldexp(static_cast<long double>(A[e]), -squarings);
+    term = X;
+    for (int k = 1; k <= 40; ++k) {
+        for (std::size_t e = 0; e < n * n; ++e) W[e] += term[e];
+        term = long_multiply(n, term, X);
+        for (long double &t : term) t /= (k + 1);
+    }
+    for (int s = 0; s < squarings; ++s) {
+        LongMatrix W2 = long_multiply(n, W, W);
+        for (std::size_t e = 0; e < n * n; ++e) W[e] = W2[e] + 2 * W[e];
+    }
+    return W;
+}
+
+double relative_error(std::size_t n, const std::vector<double> &E, const LongMatrix &reference,
+                      bool add_identity) {
+    long double diff = 0.0L, size = 0.0L;
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < n; ++j) {
+            const long double r = reference[i * n + j] + (add_identity && i == j ? 1.0L : 0.0L);
+            diff = std::max(diff, std::fabs(E[i * n + j] - r));
+            size = std::max(size, std::fabs(r));
+        }
+    return static_cast<double>(diff / size);
+}
+
+std::vector<double> random_matrix(std::size_t n, double norm, std::mt19937_64 &rng) {
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<double> A(n * n);
+    for (double &a : A) a = u(rng);
+    double current = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+        double s = 0.0;
+        for (std::size_t i = 0; i < n; ++i) s += std::fabs(A[i * n + j]);
+        current = std::max(current, s);
+    }
+    for (double &a : A) a *= norm / current;
+    return A;
+}
+
+// y = E x for the sparse path, to compare against a dense exponential.
+std::vector<double> apply_sparse(std::size_t n, const std::vector<double> &A, const std::vector<double> &x,
+                                 lpi::ExpmPath *path, long *depth) {
+    std::vector<lpi::SparseEntry> entries;
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < n; ++j)
+            if (A[i * n + j] != 0.0)
+                entries.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j), A[i * n + j]});
+    lpi::ExpmWorkspace workspace;
+    std::vector<double> y = x;
+    *path = workspace.apply(n, entries, 1.0, y.data());
+    *depth = workspace.last_depth();
+    return y;
+}
+
+double vector_error(const std::vector<double> &y, const std::vector<long double> &reference) {
+    long double diff = 0.0L, size = 0.0L;
+    for (std::size_t i = 0; i < y.size(); ++i) {
+        diff = std::max(diff, std::fabs(y[i] - reference[i]));
+        size = std::max(size, std::fabs(reference[i]));
+    }
+    return static_cast<double>(diff / size);
+}
+
+std::vector<long double> long_apply(std::size_t n, const LongMatrix &E, const std::vector<double> &x,
+                                    bool add_identity) {
+    std::vector<long double> y(n, 0.0L);
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = 0; j < n; ++j) y[i] += E[i * n + j] * x[j];
+        if (add_identity) y[i] += x[i];
+    }
+    return y;
+}
+
+void test_general_matrices(void **) {
+    // Norms below and above each theta_m of Higham 2005 (degrees 3..13) and
+    // far beyond (scaling and squaring).
+    std::mt19937_64 rng(7);
+    const double norms[] = {1e-8, 0.01, 0.2, 0.9, 2.0, 5.0, 12.0, 40.0};
+    for (double norm : norms) {
+        for (std::size_t n : {1u, 2u, 5u, 8u}) {
+            const std::vector<double> A = random_matrix(n, norm, rng);
+            const LongMatrix W = reference_expm1(n, A);
+            std::vector<double> E(n * n), W1(n * n);
+            lpi::expm_dense(n, A.data(), E.data());
+            lpi::expm1_dense(n, A.data(), W1.data());
+            const double e = relative_error(n, E, W, true);
+            const double e1 = relative_error(n, W1, W, false);
+            std::printf("expm general n=%zu ||A||_1=%g: exp rel. error %.2e, exp-I rel. error %.2e\n",
+                            n, norm, e, e1);
+            // exp(A) of a random matrix is conditioned like ||A||; allow that.
+            const double tolerance = 64 * 2.2e-16 * std::max(1.0, norm);
+            assert_true(e < tolerance);
+            assert_true(e1 < tolerance);
+        }
+    }
+}
+
+void test_skew_matrices(void **) {
+    // 2x2 rotation generators: exp = [[c, s], [-s, c]].
+    for (double theta : {1e-3, 0.3, 2.0, 7.5, 100.0}) {
+        const std::vector<double> A = {0.0, theta, -theta, 0.0};
+        std::vector<double> E(4);
+        lpi::expm_dense(2, A.data(), E.data());
+        const LongMatrix exact = {std::cos(static_cast<long double>(theta)), std::sin(static_cast<long double>(theta)),
+                                  -std::sin(static_cast<long double>(theta)), std::cos(static_cast<long double>(theta))};
+        const double e = relative_error(2, E, exact, false);
+        std::printf("expm skew 2x2 theta=%g: rel. error %.2e\n", theta, e);
+        assert_true(e < 16 * 2.2e-16 * std::max(1.0, theta));
+    }
+    // 3x3 skew K(w): exp = I + sin(t)/t K + (1 - cos t)/t^2 K^2 (Rodrigues).
+    std::mt19937_64 rng(11);
+    std::normal_distribution<double> g;
+    for (double theta : {0.05, 1.0, 3.0, 40.0}) {
+        double w[3] = {g(rng), g(rng), g(rng)};
+        const double len = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        for (double &c : w) c *= theta / len;
+        const std::vector<double> K = {0, -w[2], w[1], w[2], 0, -w[0], -w[1], w[0], 0};
+        LongMatrix KL(K.begin(), K.end());
+        const LongMatrix K2 = long_multiply(3, KL, KL);
+        const long double t = theta;
+        LongMatrix exact(9);
+        for (int e = 0; e < 9; ++e)
+            exact[e] = (e % 4 == 0 ? 1.0L : 0.0L) + std::sin(t) / t * KL[e] + (1 - std::cos(t)) / (t * t) * K2[e];
+        std::vector<double> E(9);
+        lpi::expm_dense(3, K.data(), E.data());
+        const double err = relative_error(3, E, exact, false);
+        // The sparse path (a cycle, so Pade) on a vector.
+        lpi::ExpmPath path;
+        long depth;
+        const std::vector<double> x = {0.3, -1.1, 0.7};
+        const std::vector<double> y = apply_sparse(3, K, x, &path, &depth);
+        assert_int_equal(static_cast<int>(path), static_cast<int>(lpi::ExpmPath::Pade));
+        const double ey = vector_error(y, long_apply(3, exact, x, false));
+        std::printf("expm skew 3x3 |w|=%g: rel. error %.2e, applied %.2e\n", theta, err, ey);
+        assert_true(err < 16 * 2.2e-16 * std::max(1.0, theta));
+        assert_true(ey < 16 * 2.2e-16 * std::max(1.0, theta));
+    }
+}
+
+void test_nilpotent_matrices(void **) {
+    // Strictly lower triangular under a permutation: nilpotent, detected from
+    // the pattern; reference = finite long-double series sum_{k<n} A^k / k!.
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-2.0, 2.0);
+    const std::size_t n = 7;
+    const std::size_t perm[n] = {4, 0, 6, 2, 5, 1, 3};
+    std::vector<double> A(n * n, 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < i; ++j) A[perm[i] * n + perm[j]] = u(rng);
+    LongMatrix AL(A.begin(), A.end()), power(n * n, 0.0L), exact(n * n, 0.0L);
+    for (std::size_t i = 0; i < n; ++i) power[i * n + i] = 1.0L;
+    long double factorial = 1.0L;
+    for (std::size_t k = 0; k < n; ++k) {
+        if (k > 0) factorial *= k;
+        for (std::size_t e = 0; e < n * n; ++e) exact[e] += power[e] / factorial;
+        power = long_multiply(n, power, AL);
+    }
+    for (long double p : power) assert_true(p == 0.0L);  // A^n = 0
+    std::vector<double> E(n * n);
+    lpi::expm_dense(n, A.data(), E.data());
+    const double e = relative_error(n, E, exact, false);
+    lpi::ExpmPath path;
+    long depth;
+    const std::vector<double> x = {1.0, -0.5, 0.25, 2.0, -1.5, 0.75, 0.1};
+    const std::vector<double> y = apply_sparse(n, A, x, &path, &depth);
+    assert_int_equal(static_cast<int>(path), static_cast<int>(lpi::ExpmPath::Nilpotent));
+    assert_int_equal(depth, static_cast<long>(n - 1));
+    const double ey = vector_error(y, long_apply(n, exact, x, false));
+    std::printf("expm nilpotent n=7 (depth 6): Pade rel. error %.2e, finite series %.2e\n", e, ey);
+    assert_true(e < 1e-13);
+    assert_true(ey < 1e-14);
+
+    // A self-loop (diagonal entry) is not nilpotent: the Pade path.
+    A[perm[3] * n + perm[3]] = 0.5;
+    apply_sparse(n, A, x, &path, &depth);
+    assert_int_equal(static_cast<int>(path), static_cast<int>(lpi::ExpmPath::Pade));
+    assert_int_equal(depth, -1);
+    // An explicit zero does not close a cycle.
+    std::vector<lpi::SparseEntry> cycle = {{0, 1, 2.0}, {1, 0, 0.0}};
+    lpi::ExpmWorkspace workspace;
+    double z[2] = {3.0, 5.0};
+    assert_int_equal(static_cast<int>(workspace.apply(2, cycle, 0.5, z)),
+                     static_cast<int>(lpi::ExpmPath::Nilpotent));
+    assert_true(z[0] == 3.0 + 0.5 * 2.0 * 5.0 && z[1] == 5.0);
+}
+
+void test_sparse_nilpotent_scales_with_nonzeros(void **) {
+    // Three layers of n/3 indices, each index driving two in the next layer:
+    // depth 2. A dense exponential of this size (n = 300000) could not even be
+    // stored; the series touches only the nonzeros.
+    const std::uint32_t layer = 100000, n = 3 * layer;
+    std::vector<lpi::SparseEntry> entries;
+    for (std::uint32_t i = 0; i < 2 * layer; ++i) {
+        const std::uint32_t base = (i / layer + 1) * layer, offset = i % layer;
+        entries.push_back({base + offset, i, 0.5});
+        entries.push_back({base + (offset + 1) % layer, i, -0.25});
+    }
+    std::vector<double> x(n), y(n);
+    for (std::uint32_t i = 0; i < n; ++i) x[i] = std::sin(0.001 * i) + 1.0;
+    y = x;
+    const double t = 0.7;
+    lpi::ExpmWorkspace workspace;
+    assert_int_equal(static_cast<int>(workspace.apply(n, entries, t, y.data())),
+                     static_cast<int>(lpi::ExpmPath::Nilpotent));
+    assert_int_equal(workspace.last_depth(), 2);
+    // Reference: x + t A x + t^2 A^2 x / 2 with plain loops.
+    std::vector<double> Ax(n, 0.0), AAx(n, 0.0);
+    for (const auto &e : entries) Ax[e.row] += e.value * x[e.col];
+    for (const auto &e : entries) AAx[e.row] += e.value * Ax[e.col];
+    double worst = 0.0;
+    for (std::uint32_t i = 0; i < n; ++i)
+        worst = std::max(worst, std::fabs(y[i] - (x[i] + t * Ax[i] + 0.5 * t * t * AAx[i])));
+    assert_true(worst < 1e-14);
+}
+
+}  // namespace
+
+int main() {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_general_matrices),
+        cmocka_unit_test(test_skew_matrices),
+        cmocka_unit_test(test_nilpotent_matrices),
+        cmocka_unit_test(test_sparse_nilpotent_scales_with_nonzeros),
+    };
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}

@@ -1,0 +1,400 @@
+/* Generic Lie-Poisson systems: the rigid body and the pendulum written as
+ * generic systems reproduce the built-in models to round-off; Poisson rank,
+ * user Casimirs, energy; every bad input with its exact status, a message
+ * naming the function and the fault, and the state unchanged. */
+#include "lpi_test.h"
+
+/* so(3): {m1,m2} = -m3, {m1,m3} = m2, {m2,m3} = -m1 (the paper's J). */
+static const int32_t kSoI[] = {0, 0, 1}, kSoJ[] = {1, 2, 2}, kSoK[] = {2, 1, 0};
+static const double kSoC[] = {-1, 1, -1};
+/* e(2) for the pendulum: {x1,x3} = -x2, {x2,x3} = x1. */
+static const int32_t kE2I[] = {0, 1}, kE2J[] = {2, 2}, kE2K[] = {1, 0};
+static const double kE2C[] = {-1, 1};
+
+static const double kInertia[3] = {1.0, 2.0, 3.0};
+
+/* m_k^2 / (2 I_k): user points at I_k. */
+static int axis_grad(size_t n, const double *x, double *g, void *user) {
+    (void)n;
+    g[0] = x[0] / *(const double *)user;
+    return 0;
+}
+static int axis_energy(size_t n, const double *x, double *h, void *user) {
+    (void)n;
+    *h = 0.5 * x[0] * x[0] / *(const double *)user;
+    return 0;
+}
+static int linear_grad(size_t n, const double *x, double *g, void *user) {
+    (void)n; (void)x; (void)user;
+    g[0] = 1.0;
+    return 0;
+}
+static int linear_energy(size_t n, const double *x, double *h, void *user) {
+    (void)n; (void)user;
+    *h = x[0];
+    return 0;
+}
+static int half_square_grad(size_t n, const double *x, double *g, void *user) {
+    (void)n; (void)user;
+    g[0] = x[0];
+    return 0;
+}
+static int half_square_energy(size_t n, const double *x, double *h, void *user) {
+    (void)n; (void)user;
+    *h = 0.5 * x[0] * x[0];
+    return 0;
+}
+static int norm2_casimir(size_t dim, const double *x, double *out, void *user) {
+    (void)user;
+    *out = 0;
+    for (size_t q = 0; q < dim; ++q) *out += x[q] * x[q];
+    return 0;
+}
+
+static lpi_system *generic_rigid_body(void) {
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_generic_create(&sys, 3, 3, kSoI, kSoJ, kSoK, kSoC), LPI_OK);
+    for (int32_t k = 0; k < 3; ++k)
+        assert_int_equal(lpi_add_piece(sys, 1, &k, axis_grad, axis_energy, (void *)&kInertia[k]),
+                         LPI_OK);
+    assert_int_equal(lpi_add_casimir(sys, norm2_casimir, NULL), LPI_OK);
+    return sys;
+}
+
+static lpi_system *generic_pendulum(void) {
+    lpi_system *sys = NULL;
+    const int32_t x2 = 1, x3 = 2;
+    assert_int_equal(lpi_generic_create(&sys, 3, 2, kE2I, kE2J, kE2K, kE2C), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 1, &x2, linear_grad, linear_energy, NULL), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 1, &x3, half_square_grad, half_square_energy, NULL), LPI_OK);
+    return sys;
+}
+
+/* Runs both systems side by side and returns the largest distance seen. */
+static double max_difference(lpi_system *a, lpi_system *b, const char *method, const double *x0,
+                             double dt, int chunks, int64_t steps) {
+    double xa[3], xb[3], worst = 0;
+    assert_int_equal(lpi_set_method(a, method), LPI_OK);
+    assert_int_equal(lpi_set_method(b, method), LPI_OK);
+    assert_int_equal(lpi_set_state(a, x0, 3), LPI_OK);
+    assert_int_equal(lpi_set_state(b, x0, 3), LPI_OK);
+    for (int c = 0; c < chunks; ++c) {
+        assert_int_equal(lpi_step(a, dt, steps), LPI_OK);
+        assert_int_equal(lpi_step(b, dt, steps), LPI_OK);
+        assert_int_equal(lpi_get_state(a, xa, 3), LPI_OK);
+        assert_int_equal(lpi_get_state(b, xb, 3), LPI_OK);
+        const double d = lpi_test_distance(xa, xb, 3);
+        if (d > worst) worst = d;
+    }
+    return worst;
+}
+
+static void test_rigid_body_matches_built_in(void **state) {
+    (void)state;
+    lpi_system *generic = generic_rigid_body(), *built_in = NULL;
+    assert_int_equal(lpi_rigid_body_create(&built_in, kInertia[0], kInertia[1], kInertia[2]), LPI_OK);
+    assert_int_equal(lpi_set_split(built_in, "axes"), LPI_OK);
+    const double m0[3] = {1.0, 0.5, -0.3};
+    const char *methods[] = {"lie-trotter", "leapfrog", "triple-jump-4", "rk4"};
+    for (int q = 0; q < 4; ++q) {
+        const double d = max_difference(generic, built_in, methods[q], m0, 0.05, 10, 100);
+        printf("rigid body, %s, 1000 steps: generic vs built-in %.3g\n", methods[q], d);
+        /* Round-off only: up to 6000 flows, the built-in with compensated
+         * state, the generic without, so ~u sqrt(flows) times the growth of
+         * perturbations along this orbit. */
+        assert_true(d < 5e-13);
+    }
+    /* Energy and the user's Casimir agree with the built-in ones. */
+    double h1, h2, c1, c2;
+    assert_int_equal(lpi_energy(generic, &h1), LPI_OK);
+    assert_int_equal(lpi_energy(built_in, &h2), LPI_OK);
+    assert_true(fabs(h1 - h2) < 1e-14);
+    assert_int_equal(lpi_casimir_count(generic), 1);
+    assert_int_equal(lpi_casimirs(generic, &c1, 1), LPI_OK);
+    assert_int_equal(lpi_casimirs(built_in, &c2, 1), LPI_OK);
+    assert_true(fabs(c1 - c2) < 1e-14);
+    lpi_destroy(generic);
+    lpi_destroy(built_in);
+}
+
+static void test_pendulum_matches_built_in(void **state) {
+    (void)state;
+    lpi_system *generic = generic_pendulum(), *built_in = NULL;
+    assert_int_equal(lpi_pendulum_create(&built_in), LPI_OK);
+    const double x0[3] = {0.6, -0.8, 1.2};
+    const char *methods[] = {"lie-trotter", "leapfrog", "triple-jump-4", "rk4"};
+    for (int q = 0; q < 4; ++q) {
+        const double d = max_difference(generic, built_in, methods[q], x0, 0.05, 10, 100);
+        printf("pendulum, %s, 1000 steps: generic vs built-in %.3g\n", methods[q], d);
+        assert_true(d < 1e-13);
+    }
+    double h1, h2;
+    assert_int_equal(lpi_energy(generic, &h1), LPI_OK);
+    assert_int_equal(lpi_energy(built_in, &h2), LPI_OK);
+    assert_true(fabs(h1 - h2) < 1e-14);
+    assert_int_equal(lpi_casimir_count(generic), 0);
+    lpi_destroy(generic);
+    lpi_destroy(built_in);
+}
+
+static void test_poisson_rank(void **state) {
+    (void)state;
+    lpi_system *rb = generic_rigid_body(), *pend = generic_pendulum();
+    size_t rank = 99;
+    const double m[3] = {0.3, -1.2, 0.7}, zero[3] = {0, 0, 0};
+    assert_int_equal(lpi_poisson_rank(rb, m, 3, &rank), LPI_OK);
+    assert_int_equal(rank, 2);
+    assert_int_equal(lpi_poisson_rank(rb, zero, 3, &rank), LPI_OK);
+    assert_int_equal(rank, 0);
+    assert_int_equal(lpi_poisson_rank(pend, m, 3, &rank), LPI_OK);
+    assert_int_equal(rank, 2);
+    /* At x1 = x2 = 0 the pendulum's J vanishes. */
+    const double axis[3] = {0, 0, 5};
+    assert_int_equal(lpi_poisson_rank(pend, axis, 3, &rank), LPI_OK);
+    assert_int_equal(rank, 0);
+    /* An abelian algebra (no constants) has rank 0 everywhere. */
+    lpi_system *abelian = NULL;
+    assert_int_equal(lpi_generic_create(&abelian, 4, 0, NULL, NULL, NULL, NULL), LPI_OK);
+    const double y[4] = {1, 2, 3, 4};
+    assert_int_equal(lpi_poisson_rank(abelian, y, 4, &rank), LPI_OK);
+    assert_int_equal(rank, 0);
+    lpi_destroy(abelian);
+    lpi_destroy(rb);
+    lpi_destroy(pend);
+}
+
+static void test_either_order_and_agreeing_duplicates(void **state) {
+    (void)state;
+    /* so(3) given with some pairs reversed and one entry repeated. */
+    const int32_t i[] = {1, 0, 2, 1}, j[] = {0, 2, 1, 0}, k[] = {2, 1, 0, 2};
+    const double c[] = {1, 1, 1, 1};
+    lpi_system *sys = NULL, *reference = generic_rigid_body();
+    assert_int_equal(lpi_generic_create(&sys, 3, 4, i, j, k, c), LPI_OK);
+    for (int32_t a = 0; a < 3; ++a)
+        assert_int_equal(lpi_add_piece(sys, 1, &a, axis_grad, axis_energy, (void *)&kInertia[a]),
+                         LPI_OK);
+    const double m0[3] = {1.0, 0.5, -0.3};
+    assert_true(max_difference(sys, reference, "leapfrog", m0, 0.1, 1, 50) == 0.0);
+    lpi_destroy(sys);
+    lpi_destroy(reference);
+}
+
+/* ---- bad input ------------------------------------------------------------- */
+
+static void expect_create_failure(size_t dim, size_t nnz, const int32_t *i, const int32_t *j,
+                                  const int32_t *k, const double *c, int status,
+                                  const char *detail) {
+    lpi_system *sys = (lpi_system *)&sys; /* must come back NULL */
+    LPI_ASSERT_FAILS(NULL, lpi_generic_create(&sys, dim, nnz, i, j, k, c), status,
+                     "lpi_generic_create");
+    assert_null(sys);
+    if (strstr(lpi_last_error(NULL), detail) == NULL)
+        fail_msg("message '%s' does not mention '%s'", lpi_last_error(NULL), detail);
+}
+
+static void test_create_errors(void **state) {
+    (void)state;
+    const int32_t zero[] = {0}, one[] = {1}, two[] = {2}, three[] = {3}, minus[] = {-1};
+    const double unit[] = {1.0};
+    expect_create_failure(0, 0, NULL, NULL, NULL, NULL, LPI_ERR_INVALID, "dim must be >= 1");
+    expect_create_failure(3, 1, NULL, one, two, unit, LPI_ERR_NULL, "i is NULL");
+    expect_create_failure(3, 1, zero, one, two, NULL, LPI_ERR_NULL, "c is NULL");
+    expect_create_failure(3, 1, zero, one, three, unit, LPI_ERR_INVALID,
+                          "entry 0: k = 3 is outside 0..2");
+    expect_create_failure(3, 1, minus, one, two, unit, LPI_ERR_INVALID,
+                          "entry 0: i = -1 is outside 0..2");
+    const double nan[] = {NAN};
+    expect_create_failure(3, 1, zero, one, two, nan, LPI_ERR_NONFINITE, "entry 0: c = nan");
+    /* {x_1, x_1} = x_2: not antisymmetric. */
+    expect_create_failure(3, 1, one, one, two, unit, LPI_ERR_INVALID, "{x_1, x_1} must be 0");
+    /* {x_0, x_1} = x_2 and {x_1, x_0} = x_2 contradict antisymmetry. */
+    {
+        const int32_t i[] = {0, 1}, j[] = {1, 0}, k[] = {2, 2};
+        const double c[] = {1.0, 1.0};
+        expect_create_failure(3, 2, i, j, k, c, LPI_ERR_INVALID,
+                              "entry 1: gives {x_1, x_0} the coefficient 1 on x_2, but entry 0 "
+                              "implies -1");
+    }
+    /* The same entry twice with different values. */
+    {
+        const int32_t i[] = {0, 0}, j[] = {1, 1}, k[] = {2, 2};
+        const double c[] = {1.0, 2.0};
+        expect_create_failure(3, 2, i, j, k, c, LPI_ERR_INVALID, "but entry 0 implies 1");
+    }
+    /* [e0,e1] = e2, [e1,e2] = e1: Jac(0,1,2) = -e2 != 0. */
+    {
+        const int32_t i[] = {0, 1}, j[] = {1, 2}, k[] = {2, 1};
+        const double c[] = {1.0, 1.0};
+        expect_create_failure(3, 2, i, j, k, c, LPI_ERR_INVALID,
+                              "Jacobi identity at (i, j, k) = (0, 1, 2)");
+        assert_non_null(strstr(lpi_last_error(NULL), "on x_2"));
+    }
+    /* so(3) plus a fourth element with {x_3, x_0} = x_3 and nothing else:
+     * Jac(1, 2, 3) = {{x_1, x_2}, x_3} = -{x_0, x_3} = x_3. */
+    {
+        const int32_t i[] = {0, 0, 1, 3}, j[] = {1, 2, 2, 0}, k[] = {2, 1, 0, 3};
+        const double c[] = {-1, 1, -1, 1};
+        expect_create_failure(4, 4, i, j, k, c, LPI_ERR_INVALID,
+                              "Jacobi identity at (i, j, k) = (1, 2, 3)");
+        assert_non_null(strstr(lpi_last_error(NULL), "coefficient 1 on x_3"));
+    }
+    LPI_ASSERT_FAILS(NULL, lpi_generic_create(NULL, 3, 3, kSoI, kSoJ, kSoK, kSoC), LPI_ERR_NULL,
+                     "lpi_generic_create");
+}
+
+static int failing_grad(size_t n, const double *x, double *g, void *user) {
+    (void)n; (void)x;
+    int *calls = (int *)user;
+    g[0] = 1.0;
+    return ++*calls > 5 ? 7 : 0; /* fails part-way through a run */
+}
+static int nan_grad(size_t n, const double *x, double *g, void *user) {
+    (void)n; (void)x; (void)user;
+    g[0] = NAN;
+    return 0;
+}
+static int failing_energy(size_t n, const double *x, double *h, void *user) {
+    (void)n; (void)x; (void)user;
+    *h = 0;
+    return 3;
+}
+static int failing_casimir(size_t dim, const double *x, double *out, void *user) {
+    (void)dim; (void)x; (void)user;
+    *out = 0;
+    return 4;
+}
+
+static void test_add_piece_errors(void **state) {
+    (void)state;
+    lpi_system *sys = generic_rigid_body();
+    const double m0[3] = {1.0, 0.5, -0.3};
+    assert_int_equal(lpi_set_state(sys, m0, 3), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.1, 3), LPI_OK);
+    const int32_t pair[] = {0, 1}, out_of_range[] = {3}, negative[] = {-2}, duplicate[] = {2, 2};
+    const int32_t ok = 0, four[] = {0, 1, 2, 0};
+
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 2, pair, axis_grad, axis_energy, NULL),
+                     LPI_ERR_NOT_ABELIAN, "lpi_add_piece");
+    assert_non_null(strstr(lpi_last_error(sys), "indices 0 and 1 do not commute, {x_0, x_1} = -1 x_2"));
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, out_of_range, axis_grad, axis_energy, NULL),
+                     LPI_ERR_INVALID, "lpi_add_piece");
+    assert_non_null(strstr(lpi_last_error(sys), "indices[0] = 3 is outside 0..2"));
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, negative, axis_grad, axis_energy, NULL),
+                     LPI_ERR_INVALID, "lpi_add_piece");
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 2, duplicate, axis_grad, axis_energy, NULL),
+                     LPI_ERR_INVALID, "lpi_add_piece");
+    assert_non_null(strstr(lpi_last_error(sys), "indices[0] and indices[1] are both 2"));
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 0, &ok, axis_grad, axis_energy, NULL),
+                     LPI_ERR_INVALID, "lpi_add_piece");
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 4, four, axis_grad, axis_energy, NULL),
+                     LPI_ERR_INVALID, "lpi_add_piece");
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, &ok, NULL, axis_energy, NULL), LPI_ERR_NULL,
+                     "lpi_add_piece");
+    assert_non_null(strstr(lpi_last_error(sys), "gradient callback is NULL"));
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, &ok, axis_grad, NULL, NULL), LPI_ERR_NULL,
+                     "lpi_add_piece");
+    assert_non_null(strstr(lpi_last_error(sys), "energy callback is NULL"));
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, NULL, axis_grad, axis_energy, NULL), LPI_ERR_NULL,
+                     "lpi_add_piece");
+    LPI_ASSERT_FAILS(NULL, lpi_add_piece(NULL, 1, &ok, axis_grad, axis_energy, NULL), LPI_ERR_NULL,
+                     "lpi_add_piece");
+    LPI_ASSERT_FAILS(sys, lpi_add_casimir(sys, NULL, NULL), LPI_ERR_NULL, "lpi_add_casimir");
+    assert_int_equal(lpi_casimir_count(sys), 1);
+
+    /* Nothing was added: the system still equals a fresh generic rigid body. */
+    lpi_system *fresh = generic_rigid_body();
+    assert_true(max_difference(sys, fresh, "leapfrog", m0, 0.1, 1, 20) == 0.0);
+    lpi_destroy(fresh);
+
+    size_t rank = 0;
+    const double bad[3] = {1, NAN, 0};
+    LPI_ASSERT_FAILS(sys, lpi_poisson_rank(sys, m0, 2, &rank), LPI_ERR_SIZE, "lpi_poisson_rank");
+    LPI_ASSERT_FAILS(sys, lpi_poisson_rank(sys, bad, 3, &rank), LPI_ERR_NONFINITE, "lpi_poisson_rank");
+    LPI_ASSERT_FAILS(sys, lpi_poisson_rank(sys, m0, 3, NULL), LPI_ERR_NULL, "lpi_poisson_rank");
+    LPI_ASSERT_FAILS(sys, lpi_poisson_rank(sys, NULL, 3, &rank), LPI_ERR_NULL, "lpi_poisson_rank");
+    lpi_destroy(sys);
+
+    /* Built-in models have no user pieces. */
+    lpi_system *rb = NULL;
+    assert_int_equal(lpi_rigid_body_create(&rb, 1, 2, 3), LPI_OK);
+    LPI_ASSERT_FAILS(rb, lpi_add_piece(rb, 1, &ok, axis_grad, axis_energy, NULL),
+                     LPI_ERR_UNSUPPORTED, "lpi_add_piece");
+    LPI_ASSERT_FAILS(rb, lpi_add_casimir(rb, norm2_casimir, NULL), LPI_ERR_UNSUPPORTED,
+                     "lpi_add_casimir");
+    LPI_ASSERT_FAILS(rb, lpi_poisson_rank(rb, m0, 3, &rank), LPI_ERR_UNSUPPORTED,
+                     "lpi_poisson_rank");
+    lpi_destroy(rb);
+}
+
+static void test_callback_failures_roll_back(void **state) {
+    (void)state;
+    const double m0[3] = {1.0, 0.5, -0.3};
+    const char *methods[] = {"leapfrog", "rk4"};
+    for (int q = 0; q < 2; ++q) {
+        lpi_system *sys = NULL;
+        int calls = 0;
+        const int32_t x0 = 0, x1 = 1;
+        assert_int_equal(lpi_generic_create(&sys, 3, 3, kSoI, kSoJ, kSoK, kSoC), LPI_OK);
+        assert_int_equal(lpi_add_piece(sys, 1, &x0, axis_grad, axis_energy, (void *)&kInertia[0]),
+                         LPI_OK);
+        assert_int_equal(lpi_add_piece(sys, 1, &x1, failing_grad, failing_energy, &calls), LPI_OK);
+        assert_int_equal(lpi_set_method(sys, methods[q]), LPI_OK);
+        assert_int_equal(lpi_set_state(sys, m0, 3), LPI_OK);
+        LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.1, 10), LPI_ERR_CALLBACK, "lpi_step");
+        assert_non_null(strstr(lpi_last_error(sys),
+                               "the gradient callback of piece 1 (indices {1}) returned 7"));
+        assert_true(lpi_time(sys) == 0.0);
+        double h;
+        LPI_ASSERT_FAILS(sys, lpi_energy(sys, &h), LPI_ERR_CALLBACK, "lpi_energy");
+        assert_non_null(strstr(lpi_last_error(sys), "energy callback of piece 1"));
+        lpi_destroy(sys);
+    }
+    /* A non-finite gradient. */
+    lpi_system *sys = NULL;
+    const int32_t x2 = 2;
+    assert_int_equal(lpi_generic_create(&sys, 3, 3, kSoI, kSoJ, kSoK, kSoC), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 1, &x2, nan_grad, axis_energy, (void *)&kInertia[2]), LPI_OK);
+    assert_int_equal(lpi_set_state(sys, m0, 3), LPI_OK);
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.1, 2), LPI_ERR_CALLBACK, "lpi_step");
+    assert_non_null(strstr(lpi_last_error(sys), "piece 0 (indices {2}) gave a non-finite component 0"));
+    /* A failing Casimir callback. */
+    assert_int_equal(lpi_add_casimir(sys, norm2_casimir, NULL), LPI_OK);
+    assert_int_equal(lpi_add_casimir(sys, failing_casimir, NULL), LPI_OK);
+    assert_int_equal(lpi_casimir_count(sys), 2);
+    double c[2];
+    LPI_ASSERT_FAILS(sys, lpi_casimirs(sys, c, 2), LPI_ERR_CALLBACK, "lpi_casimirs");
+    assert_non_null(strstr(lpi_last_error(sys), "Casimir 1 returned 4"));
+    lpi_destroy(sys);
+}
+
+static void test_no_pieces(void **state) {
+    (void)state;
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_generic_create(&sys, 3, 3, kSoI, kSoJ, kSoK, kSoC), LPI_OK);
+    const double m0[3] = {1.0, 0.5, -0.3};
+    assert_int_equal(lpi_set_state(sys, m0, 3), LPI_OK);
+    const char *methods[] = {"lie-trotter", "leapfrog", "rk4"};
+    for (int q = 0; q < 3; ++q) {
+        assert_int_equal(lpi_set_method(sys, methods[q]), LPI_OK);
+        LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.1, 1), LPI_ERR_INVALID, "lpi_step");
+        assert_non_null(strstr(lpi_last_error(sys), "no Hamiltonian pieces"));
+    }
+    double h = 1;
+    assert_int_equal(lpi_energy(sys, &h), LPI_OK);
+    assert_true(h == 0.0);
+    lpi_destroy(sys);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_rigid_body_matches_built_in),
+        cmocka_unit_test(test_pendulum_matches_built_in),
+        cmocka_unit_test(test_poisson_rank),
+        cmocka_unit_test(test_either_order_and_agreeing_duplicates),
+        cmocka_unit_test(test_create_errors),
+        cmocka_unit_test(test_add_piece_errors),
+        cmocka_unit_test(test_callback_failures_roll_back),
+        cmocka_unit_test(test_no_pieces),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

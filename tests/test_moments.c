@@ -1,0 +1,370 @@
+/* The moment algebra (McLachlan 1993): Casimirs I and K kept to round-off over
+ * 10^5 steps, measured orders against an independent RK4 on J(x) grad H with
+ * the paper's 8x8 J, the closed-form product-piece flow against a fine
+ * integration, and the separable case H = T(x3, x8) + V(x1, x4). */
+#include "lpi_test.h"
+
+/* The paper's J, written out from its printed matrix (x[0] is x1). */
+static void paper_J(const double *x, double J[8][8]) {
+    const double x1 = x[0], x2 = x[1], x3 = x[2], x4 = x[3], x5 = x[4], x6 = x[5], x7 = x[6],
+                 x8 = x[7];
+    const double rows[8][8] = {
+        {0, 2 * x1, 4 * x2, 0, 2 * x4, 4 * x5, 6 * x6, 8 * x7},
+        {-2 * x1, 0, 2 * x3, -4 * x4, -2 * x5, 0, 2 * x7, 4 * x8},
+        {-4 * x2, -2 * x3, 0, -8 * x5, -6 * x6, -4 * x7, -2 * x8, 0},
+        {0, 4 * x4, 8 * x5, 0, 0, 0, 0, 0},
+        {-2 * x4, 2 * x5, 6 * x6, 0, 0, 0, 0, 0},
+        {-4 * x5, 0, 4 * x7, 0, 0, 0, 0, 0},
+        {-6 * x6, -2 * x7, 2 * x8, 0, 0, 0, 0, 0},
+        {-8 * x7, -4 * x8, 0, 0, 0, 0, 0, 0},
+    };
+    memcpy(J, rows, sizeof rows);
+}
+
+/* ---- the Hamiltonian: four linear pieces on the paper's abelian sets plus
+ * the product piece. Coefficients are small so the motion stays bounded. */
+static const int32_t kSet1[] = {0, 3}, kSet2[] = {1, 5}, kSet3[] = {2, 7}, kSet4[] = {3, 4, 5, 6, 7};
+
+static int grad1(size_t n, const double *x, double *g, void *u) { /* 0.5 x1 + 0.01 x1^2 + 0.01 x4 */
+    (void)n; (void)u;
+    g[0] = 0.5 + 0.02 * x[0];
+    g[1] = 0.01;
+    return 0;
+}
+static int energy1(size_t n, const double *x, double *h, void *u) {
+    (void)n; (void)u;
+    *h = 0.5 * x[0] + 0.01 * x[0] * x[0] + 0.01 * x[1];
+    return 0;
+}
+static int grad2(size_t n, const double *x, double *g, void *u) { /* 0.01 x2 x6 */
+    (void)n; (void)u;
+    g[0] = 0.01 * x[1];
+    g[1] = 0.01 * x[0];
+    return 0;
+}
+static int energy2(size_t n, const double *x, double *h, void *u) {
+    (void)n; (void)u;
+    *h = 0.01 * x[0] * x[1];
+    return 0;
+}
+static int grad3(size_t n, const double *x, double *g, void *u) { /* 0.5 x3 + 0.01 x8 + 0.01 x3^2 */
+    (void)n; (void)u;
+    g[0] = 0.5 + 0.02 * x[0];
+    g[1] = 0.01;
+    return 0;
+}
+static int energy3(size_t n, const double *x, double *h, void *u) {
+    (void)n; (void)u;
+    *h = 0.5 * x[0] + 0.01 * x[1] + 0.01 * x[0] * x[0];
+    return 0;
+}
+static int grad4(size_t n, const double *x, double *g, void *u) { /* 0.005 (x5 x7 + x6^2) */
+    (void)n; (void)u;
+    g[0] = 0;
+    g[1] = 0.005 * x[3];
+    g[2] = 0.01 * x[2];
+    g[3] = 0.005 * x[1];
+    g[4] = 0;
+    return 0;
+}
+static int energy4(size_t n, const double *x, double *h, void *u) {
+    (void)n; (void)u;
+    *h = 0.005 * (x[1] * x[3] + x[2] * x[2]);
+    return 0;
+}
+static int product_h(double u, double *out, void *user) { /* 0.02 u + 0.01 u^2 */
+    (void)user;
+    *out = 0.02 * u + 0.01 * u * u;
+    return 0;
+}
+static int product_dh(double u, double *out, void *user) {
+    (void)user;
+    *out = 0.02 + 0.02 * u;
+    return 0;
+}
+
+/* A generic point (J of rank 6; Gaussian moments lie on a rank-4 stratum). */
+static const double kX0[8] = {1.0, 0.2, 0.5, 2.5, 0.6, 0.6, 0.3, 0.8};
+
+static lpi_system *full_system(void) {
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_moments_create(&sys), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 2, kSet1, grad1, energy1, NULL), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 2, kSet2, grad2, energy2, NULL), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 2, kSet3, grad3, energy3, NULL), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 5, kSet4, grad4, energy4, NULL), LPI_OK);
+    assert_int_equal(lpi_moments_add_product_piece(sys, product_h, product_dh, NULL), LPI_OK);
+    assert_int_equal(lpi_set_state(sys, kX0, 8), LPI_OK);
+    return sys;
+}
+
+/* grad H of the full Hamiltonian on all 8 coordinates, written independently. */
+static void full_gradient(const double *x, double *g) {
+    const double u = x[0] * x[2], dh = 0.02 + 0.02 * u;
+    g[0] = 0.5 + 0.02 * x[0] + dh * x[2];
+    g[1] = 0.01 * x[5];
+    g[2] = 0.5 + 0.02 * x[2] + dh * x[0];
+    g[3] = 0.01;
+    g[4] = 0.005 * x[6];
+    g[5] = 0.01 * x[1] + 0.01 * x[5];
+    g[6] = 0.005 * x[4];
+    g[7] = 0.01;
+}
+
+static void field_from_gradient(const double *x, const double *g, double *dx) {
+    double J[8][8];
+    paper_J(x, J);
+    for (int i = 0; i < 8; ++i) {
+        dx[i] = 0;
+        for (int j = 0; j < 8; ++j) dx[i] += J[i][j] * g[j];
+    }
+}
+
+static void full_field(const double *x, double *dx, const void *ctx) {
+    (void)ctx;
+    double g[8];
+    full_gradient(x, g);
+    field_from_gradient(x, g, dx);
+}
+
+static void product_field(const double *x, double *dx, const void *ctx) {
+    (void)ctx;
+    const double dh = 0.02 + 0.02 * x[0] * x[2];
+    double g[8] = {dh * x[2], 0, dh * x[0], 0, 0, 0, 0, 0};
+    field_from_gradient(x, g, dx);
+}
+
+static void casimirs_of(const double *x, double c[2]) {
+    c[0] = x[3] * x[7] - 4 * x[4] * x[6] + 3 * x[5] * x[5];
+    c[1] = x[3] * (x[5] * x[7] - x[6] * x[6]) - x[4] * (x[4] * x[7] - x[6] * x[5]) +
+           x[5] * (x[4] * x[6] - x[5] * x[5]);
+}
+
+static void test_built_in_casimirs_and_rank(void **state) {
+    (void)state;
+    lpi_system *sys = full_system();
+    assert_int_equal(lpi_casimir_count(sys), 2);
+    double c[2], expected[2];
+    assert_int_equal(lpi_casimirs(sys, c, 2), LPI_OK);
+    casimirs_of(kX0, expected);
+    assert_true(fabs(c[0] - expected[0]) <= 1e-15 * fabs(expected[0]));
+    assert_true(fabs(c[1] - expected[1]) <= 1e-15 * fabs(expected[1]));
+    /* J has rank 6 at a generic point: two Casimirs, as built in. */
+    size_t rank = 0;
+    assert_int_equal(lpi_poisson_rank(sys, kX0, 8, &rank), LPI_OK);
+    assert_int_equal(rank, 6);
+    /* J grad I = J grad K = 0 with the paper's J: they are Casimirs. */
+    const double *x = kX0;
+    const double gI[8] = {0, 0, 0, x[7], -4 * x[6], 6 * x[5], -4 * x[4], x[3]};
+    const double gK[8] = {0, 0, 0, x[5] * x[7] - x[6] * x[6], 2 * (x[6] * x[5] - x[4] * x[7]),
+                          x[3] * x[7] + 2 * x[4] * x[6] - 3 * x[5] * x[5],
+                          2 * (x[4] * x[5] - x[3] * x[6]), x[3] * x[5] - x[4] * x[4]};
+    double r[8];
+    field_from_gradient(x, gI, r);
+    for (int i = 0; i < 8; ++i) assert_true(fabs(r[i]) < 1e-14);
+    field_from_gradient(x, gK, r);
+    for (int i = 0; i < 8; ++i) assert_true(fabs(r[i]) < 1e-14);
+    /* The energy is the sum of the pieces. */
+    double h = 0;
+    assert_int_equal(lpi_energy(sys, &h), LPI_OK);
+    const double u = x[0] * x[2];
+    const double expected_h = 0.5 * x[0] + 0.01 * x[0] * x[0] + 0.01 * x[3] + 0.01 * x[1] * x[5] +
+                              0.5 * x[2] + 0.01 * x[7] + 0.01 * x[2] * x[2] +
+                              0.005 * (x[4] * x[6] + x[5] * x[5]) + 0.02 * u + 0.01 * u * u;
+    assert_true(fabs(h - expected_h) < 1e-15);
+    lpi_destroy(sys);
+}
+
+static void test_casimirs_over_1e5_steps(void **state) {
+    (void)state;
+    lpi_system *sys = full_system();
+    double c0[2], c[2], h0, h;
+    assert_int_equal(lpi_casimirs(sys, c0, 2), LPI_OK);
+    assert_int_equal(lpi_energy(sys, &h0), LPI_OK);
+    double worst[2] = {0, 0};
+    for (int chunk = 0; chunk < 100; ++chunk) {
+        assert_int_equal(lpi_step(sys, 0.01, 1000), LPI_OK);
+        assert_int_equal(lpi_casimirs(sys, c, 2), LPI_OK);
+        for (int q = 0; q < 2; ++q) {
+            const double rel = fabs(c[q] - c0[q]) / fabs(c0[q]);
+            if (rel > worst[q]) worst[q] = rel;
+        }
+    }
+    assert_int_equal(lpi_energy(sys, &h), LPI_OK);
+    printf("moments, leapfrog, 1e5 steps of 0.01: max relative drift I %.3g, K %.3g; "
+           "energy error %.3g\n", worst[0], worst[1], fabs(h - h0) / fabs(h0));
+    assert_true(worst[0] <= 1e-12);
+    assert_true(worst[1] <= 1e-12);
+    /* Energy is not a Casimir but stays bounded (a Poisson map). */
+    assert_true(fabs(h - h0) <= 1e-3 * fabs(h0));
+    lpi_destroy(sys);
+}
+
+static void measure_order(const char *method, const int64_t *steps, int count, double expected) {
+    const double T = 1.0;
+    double reference[8];
+    memcpy(reference, kX0, sizeof reference);
+    lpi_test_rk4(full_field, NULL, 8, reference, T, 4000);
+    lpi_system *sys = full_system();
+    double h[8], err[8];
+    for (int r = 0; r < count; ++r) {
+        h[r] = T / (double)steps[r];
+        err[r] = lpi_test_error(sys, method, kX0, T, steps[r], reference);
+    }
+    const double slope = lpi_fit_order(h, err, count);
+    printf("moments, %s: errors", method);
+    for (int r = 0; r < count; ++r) printf(" %.3g", err[r]);
+    printf("; measured order %.3f\n", slope);
+    assert_true(fabs(slope - expected) < 0.2);
+    lpi_destroy(sys);
+}
+
+static void test_orders_against_rk4(void **state) {
+    (void)state;
+    const int64_t leapfrog_steps[] = {8, 16, 32, 64};
+    measure_order("leapfrog", leapfrog_steps, 4, 2.0);
+    const int64_t triple_steps[] = {4, 8, 16, 32};
+    measure_order("triple-jump-4", triple_steps, 4, 4.0);
+}
+
+static void check_product_flow(const double *x0, double t) {
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_moments_create(&sys), LPI_OK);
+    assert_int_equal(lpi_moments_add_product_piece(sys, product_h, product_dh, NULL), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
+    assert_int_equal(lpi_set_state(sys, x0, 8), LPI_OK);
+    assert_int_equal(lpi_step(sys, t, 1), LPI_OK); /* one exact flow of the piece */
+    double x[8], reference[8], scale = 0;
+    assert_int_equal(lpi_get_state(sys, x, 8), LPI_OK);
+    memcpy(reference, x0, sizeof reference);
+    lpi_test_rk4(product_field, NULL, 8, reference, t, 20000);
+    for (int i = 0; i < 8; ++i) scale = fmax(scale, fabs(reference[i]));
+    const double err = lpi_test_distance(x, reference, 8) / scale;
+    printf("product piece, t = %g, x2^2 - x1 x3 = %.3g: closed form vs RK4 %.3g\n", t,
+           x0[1] * x0[1] - x0[0] * x0[2], err);
+    assert_true(err < 1e-12);
+    lpi_destroy(sys);
+}
+
+static void test_product_piece_closed_form(void **state) {
+    (void)state;
+    check_product_flow(kX0, 2.5);                 /* x2^2 < x1 x3: trigonometric */
+    const double hyperbolic[8] = {0.5, 0.9, 0.7, 1.0, -0.3, 0.4, 0.2, 1.5};
+    check_product_flow(hyperbolic, 1.5);          /* x2^2 > x1 x3: hyperbolic */
+    const double degenerate[8] = {1.0, 0.5, 0.25, 1.0, 0.5, 0.25, 0.125, 0.0625};
+    check_product_flow(degenerate, 1.0);          /* x2^2 = x1 x3 */
+}
+
+/* The separable case of the paper: H = T(x3, x8) + V(x1, x4), as for
+ * Vlasov-Poisson; T = x3/2 + 0.05 x8, V = x1/2 + 0.1 x4. */
+static const int32_t kT[] = {2, 7}, kV[] = {0, 3};
+static int gradT(size_t n, const double *x, double *g, void *u) {
+    (void)n; (void)x; (void)u;
+    g[0] = 0.5;
+    g[1] = 0.05;
+    return 0;
+}
+static int energyT(size_t n, const double *x, double *h, void *u) {
+    (void)n; (void)u;
+    *h = 0.5 * x[0] + 0.05 * x[1];
+    return 0;
+}
+static int gradV(size_t n, const double *x, double *g, void *u) {
+    (void)n; (void)x; (void)u;
+    g[0] = 0.5;
+    g[1] = 0.1;
+    return 0;
+}
+static int energyV(size_t n, const double *x, double *h, void *u) {
+    (void)n; (void)u;
+    *h = 0.5 * x[0] + 0.1 * x[1];
+    return 0;
+}
+static void separable_field(const double *x, double *dx, const void *ctx) {
+    (void)ctx;
+    const double g[8] = {0.5, 0, 0.5, 0.1, 0, 0, 0, 0.05};
+    field_from_gradient(x, g, dx);
+}
+
+static void test_separable_case(void **state) {
+    (void)state;
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_moments_create(&sys), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 2, kT, gradT, energyT, NULL), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 2, kV, gradV, energyV, NULL), LPI_OK);
+    const double T = 2.0;
+    double reference[8];
+    memcpy(reference, kX0, sizeof reference);
+    lpi_test_rk4(separable_field, NULL, 8, reference, T, 4000);
+    const int64_t steps[] = {10, 20, 40, 80};
+    double h[4], err[4];
+    for (int r = 0; r < 4; ++r) {
+        h[r] = T / (double)steps[r];
+        err[r] = lpi_test_error(sys, "leapfrog", kX0, T, steps[r], reference);
+    }
+    const double slope = lpi_fit_order(h, err, 4);
+    printf("moments, separable T(x3,x8) + V(x1,x4), leapfrog: measured order %.3f\n", slope);
+    assert_true(fabs(slope - 2.0) < 0.2);
+    double c0[2], c[2];
+    casimirs_of(kX0, c0);
+    assert_int_equal(lpi_set_state(sys, kX0, 8), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.05, 10000), LPI_OK);
+    assert_int_equal(lpi_casimirs(sys, c, 2), LPI_OK);
+    for (int q = 0; q < 2; ++q) assert_true(fabs(c[q] - c0[q]) <= 1e-12 * fabs(c0[q]));
+    lpi_destroy(sys);
+}
+
+static int nan_dh(double u, double *out, void *user) {
+    (void)u; (void)user;
+    *out = NAN;
+    return 0;
+}
+
+static void test_product_piece_errors(void **state) {
+    (void)state;
+    lpi_system *sys = full_system();
+    LPI_ASSERT_FAILS(sys, lpi_moments_add_product_piece(sys, NULL, product_dh, NULL), LPI_ERR_NULL,
+                     "lpi_moments_add_product_piece");
+    assert_non_null(strstr(lpi_last_error(sys), "H callback"));
+    LPI_ASSERT_FAILS(sys, lpi_moments_add_product_piece(sys, product_h, NULL, NULL), LPI_ERR_NULL,
+                     "lpi_moments_add_product_piece");
+    LPI_ASSERT_FAILS(NULL, lpi_moments_add_product_piece(NULL, product_h, product_dh, NULL),
+                     LPI_ERR_NULL, "lpi_moments_add_product_piece");
+    /* {x1, x3} = 4 x2: the product piece's indices are not an abelian set. */
+    const int32_t product_set[] = {0, 2};
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 2, product_set, grad1, energy1, NULL),
+                     LPI_ERR_NOT_ABELIAN, "lpi_add_piece");
+    assert_non_null(strstr(lpi_last_error(sys), "indices 0 and 2"));
+    lpi_destroy(sys);
+
+    lpi_system *generic = NULL;
+    const int32_t i[] = {0}, j[] = {1}, k[] = {2};
+    const double c[] = {1.0};
+    assert_int_equal(lpi_generic_create(&generic, 3, 1, i, j, k, c), LPI_OK);
+    LPI_ASSERT_FAILS(generic, lpi_moments_add_product_piece(generic, product_h, product_dh, NULL),
+                     LPI_ERR_UNSUPPORTED, "lpi_moments_add_product_piece");
+    lpi_destroy(generic);
+    LPI_ASSERT_FAILS(NULL, lpi_moments_create(NULL), LPI_ERR_NULL, "lpi_moments_create");
+
+    /* A non-finite H' fails the step cleanly, naming the piece. */
+    lpi_system *bad = NULL;
+    assert_int_equal(lpi_moments_create(&bad), LPI_OK);
+    assert_int_equal(lpi_add_piece(bad, 2, kSet1, grad1, energy1, NULL), LPI_OK);
+    assert_int_equal(lpi_moments_add_product_piece(bad, product_h, nan_dh, NULL), LPI_OK);
+    assert_int_equal(lpi_set_state(bad, kX0, 8), LPI_OK);
+    LPI_ASSERT_FAILS(bad, lpi_step(bad, 0.1, 5), LPI_ERR_CALLBACK, "lpi_step");
+    assert_non_null(strstr(lpi_last_error(bad), "H' callback of piece 1 (product H(x1 x3))"));
+    lpi_destroy(bad);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_built_in_casimirs_and_rank),
+        cmocka_unit_test(test_casimirs_over_1e5_steps),
+        cmocka_unit_test(test_orders_against_rk4),
+        cmocka_unit_test(test_product_piece_closed_form),
+        cmocka_unit_test(test_separable_case),
+        cmocka_unit_test(test_product_piece_errors),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
