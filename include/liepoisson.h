@@ -69,6 +69,9 @@ LPI_API const char *lpi_status_message(int status);  /* one-line description */
 LPI_API int lpi_method_count(void);
 LPI_API const char *lpi_method_name(int i);
 LPI_API int lpi_method_order(int i);
+/* 1 if method i is a Poisson map (keeps every Casimir to round-off), 0 for the
+ * baselines (rk4, implicit-midpoint, ...), -1 out of range. */
+LPI_API int lpi_method_is_poisson(int i);
 
 /* ---- Systems ------------------------------------------------------------- */
 
@@ -141,6 +144,12 @@ LPI_API int lpi_set_composition(lpi_system *sys, size_t n, const double *gammas)
  * flows of the same piece that meet at stage seams and across steps are
  * merged (for rk4: vector-field evaluations per step). */
 LPI_API int lpi_flows_per_step(const lpi_system *sys, size_t *out);
+
+/* Settings of the implicit baselines (implicit-midpoint; isomp for sine-Euler):
+ * the fixed-point iteration stops when max|change| <= tolerance * max(1, max|x|)
+ * and fails with LPI_ERR_NO_CONVERGENCE (state rolled back) after
+ * max_iterations. Defaults: 1e-13 and 100. Kept across lpi_set_method. */
+LPI_API int lpi_set_implicit_options(lpi_system *sys, double tolerance, int32_t max_iterations);
 /* ---- Generic Lie-Poisson systems and the moment algebra ------------------ */
 
 /* Callbacks of user-defined systems. Each returns 0 on success; any other

@@ -1,6 +1,8 @@
 // The C ABI of the method registry and of a system's composition: names,
 // orders, stages and sources of the methods; user-supplied compositions; the
 // cost of a step in piece flows.
+#include <cmath>
+
 #include "../core/methods.hpp"
 #include "handle.hpp"
 
@@ -38,6 +40,19 @@ LPI_API int lpi_method_stages(int i) {
 LPI_API const char *lpi_method_reference(int i) {
     const lpi::Method *m = row(i);
     return m ? m->reference.c_str() : nullptr;
+}
+
+LPI_API int lpi_method_is_poisson(int i) {
+    const lpi::Method *m = row(i);
+    return m ? (m->poisson ? 1 : 0) : -1;
+}
+
+LPI_API int lpi_set_implicit_options(lpi_system *sys, double tolerance, int32_t max_iterations) {
+    return guarded(sys, "lpi_set_implicit_options", [&] {
+        require(sys, "system");
+        if (std::isnan(tolerance)) lpi::fail(LPI_ERR_NONFINITE, "tolerance is NaN");
+        sys->system.set_implicit_settings({tolerance, max_iterations});
+    });
 }
 
 LPI_API int lpi_set_composition(lpi_system *sys, size_t n, const double *gammas) {

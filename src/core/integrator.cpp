@@ -3,6 +3,7 @@
 #include <cmath>
 #include <vector>
 
+#include "../reference/implicit_midpoint.hpp"
 #include "../reference/runge_kutta4.hpp"
 #include "error.hpp"
 
@@ -59,7 +60,8 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Integrator> make_integrator(const Method &method, const Model &model) {
+std::unique_ptr<Integrator> make_integrator(const Method &method, const Model &model,
+                                            const ImplicitSettings &implicit) {
     switch (method.kind) {
     case MethodKind::Sequence:
     case MethodKind::SequenceAdjoint:
@@ -68,6 +70,8 @@ std::unique_ptr<Integrator> make_integrator(const Method &method, const Model &m
             build_flow_program(method, model.piece_count()));
     case MethodKind::RungeKutta4:
         return std::make_unique<RungeKutta4>(model.state_size());
+    case MethodKind::ImplicitMidpoint:
+        return std::make_unique<ImplicitMidpoint>(model.state_size(), implicit);
     }
     fail(LPI_ERR_INTERNAL, "unhandled method kind for '" + method.name + "'");
 }

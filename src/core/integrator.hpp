@@ -23,7 +23,14 @@ public:
     virtual std::size_t evaluations_per_step() const = 0;
 };
 
-std::unique_ptr<Integrator> make_integrator(const Method &method, const Model &model);
+// How implicit methods solve their equations (fixed-point iteration).
+struct ImplicitSettings {
+    double tolerance = 1e-13;  // on max|increment| relative to max(1, max|x|)
+    int max_iterations = 100;
+};
+
+std::unique_ptr<Integrator> make_integrator(const Method &method, const Model &model,
+                                            const ImplicitSettings &implicit = {});
 
 bool all_finite(const double *x, std::size_t n);
 

@@ -157,6 +157,17 @@ std::vector<Method> make_table() {
     rk4.poisson = false;
     rk4.kind = MethodKind::RungeKutta4;
     table.push_back(rk4);
+
+    Method midpoint;
+    midpoint.name = "implicit-midpoint";
+    midpoint.order = 2;
+    midpoint.stages = 1;
+    midpoint.reference = "implicit midpoint rule, fixed-point iteration (Hairer, Lubich & Wanner, "
+                         "Geometric Numerical Integration (2006) sect. IV.4.2, VI.3); symplectic "
+                         "for canonical systems, not a Lie-Poisson map";
+    midpoint.poisson = false;
+    midpoint.kind = MethodKind::ImplicitMidpoint;
+    table.push_back(midpoint);
     return table;
 }
 
@@ -293,6 +304,7 @@ std::vector<Flow> build_flow_program(const Method &method, std::size_t pieces) {
         }
         break;
     case MethodKind::RungeKutta4:
+    case MethodKind::ImplicitMidpoint:
         fail(LPI_ERR_INTERNAL, "build_flow_program called for a non-splitting method");
     }
     std::vector<Flow> merged;

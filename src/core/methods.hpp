@@ -14,6 +14,7 @@ enum class MethodKind {
     SequenceAdjoint,     // each piece once per step, in reverse order
     SymmetricComposition,// leapfrog stages with weights gammas (sum 1, symmetric)
     RungeKutta4,         // classical RK4 on the full vector field (not Poisson)
+    ImplicitMidpoint,    // implicit midpoint rule on the full vector field (not Poisson)
 };
 
 struct Method {

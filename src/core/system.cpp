@@ -18,18 +18,18 @@ System::System(std::unique_ptr<Model> model)
     rebuild_integrator();
 }
 
-void System::rebuild_integrator() { integrator_ = make_integrator(method_, *model_); }
+void System::rebuild_integrator() { integrator_ = make_integrator(method_, *model_, implicit_); }
 
 void System::set_method(const std::string &name) {
     Method method = find_method(name);
-    auto integrator = make_integrator(method, *model_);
+    auto integrator = make_integrator(method, *model_, implicit_);
     method_ = std::move(method);
     integrator_ = std::move(integrator);
 }
 
 void System::set_composition(const double *gammas, std::size_t n) {
     Method method = custom_composition(gammas, n);
-    auto integrator = make_integrator(method, *model_);
+    auto integrator = make_integrator(method, *model_, implicit_);
     method_ = std::move(method);
     integrator_ = std::move(integrator);
 }
@@ -43,6 +43,17 @@ void System::set_split(const std::string &name) {
         model_->set_split(previous);
         throw;
     }
+}
+
+void System::set_implicit_settings(const ImplicitSettings &settings) {
+    if (!(settings.tolerance > 0.0) || !std::isfinite(settings.tolerance))
+        fail(LPI_ERR_INVALID, "tolerance must be finite and > 0");
+    if (settings.max_iterations < 1)
+        fail(LPI_ERR_INVALID, "max_iterations must be >= 1, got " +
+                                  std::to_string(settings.max_iterations));
+    auto integrator = make_integrator(method_, *model_, settings);
+    implicit_ = settings;
+    integrator_ = std::move(integrator);
 }
 
 void System::set_state(const double *x, std::size_t n) {

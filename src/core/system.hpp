@@ -25,6 +25,7 @@ public:
     void set_method(const std::string &name);
     // A user-supplied symmetric composition of leapfrog (see custom_composition).
     void set_composition(const double *gammas, std::size_t n);
+    void set_implicit_settings(const ImplicitSettings &settings);
     // Piece flows (RK4: vector-field evaluations) per step in a long run.
     std::size_t flows_per_step() const { return integrator_->evaluations_per_step(); }
     void set_split(const std::string &name);
@@ -52,6 +53,7 @@ private:
     std::vector<double> state_;
     std::vector<double> saved_;  // the state before the step in progress
     double time_ = 0.0;
+    ImplicitSettings implicit_;
 };
 
 // Throws LPI_ERR_SIZE unless given == expected, naming what was expected.

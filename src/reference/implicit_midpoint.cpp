@@ -31,10 +31,14 @@ bool ImplicitMidpoint::advance(Model &model, double *x, double dt, std::int64_t 
             double change = 0.0;
             for (std::size_t i = 0; i < size; ++i) {
                 const double y = x[i] + 0.5 * dt * rate_[i];
-                change = std::max(change, std::fabs(y - midpoint_[i]));
+                const double d = std::fabs(y - midpoint_[i]);
+                if (d > change || std::isnan(d)) change = d;  // a NaN, once seen, stays
                 midpoint_[i] = y;
             }
-            if (!std::isfinite(change)) return false;
+            if (!std::isfinite(change))
+                fail(LPI_ERR_NO_CONVERGENCE,
+                     "implicit midpoint: fixed-point iteration diverged at step " +
+                         std::to_string(step) + " (dt too large for the iteration); state rolled back");
             converged = change <= settings_.tolerance * scale;
         }
         if (!converged)

@@ -9,11 +9,6 @@
 
 namespace lpi {
 
-struct ImplicitSettings {
-    double tolerance = 1e-13;  // on max|increment| relative to max(1, max|x|)
-    int max_iterations = 100;
-};
-
 class ImplicitMidpoint final : public Integrator {
 public:
     ImplicitMidpoint(std::size_t size, ImplicitSettings settings);

@@ -1,0 +1,103 @@
+/* The non-Poisson baselines a user would otherwise pick: RK4 and the implicit
+ * midpoint rule. Their accuracy is measured in test_compositions; here: their
+ * failure modes (non-convergence rolled back), their settings, and that the
+ * registry says honestly which methods are Poisson maps. */
+#include "lpi_test.h"
+
+static lpi_system *rigid_body(void) {
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_rigid_body_create(&sys, 1.0, 2.0, 3.0), LPI_OK);
+    const double m[3] = {1.0, 0.5, -0.3};
+    assert_int_equal(lpi_set_state(sys, m, 3), LPI_OK);
+    return sys;
+}
+
+static int method_index(const char *name) {
+    for (int i = 0; i < lpi_method_count(); ++i)
+        if (strcmp(lpi_method_name(i), name) == 0) return i;
+    fail_msg("method %s not registered", name);
+    return -1;
+}
+
+static void test_poisson_flags(void **state) {
+    (void)state;
+    assert_int_equal(lpi_method_is_poisson(method_index("leapfrog")), 1);
+    assert_int_equal(lpi_method_is_poisson(method_index("kahan-li-8")), 1);
+    assert_int_equal(lpi_method_is_poisson(method_index("rk4")), 0);
+    assert_int_equal(lpi_method_is_poisson(method_index("implicit-midpoint")), 0);
+    assert_int_equal(lpi_method_is_poisson(-1), -1);
+    assert_int_equal(lpi_method_is_poisson(lpi_method_count()), -1);
+}
+
+/* A step far beyond the fixed-point iteration's reach (h * |omega| >> 2)
+ * fails with LPI_ERR_NO_CONVERGENCE and leaves the state as it was. */
+static void test_midpoint_non_convergence_rolls_back(void **state) {
+    (void)state;
+    lpi_system *sys = rigid_body();
+    assert_int_equal(lpi_step(sys, 0.01, 10), LPI_OK); /* some history to keep */
+    assert_int_equal(lpi_set_method(sys, "implicit-midpoint"), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.01, 10), LPI_OK);
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 50.0, 5), LPI_ERR_NO_CONVERGENCE, "lpi_step");
+    assert_non_null(strstr(lpi_last_error(sys), "rolled back"));
+    /* With a tiny iteration limit even a modest step does not converge... */
+    assert_int_equal(lpi_set_implicit_options(sys, 1e-15, 2), LPI_OK);
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.1, 100), LPI_ERR_NO_CONVERGENCE, "lpi_step");
+    /* ...and a loose tolerance makes it converge, less accurately. */
+    assert_int_equal(lpi_set_implicit_options(sys, 1e-3, 2), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.1, 100), LPI_OK);
+    /* The settings survive a change of method. */
+    assert_int_equal(lpi_set_method(sys, "leapfrog"), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "implicit-midpoint"), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.1, 10), LPI_OK);
+    lpi_destroy(sys);
+}
+
+/* The implicit midpoint rule conserves every quadratic invariant in exact
+ * arithmetic; for the rigid body both |m|^2 and H are quadratic, so both stay
+ * at the level of the iteration tolerance: a check that the solve is tight. */
+static void test_midpoint_keeps_quadratic_invariants(void **state) {
+    (void)state;
+    lpi_system *sys = rigid_body();
+    assert_int_equal(lpi_set_method(sys, "implicit-midpoint"), LPI_OK);
+    double c0, c, h0, h;
+    assert_int_equal(lpi_casimirs(sys, &c0, 1), LPI_OK);
+    assert_int_equal(lpi_energy(sys, &h0), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.05, 20000), LPI_OK);
+    assert_int_equal(lpi_casimirs(sys, &c, 1), LPI_OK);
+    assert_int_equal(lpi_energy(sys, &h), LPI_OK);
+    print_message("implicit midpoint, 20000 steps: |m|^2 drift %.2e, energy drift %.2e\n",
+                  fabs(c / c0 - 1), fabs(h / h0 - 1));
+    assert_true(fabs(c / c0 - 1) < 1e-10);
+    assert_true(fabs(h / h0 - 1) < 1e-10);
+    lpi_destroy(sys);
+}
+
+static void test_implicit_options_bad_input(void **state) {
+    (void)state;
+    lpi_system *sys = rigid_body();
+    LPI_ASSERT_FAILS(NULL, lpi_set_implicit_options(NULL, 1e-12, 10), LPI_ERR_NULL,
+                     "lpi_set_implicit_options");
+    LPI_ASSERT_FAILS(sys, lpi_set_implicit_options(sys, 0.0, 10), LPI_ERR_INVALID,
+                     "lpi_set_implicit_options");
+    LPI_ASSERT_FAILS(sys, lpi_set_implicit_options(sys, -1e-12, 10), LPI_ERR_INVALID,
+                     "lpi_set_implicit_options");
+    LPI_ASSERT_FAILS(sys, lpi_set_implicit_options(sys, NAN, 10), LPI_ERR_NONFINITE,
+                     "lpi_set_implicit_options");
+    LPI_ASSERT_FAILS(sys, lpi_set_implicit_options(sys, INFINITY, 10), LPI_ERR_INVALID,
+                     "lpi_set_implicit_options");
+    LPI_ASSERT_FAILS(sys, lpi_set_implicit_options(sys, 1e-12, 0), LPI_ERR_INVALID,
+                     "lpi_set_implicit_options");
+    LPI_ASSERT_FAILS(sys, lpi_set_implicit_options(sys, 1e-12, -5), LPI_ERR_INVALID,
+                     "lpi_set_implicit_options");
+    lpi_destroy(sys);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_poisson_flags),
+        cmocka_unit_test(test_midpoint_non_convergence_rolls_back),
+        cmocka_unit_test(test_midpoint_keeps_quadratic_invariants),
+        cmocka_unit_test(test_implicit_options_bad_input),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
