@@ -100,11 +100,18 @@ Row measure(const Scene &scene, const char *method, int order, double dt,
 }
 
 // CPU time a method needs for `target` error, interpolated log-log along its
-// sweep; NaN when the sweep does not reach it.
-double cpu_at_error(const std::vector<Row> &rows, const std::string &method, double target) {
+// sweep. `bound` is set when even the largest step beats the target (the
+// figure is then an upper bound); NaN when the sweep does not reach it.
+double cpu_at_error(const std::vector<Row> &rows, const std::string &method, double target,
+                    bool *bound) {
     const Row *previous = nullptr;
+    *bound = false;
     for (const Row &r : rows) {
         if (r.method != method || !(r.error > 0.0) || std::isnan(r.cpu)) continue;
+        if (!previous && r.error <= target) {
+            *bound = true;
+            return r.cpu;
+        }
         if (previous && (previous->error - target) * (r.error - target) <= 0.0) {
             const double f = std::log(target / previous->error) / std::log(r.error / previous->error);
             return std::exp(std::log(previous->cpu) + f * std::log(r.cpu / previous->cpu));
@@ -198,8 +205,12 @@ void run_report(const Scene &scene, const ReportOptions &options) {
             if (lpi_set_method(probe.get(), method) != LPI_OK) continue;  // not applicable here
         }
         methods.push_back(method);
-        for (double dt : scene.steps) {
-            std::vector<Sample> *history = dt == history_dt ? &histories[method] : nullptr;
+        // A composition of s leapfrog stages sweeps steps s times larger, so
+        // every method spans about the same range of cost.
+        const double stretch = std::max(1, lpi_method_stages(i));
+        for (double base_dt : scene.steps) {
+            const double dt = std::min(base_dt * stretch, scene.final_time);
+            std::vector<Sample> *history = base_dt == history_dt ? &histories[method] : nullptr;
             const Row r = measure(scene, method, lpi_method_order(i), dt, reference, options, history);
             rows.push_back(r);
             std::printf("%-24s %9.4g %9lld %11.3e %11.3e %11.3e %11.3e %10.1f  %s\n", r.method.c_str(),
@@ -209,7 +220,7 @@ void run_report(const Scene &scene, const ReportOptions &options) {
         }
     }
 
-    std::printf("\n   CPU seconds to reach a final error (interpolated along each sweep; - = not reached):\n");
+    std::printf("\n   CPU seconds to reach a final error (interpolated along each sweep;\n   < = reached at the largest step already, an upper bound; - = not reached):\n");
     const double targets[] = {1e-2, 1e-4, 1e-6, 1e-8};
     std::printf("   %-24s", "method");
     for (double t : targets) std::printf(" %11.0e", t);
@@ -217,11 +228,44 @@ void run_report(const Scene &scene, const ReportOptions &options) {
     for (const std::string &m : methods) {
         std::printf("   %-24s", m.c_str());
         for (double t : targets) {
-            const double c = cpu_at_error(rows, m, t);
+            bool bound = false;
+            const double c = cpu_at_error(rows, m, t, &bound);
             if (std::isnan(c))
                 std::printf(" %11s", "-");
             else
-                std::printf(" %11.3e", c);
+                std::printf(" %s%10.3e", bound ? "<" : " ", c);
+        }
+        std::printf("\n");
+    }
+
+    // At equal final error: each baseline's CPU time over the best Poisson
+    // (splitting) method's.
+    std::printf("\n   at equal final error, CPU time of each baseline over the best splitting method:\n");
+    for (double t : targets) {
+        double best = kNaN;
+        std::string best_method;
+        for (int i = 0; i < lpi_method_count(); ++i) {
+            bool bound = false;
+            const std::string m = lpi_method_name(i);
+            if (lpi_method_is_poisson(i) != 1 ||
+                std::find(methods.begin(), methods.end(), m) == methods.end())
+                continue;
+            const double c = cpu_at_error(rows, m, t, &bound);
+            if (!bound && c > 0.0 && !(c >= best)) best = c, best_method = m;
+        }
+        if (std::isnan(best)) continue;
+        std::printf("   error %.0e: best splitting %s %.3e s;", t, best_method.c_str(), best);
+        for (int i = 0; i < lpi_method_count(); ++i) {
+            bool bound = false;
+            const std::string m = lpi_method_name(i);
+            if (lpi_method_is_poisson(i) != 0 ||
+                std::find(methods.begin(), methods.end(), m) == methods.end())
+                continue;
+            const double c = cpu_at_error(rows, m, t, &bound);
+            if (std::isnan(c))
+                std::printf(" %s not reached;", m.c_str());
+            else
+                std::printf(" %s %s%.2fx;", m.c_str(), bound ? "<" : "", c / best);
         }
         std::printf("\n");
     }

@@ -6,6 +6,28 @@ namespace lpi_cli {
 
 namespace {
 
+// The moment scene's Hamiltonian, split as in the paper: a nearly harmonic
+// ensemble with weak quartic coupling,
+// H = V(x1, x4) + T(x3, x8) + P(x1 x3) with V = x1/2 + x1^2/100 + x4/100,
+// T = x3/2 + x3^2/100 + x8/100 and P(u) = u/50 + u^2/100.
+int potential_gradient(size_t, const double *x, double *g, void *) {
+    g[0] = 0.5 + 0.02 * x[0];
+    g[1] = 0.01;
+    return 0;
+}
+int potential_energy(size_t, const double *x, double *h, void *) {
+    *h = 0.5 * x[0] + 0.01 * x[0] * x[0] + 0.01 * x[1];
+    return 0;
+}
+int product_h(double u, double *out, void *) {
+    *out = 0.02 * u + 0.01 * u * u;
+    return 0;
+}
+int product_dh(double u, double *out, void *) {
+    *out = 0.02 + 0.02 * u;
+    return 0;
+}
+
 Handle with_state(Handle h, const std::vector<double> &x) {
     check(lpi_set_state(h.get(), x.data(), x.size()), h.get(), "set state");
     return h;
@@ -42,6 +64,28 @@ std::vector<Scene> builtin_scenes() {
         s.steps = {0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625};
         s.reference_method = "rk4";
         s.reference_step = 2e-4;
+        scenes.push_back(s);
+    }
+    {
+        Scene s;
+        s.name = "moments";
+        s.description = "moment algebra (8-dim), pieces V(x1,x4) + T(x3,x8) + P(x1 x3)";
+        s.create = [] {
+            Handle h;
+            check(lpi_moments_create(h.out()), nullptr, "create moments");
+            const int32_t potential[2] = {0, 3}, kinetic[2] = {2, 7};
+            check(lpi_add_piece(h.get(), 2, potential, potential_gradient, potential_energy, nullptr),
+                  h.get(), "add piece");
+            check(lpi_add_piece(h.get(), 2, kinetic, potential_gradient, potential_energy, nullptr),
+                  h.get(), "add piece");
+            check(lpi_moments_add_product_piece(h.get(), product_h, product_dh, nullptr), h.get(),
+                  "add product piece");
+            return with_state(std::move(h), {1.0, 0.2, 0.5, 2.5, 0.6, 0.6, 0.3, 0.8});
+        };
+        s.final_time = 20.0;
+        s.steps = {0.05, 0.025, 0.0125, 0.00625, 0.003125};
+        s.reference_method = "kahan-li-8";
+        s.reference_step = 5e-4;
         scenes.push_back(s);
     }
     return scenes;
