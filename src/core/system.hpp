@@ -24,6 +24,7 @@ public:
 
     void set_method(const std::string &name);
     void set_split(const std::string &name);
+    void set_threads(int n) { model_->set_threads(n); }
 
     std::size_t dim() const { return model_->dim(); }
     void set_state(const double *x, std::size_t n);  // also resets time to 0
