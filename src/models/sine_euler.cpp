@@ -9,6 +9,10 @@
 // so exp(t Lambda_l) = u_{l-c} conj(u_{l+c}) with u_l = exp(i t B_l / (2 eps)).
 // One FFT gives B; each line costs a forward and a backward FFT, and lines
 // -c are the conjugates of lines c, so M = (N-1)/2 lines are integrated.
+// Every flow is exactly unitary; what remains of the Casimir drift is FFTW's
+// own round-trip norm bias (a property of each plan: measured -6e-17 per round
+// trip at N = 31, -1e-16 at 61, +3.4e-16 at 127), accumulated over the
+// (2P-2) M line round trips of a step.
 #include "sine_euler.hpp"
 
 #include <algorithm>
