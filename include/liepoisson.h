@@ -203,6 +203,58 @@ LPI_API int lpi_moments_create(lpi_system **out);
  * flow; h and dh give H(u) and H'(u) at u = x1 x3. */
 LPI_API int lpi_moments_add_product_piece(lpi_system *sys, lpi_scalar_fn h, lpi_scalar_fn dh,
                                           void *user);
+/* ---- Sine-Euler (Zeitlin's su(N) model of 2D Euler; needs FFTW3) ------- *
+ * Modes w_m, m in Z_N x Z_N, N odd >= 3, eps = 2 pi / N, w_{-m} = conj(w_m):
+ *   dw_m/dt = sum_{n != 0} sin(eps m x n) / (eps |n|^2) w_{m+n} w_{-n}
+ * (McLachlan 1993, eq. 5), H = 1/2 sum_{n != 0} |w_n|^2 / |n|^2, |n| from the
+ * representative of n in -M..M (N = 2M+1). Integrated by exact flows of one
+ * piece per direction of the projective line over Z_N (N + 1 directions for
+ * prime N); every Casimir (the spectrum of W = sum_m w_m J_m) is kept to
+ * round-off. See lpi_sine_euler_create(3). */
+
+/* Built without FFTW3: LPI_ERR_UNSUPPORTED. N even or < 3: LPI_ERR_INVALID. */
+LPI_API int lpi_sine_euler_create(lpi_system **out, int32_t N);
+/* N of a sine-Euler system (LPI_ERR_INVALID for another kind of system). */
+LPI_API int lpi_sine_euler_size(const lpi_system *sys, int32_t *N);
+
+/* Modes, n = 2*N*N doubles: entry [a*N + b] is mode (a, b) mod N (FFT order)
+ * as interleaved re, im. set checks finiteness and Hermitian symmetry
+ * (tolerance 1e-10 * max |w_m|) and stores the symmetrised field; resets the
+ * time to 0. The inert mode w_0 is kept as given (its imaginary part must be 0
+ * within the tolerance). */
+LPI_API int lpi_sine_euler_set_modes(lpi_system *sys, const double *re_im, size_t n);
+LPI_API int lpi_sine_euler_get_modes(const lpi_system *sys, double *re_im, size_t n);
+/* Real vorticity on the grid, n = N*N: entry [a*N + b] is
+ * w(2 pi a / N, 2 pi b / N) = sum_m w_m exp(i (m1 x + m2 y)). */
+LPI_API int lpi_sine_euler_set_grid(lpi_system *sys, const double *w, size_t n);
+LPI_API int lpi_sine_euler_get_grid(const lpi_system *sys, double *w, size_t n);
+
+/* Enstrophy 1/2 sum_m |w_m|^2 (w_0 included) = tr(W^2) / (2N). */
+LPI_API int lpi_sine_euler_enstrophy(const lpi_system *sys, double *out);
+/* out[k-1] = (1/N) tr W^k for k = 1 .. kmax (kmax >= 1; O(kmax N^3)). */
+LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, double *out);
+
+/* Measures the FFT floor: FFTW executing, with this system's plans, buffers
+ * and thread count, the transforms that nsteps steps of the current method
+ * execute (and nothing else). Gives seconds per step and transforms per step.
+ * A benchmark diagnostic; the state is not touched. */
+LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *seconds_per_step,
+                                     double *transforms_per_step);
+
+/* Threads used inside one step (OpenMP over the lines of a direction); n >= 1.
+ * Results are identical to the bit for every n. Models that integrate on one
+ * thread accept only n = 1 (LPI_ERR_UNSUPPORTED otherwise), as does a build
+ * without OpenMP. */
+LPI_API int lpi_set_threads(lpi_system *sys, int32_t n);
+
+/* FFTW wisdom (shared by the whole process; planning is serialised inside the
+ * library). Built without FFTW3: LPI_ERR_UNSUPPORTED. export_string writes at
+ * most size bytes including the NUL and sets *length to the length without
+ * it; LPI_ERR_SIZE when size <= *length (buf may then be NULL with size 0). */
+LPI_API int lpi_fftw_wisdom_import_file(const char *path);
+LPI_API int lpi_fftw_wisdom_export_file(const char *path);
+LPI_API int lpi_fftw_wisdom_import_string(const char *wisdom);
+LPI_API int lpi_fftw_wisdom_export_string(char *buf, size_t size, size_t *length);
 
 #ifdef __cplusplus
 }

@@ -19,6 +19,12 @@ void Model::from_public(const double *x, double *state) const {
     std::copy(x, x + dim(), state);
 }
 
+void Model::set_threads(int n) {
+    if (n < 1) fail(LPI_ERR_INVALID, "thread count must be >= 1, got " + std::to_string(n));
+    if (n > 1)
+        fail(LPI_ERR_UNSUPPORTED, std::string(kind()) + " integrates on one thread only");
+}
+
 }  // namespace lpi
 
 namespace lpi {

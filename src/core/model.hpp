@@ -43,6 +43,10 @@ public:
     // The full vector field J(x) grad H(x) in the working layout: what the
     // non-splitting reference methods integrate.
     virtual void vector_field(const double *state, double *rate) const = 0;
+
+    // Threads used inside one flow. The default integrates on one thread:
+    // n = 1 is accepted, n > 1 throws LPI_ERR_UNSUPPORTED.
+    virtual void set_threads(int n);
 };
 
 }  // namespace lpi

@@ -29,6 +29,7 @@ public:
     // Piece flows (RK4: vector-field evaluations) per step in a long run.
     std::size_t flows_per_step() const { return integrator_->evaluations_per_step(); }
     void set_split(const std::string &name);
+    void set_threads(int n) { model_->set_threads(n); }
 
     std::size_t dim() const { return model_->dim(); }
     void set_state(const double *x, std::size_t n);  // also resets time to 0

@@ -1,0 +1,152 @@
+// The matrix form of sine-Euler (design notes, section 1): with q = exp(4 pi i/N),
+// g = diag(q^a), h e_a = e_{a-1}, J_m = exp(2 pi i m1 m2 / N) g^m1 h^m2, the entry
+// (a, b) of J_m is exp(2 pi i m1 (a + b) / N) when b - a = m2 (mod N), else 0.
+// So W = sum_m w_m J_m has W_{a,a+m2} = sum_m1 w_(m1,m2) exp(2 pi i m1 (2a + m2) / N),
+// and w_m = tr(W J_m^dagger) / N inverts it. Eq. 5 is dW/dt = (i/(2 eps)) [P, W]
+// with P = sum_{n != 0} w_n / |n|^2 J_n. These serve diagnostics and the
+// reference methods, never the splitting's hot path.
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "../core/error.hpp"
+#include "lpi_config.h"
+#include "sine_euler.hpp"
+
+namespace lpi {
+
+namespace {
+
+using cplx = std::complex<double>;
+
+std::vector<cplx> roots_of_unity(int N) {
+    std::vector<cplx> root(N);
+    const double two_pi = 2.0 * std::acos(-1.0);
+    for (int k = 0; k < N; ++k) root[k] = std::polar(1.0, two_pi * k / N);
+    return root;
+}
+
+int rep(int a, int N) { return a > N / 2 ? a - N : a; }
+
+// C = A B for N x N row-major complex matrices.
+void multiply(int N, const cplx *A, const cplx *B, cplx *C) {
+    for (int i = 0; i < N * N; ++i) C[i] = 0.0;
+    for (int i = 0; i < N; ++i)
+        for (int k = 0; k < N; ++k) {
+            const cplx a = A[i * N + k];
+            const cplx *b = B + k * N;
+            cplx *c = C + i * N;
+            for (int j = 0; j < N; ++j) c[j] += a * b[j];
+        }
+}
+
+}  // namespace
+
+void sine_euler_modes_to_matrix(int N, const double *modes, double *W_out) {
+    const auto root = roots_of_unity(N);
+    const cplx *w = reinterpret_cast<const cplx *>(modes);
+    cplx *W = reinterpret_cast<cplx *>(W_out);
+    for (int a = 0; a < N; ++a)
+        for (int m2 = 0; m2 < N; ++m2) {
+            const int step = (2 * a + m2) % N;
+            cplx sum = 0.0;
+            int phase = 0;
+            for (int m1 = 0; m1 < N; ++m1) {
+                sum += w[m1 * N + m2] * root[phase];
+                phase += step;
+                if (phase >= N) phase -= N;
+            }
+            W[a * N + (a + m2) % N] = sum;
+        }
+}
+
+void sine_euler_matrix_to_modes(int N, const double *W_in, double *modes) {
+    const auto root = roots_of_unity(N);
+    const cplx *W = reinterpret_cast<const cplx *>(W_in);
+    cplx *w = reinterpret_cast<cplx *>(modes);
+    for (int m1 = 0; m1 < N; ++m1)
+        for (int m2 = 0; m2 < N; ++m2) {
+            cplx sum = 0.0;
+            for (int a = 0; a < N; ++a) {
+                const int phase = static_cast<int>((static_cast<long>(m1) * (2 * a + m2)) % N);
+                sum += W[a * N + (a + m2) % N] * std::conj(root[phase]);
+            }
+            w[m1 * N + m2] = sum / static_cast<double>(N);
+        }
+}
+
+void sine_euler_matrix_vector_field(int N, const double *modes, double *rate) {
+    const std::size_t n2 = static_cast<std::size_t>(N) * N;
+    std::vector<cplx> p(n2), W(n2), P(n2), PW(n2), WP(n2);
+    const cplx *w = reinterpret_cast<const cplx *>(modes);
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const int ra = rep(a, N), rb = rep(b, N);
+            const int norm2 = ra * ra + rb * rb;
+            p[a * N + b] = norm2 ? w[a * N + b] / static_cast<double>(norm2) : 0.0;
+        }
+    sine_euler_modes_to_matrix(N, modes, reinterpret_cast<double *>(W.data()));
+    sine_euler_modes_to_matrix(N, reinterpret_cast<const double *>(p.data()),
+                               reinterpret_cast<double *>(P.data()));
+    multiply(N, P.data(), W.data(), PW.data());
+    multiply(N, W.data(), P.data(), WP.data());
+    const double eps = 2.0 * std::acos(-1.0) / N;
+    const cplx factor(0.0, 1.0 / (2.0 * eps));
+    for (std::size_t i = 0; i < n2; ++i) PW[i] = factor * (PW[i] - WP[i]);
+    sine_euler_matrix_to_modes(N, reinterpret_cast<const double *>(PW.data()), rate);
+}
+
+void sine_euler_traces(int N, const double *modes, int kmax, double *out) {
+    const std::size_t n2 = static_cast<std::size_t>(N) * N;
+    std::vector<cplx> W(n2), power(n2), next(n2);
+    sine_euler_modes_to_matrix(N, modes, reinterpret_cast<double *>(W.data()));
+    power = W;
+    for (int k = 1; k <= kmax; ++k) {
+        if (k > 1) {
+            multiply(N, power.data(), W.data(), next.data());
+            power.swap(next);
+        }
+        double trace = 0.0;
+        for (int i = 0; i < N; ++i) trace += power[i * N + i].real();
+        out[k - 1] = trace / N;
+    }
+}
+
+#if LPI_HAVE_LAPACK
+extern "C" void zheevd_(const char *jobz, const char *uplo, const int *n, cplx *a, const int *lda,
+                        double *w, cplx *work, const int *lwork, double *rwork, const int *lrwork,
+                        int *iwork, const int *liwork, int *info, std::size_t jobz_len,
+                        std::size_t uplo_len);
+
+void sine_euler_spectrum(int N, const double *modes, double *out) {
+    // Row-major W is column-major W^T = conj(W): the same real spectrum.
+    std::vector<cplx> W(static_cast<std::size_t>(N) * N);
+    sine_euler_modes_to_matrix(N, modes, reinterpret_cast<double *>(W.data()));
+    const char jobz = 'N', uplo = 'U';
+    int info = 0, lwork = -1, lrwork = -1, liwork = -1, iwork_query = 0;
+    cplx work_query;
+    double rwork_query = 0.0;
+    zheevd_(&jobz, &uplo, &N, W.data(), &N, out, &work_query, &lwork, &rwork_query, &lrwork,
+            &iwork_query, &liwork, &info, 1, 1);
+    if (info != 0) fail(LPI_ERR_INTERNAL, "zheevd workspace query failed, info = " + std::to_string(info));
+    lwork = static_cast<int>(work_query.real());
+    lrwork = static_cast<int>(rwork_query);
+    liwork = iwork_query;
+    std::vector<cplx> work(std::max(lwork, 1));
+    std::vector<double> rwork(std::max(lrwork, 1));
+    std::vector<int> iwork(std::max(liwork, 1));
+    zheevd_(&jobz, &uplo, &N, W.data(), &N, out, work.data(), &lwork, rwork.data(), &lrwork,
+            iwork.data(), &liwork, &info, 1, 1);
+    if (info != 0) fail(LPI_ERR_INTERNAL, "zheevd failed to converge, info = " + std::to_string(info));
+}
+#else
+void sine_euler_spectrum(int, const double *, double *) {
+    fail(LPI_ERR_UNSUPPORTED,
+         "the Casimir spectrum needs LAPACK (zheevd); this build has none "
+         "(use lpi_sine_euler_casimir_traces)");
+}
+#endif
+
+}  // namespace lpi

@@ -1,0 +1,117 @@
+/* Sine-Euler: time per leapfrog step against the FFT floor (FFTW executing
+ * the same transforms with the same plans, buffers and thread count, in the
+ * same run: lpi_sine_euler_fft_floor), their ratio, the speed-up with two
+ * threads, and the peak memory at N = 1021. Prints figures; asserts nothing. */
+#include <liepoisson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+static double now(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void check(int status, lpi_system *sys, const char *what) {
+    if (status != LPI_OK) {
+        fprintf(stderr, "bench_sine_euler: %s: %s\n", what, lpi_last_error(sys));
+        exit(1);
+    }
+}
+
+static lpi_system *make(int N) {
+    lpi_system *sys = NULL;
+    check(lpi_sine_euler_create(&sys, N), NULL, "create");
+    const size_t n = (size_t)N * N;
+    double *grid = malloc(sizeof(double) * n);
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const double x = 2 * M_PI * a / N, y = 2 * M_PI * b / N;
+            grid[a * N + b] = sin(x) * cos(2 * y) + 0.3 * cos(3 * x - y) + 0.1 * sin(5 * x + 4 * y);
+        }
+    check(lpi_sine_euler_set_grid(sys, grid, n), sys, "set_grid");
+    free(grid);
+    return sys;
+}
+
+/* Seconds per step over at least `budget` seconds (best of three passes: the
+ * machine may be shared, and the best pass is the least disturbed). */
+static double time_steps(lpi_system *sys, double budget) {
+    check(lpi_step(sys, 1e-3, 2), sys, "step"); /* warm-up: the first step plans */
+    double t0 = now();
+    check(lpi_step(sys, 1e-3, 1), sys, "step");
+    const double one = now() - t0;
+    const int64_t reps = one > budget ? 1 : (int64_t)(budget / one) + 1;
+    double best = one;
+    for (int pass = 0; pass < 3 && reps > 1; ++pass) {
+        t0 = now();
+        check(lpi_step(sys, 1e-3, reps), sys, "step");
+        const double per = (now() - t0) / (double)reps;
+        if (per < best) best = per;
+    }
+    return best;
+}
+
+static double time_floor(lpi_system *sys, double step_time, double budget, double *transforms) {
+    const int64_t reps = step_time > budget ? 1 : (int64_t)(budget / step_time) + 1;
+    double best = INFINITY;
+    for (int pass = 0; pass < 3; ++pass) {
+        double per;
+        check(lpi_sine_euler_fft_floor(sys, reps, &per, transforms), sys, "fft_floor");
+        if (per < best) best = per;
+    }
+    return best;
+}
+
+int main(void) {
+    lpi_system *probe = NULL;
+    if (lpi_sine_euler_create(&probe, 3) != LPI_OK) {
+        printf("bench_sine_euler: %s\n", lpi_last_error(NULL));
+        return 0;
+    }
+    lpi_destroy(probe);
+    const double budget = getenv("LPI_BENCH_SECONDS") ? atof(getenv("LPI_BENCH_SECONDS")) : 0.4;
+    printf("sine-Euler, leapfrog (time per step; floor = FFTW alone, same plans and transforms)\n");
+    printf("%5s %10s %12s %12s %7s %12s %12s %9s\n", "N", "FFTs/step", "step 1T", "floor 1T",
+           "ratio", "step 2T", "floor 2T", "speed-up");
+    const int Ns[] = {31, 61, 125, 127, 243, 251, 509};
+    for (size_t i = 0; i < sizeof Ns / sizeof Ns[0]; ++i) {
+        const int N = Ns[i];
+        lpi_system *sys = make(N);
+        double transforms = 0;
+        const double step1 = time_steps(sys, budget);
+        const double floor1 = time_floor(sys, step1, budget, &transforms);
+        double step2 = NAN, floor2 = NAN;
+        if (lpi_set_threads(sys, 2) == LPI_OK) {
+            step2 = time_steps(sys, budget);
+            floor2 = time_floor(sys, step2, budget, &transforms);
+        }
+        printf("%5d %10.0f %10.3f ms %9.3f ms %7.2f %9.3f ms %9.3f ms %9.2f\n", N, transforms,
+               1e3 * step1, 1e3 * floor1, step1 / floor1, 1e3 * step2, 1e3 * floor2, step1 / step2);
+        fflush(stdout);
+        lpi_destroy(sys);
+    }
+    /* Peak memory at N = 1021 in a child process, so that nothing else counts. */
+    const int N = 1021;
+    const pid_t child = fork();
+    if (child == 0) {
+        lpi_system *sys = make(N);
+        check(lpi_set_method(sys, "lie-trotter"), sys, "method");
+        check(lpi_step(sys, 1e-3, 1), sys, "step");
+        lpi_destroy(sys);
+        _exit(0);
+    }
+    int status = 0;
+    waitpid(child, &status, 0);
+    struct rusage usage;
+    getrusage(RUSAGE_CHILDREN, &usage);
+    printf("N = %d: peak RSS %.1f MiB after one Lie-Trotter step (the modes alone: %.1f MiB)\n", N,
+           usage.ru_maxrss / 1024.0, 2.0 * N * N * 8 / 1048576.0);
+    return 0;
+}

@@ -1,0 +1,665 @@
+/* Sine-Euler against an independent matrix-form integration, invariants,
+ * orders, steady states, the paper's Figure 2 run, and the API contract.
+ * The references here are written from the mathematics (DESIGN.md section 1)
+ * and share no code with the library. */
+#include <complex.h>
+#include <pthread.h>
+
+#include "lpi_test.h"
+
+typedef double complex cplx;
+
+static int rep(int a, int N) { return a > N / 2 ? a - N : a; }
+static int mod(int a, int N) { return ((a % N) + N) % N; }
+
+/* A reproducible Hermitian field with w_0 = 0 and spectrum ~ 1/|m|^2 decay. */
+static void random_field(int N, unsigned seed, double *w) {
+    uint64_t state = 0x9E3779B97F4A7C15ull ^ seed;
+    memset(w, 0, sizeof(double) * 2 * N * N);
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const int ra = rep(a, N), rb = rep(b, N);
+            if (ra < 0 || (ra == 0 && rb <= 0)) continue;
+            double v[2];
+            for (int i = 0; i < 2; ++i) {
+                state = state * 6364136223846793005ull + 1442695040888963407ull;
+                v[i] = (double)(state >> 11) / 9007199254740992.0 - 0.5;
+            }
+            const double decay = 1.0 / (1.0 + ra * ra + rb * rb);
+            const int m = a * N + b, minus = mod(-a, N) * N + mod(-b, N);
+            w[2 * m] = v[0] * decay, w[2 * m + 1] = v[1] * decay;
+            w[2 * minus] = v[0] * decay, w[2 * minus + 1] = -v[1] * decay;
+        }
+}
+
+static double max_abs_diff(const double *a, const double *b, size_t n) {
+    double d = 0;
+    for (size_t i = 0; i < n; ++i) d = fmax(d, fabs(a[i] - b[i]));
+    return d;
+}
+
+/* ---- independent references ------------------------------------------- */
+
+/* Eq. 5 of the paper, summed directly: O(N^4). */
+static void eq5_rate(int N, const cplx *w, cplx *rate) {
+    const double eps = 2 * M_PI / N;
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            cplx sum = 0;
+            for (int n1 = 0; n1 < N; ++n1)
+                for (int n2 = 0; n2 < N; ++n2) {
+                    const int r1 = rep(n1, N), r2 = rep(n2, N);
+                    if (r1 == 0 && r2 == 0) continue;
+                    const double cross = (double)rep(a, N) * r2 - (double)rep(b, N) * r1;
+                    sum += sin(eps * cross) / (eps * (r1 * r1 + r2 * r2)) *
+                           w[mod(a + n1, N) * N + mod(b + n2, N)] * w[mod(-n1, N) * N + mod(-n2, N)];
+                }
+            rate[a * N + b] = sum;
+        }
+}
+
+/* W = sum_m w_m J_m, J_m = exp(2 pi i m1 m2/N) g^m1 h^m2, g = diag(q^a),
+ * q = exp(4 pi i/N), h e_a = e_{a-1}: built entry by entry from the definition. */
+static void to_matrix(int N, const cplx *w, cplx *W) {
+    memset(W, 0, sizeof(cplx) * N * N);
+    for (int m1 = 0; m1 < N; ++m1)
+        for (int m2 = 0; m2 < N; ++m2) {
+            const cplx phase = cexp(2 * M_PI * I * m1 * m2 / N);
+            for (int b = 0; b < N; ++b) {
+                const int a = mod(b - m2, N); /* h^m2 e_b = e_{b-m2}, then g^m1 */
+                W[a * N + b] += w[m1 * N + m2] * phase * cexp(4 * M_PI * I * (double)m1 * a / N);
+            }
+        }
+}
+
+/* w_m = tr(W J_m^dagger) / N. */
+static void from_matrix(int N, const cplx *W, cplx *w) {
+    for (int m1 = 0; m1 < N; ++m1)
+        for (int m2 = 0; m2 < N; ++m2) {
+            const cplx phase = cexp(2 * M_PI * I * m1 * m2 / N);
+            cplx sum = 0;
+            for (int b = 0; b < N; ++b) {
+                const int a = mod(b - m2, N);
+                sum += W[a * N + b] * conj(phase * cexp(4 * M_PI * I * (double)m1 * a / N));
+            }
+            w[m1 * N + m2] = sum / N;
+        }
+}
+
+/* dW/dt = (i / (2 eps)) [P, W], P = sum_{n != 0} w_n / |n|^2 J_n. */
+static void matrix_rate(int N, const cplx *W, cplx *dW) {
+    cplx *w = malloc(sizeof(cplx) * N * N), *P = malloc(sizeof(cplx) * N * N);
+    from_matrix(N, W, w);
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const int n2 = rep(a, N) * rep(a, N) + rep(b, N) * rep(b, N);
+            w[a * N + b] = n2 ? w[a * N + b] / n2 : 0;
+        }
+    to_matrix(N, w, P);
+    const double eps = 2 * M_PI / N;
+    for (int i = 0; i < N; ++i)
+        for (int j = 0; j < N; ++j) {
+            cplx c = 0;
+            for (int k = 0; k < N; ++k) c += P[i * N + k] * W[k * N + j] - W[i * N + k] * P[k * N + j];
+            dW[i * N + j] = I / (2 * eps) * c;
+        }
+    free(w);
+    free(P);
+}
+
+/* RK4 on the matrix form from modes w0 for time T in `steps` steps. */
+static void matrix_rk4(int N, const double *w0, double T, int steps, double *w_out) {
+    const size_t n = (size_t)N * N;
+    cplx *W = malloc(sizeof(cplx) * n), *Y = malloc(sizeof(cplx) * n), *k[4];
+    for (int i = 0; i < 4; ++i) k[i] = malloc(sizeof(cplx) * n);
+    to_matrix(N, (const cplx *)w0, W);
+    const double h = T / steps;
+    for (int s = 0; s < steps; ++s) {
+        matrix_rate(N, W, k[0]);
+        for (size_t i = 0; i < n; ++i) Y[i] = W[i] + 0.5 * h * k[0][i];
+        matrix_rate(N, Y, k[1]);
+        for (size_t i = 0; i < n; ++i) Y[i] = W[i] + 0.5 * h * k[1][i];
+        matrix_rate(N, Y, k[2]);
+        for (size_t i = 0; i < n; ++i) Y[i] = W[i] + h * k[2][i];
+        matrix_rate(N, Y, k[3]);
+        for (size_t i = 0; i < n; ++i) W[i] += h / 6 * (k[0][i] + 2 * k[1][i] + 2 * k[2][i] + k[3][i]);
+    }
+    from_matrix(N, W, (cplx *)w_out);
+    free(W);
+    free(Y);
+    for (int i = 0; i < 4; ++i) free(k[i]);
+}
+
+static lpi_system *sine_euler(int N, const double *w) {
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_sine_euler_create(&sys, N), LPI_OK);
+    assert_int_equal(lpi_sine_euler_set_modes(sys, w, 2 * (size_t)N * N), LPI_OK);
+    return sys;
+}
+
+/* Integrates from w0 with `steps` steps of `method` to time T; modes to out. */
+static void run(int N, const char *method, const double *w0, double T, int64_t steps, double *out) {
+    lpi_system *sys = sine_euler(N, w0);
+    assert_int_equal(lpi_set_method(sys, method), LPI_OK);
+    assert_int_equal(lpi_step(sys, T / (double)steps, steps), LPI_OK);
+    assert_int_equal(lpi_sine_euler_get_modes(sys, out, 2 * (size_t)N * N), LPI_OK);
+    lpi_destroy(sys);
+}
+
+/* ---- the formulas ------------------------------------------------------ */
+
+/* The matrix form used as the reference is eq. 5 (checked before it is trusted). */
+static void test_matrix_form_is_eq5(void **state) {
+    (void)state;
+    const int Ns[] = {5, 7, 9};
+    for (int t = 0; t < 3; ++t) {
+        const int N = Ns[t];
+        const size_t n = (size_t)N * N;
+        double w[2 * 81];
+        random_field(N, 7 + N, w);
+        cplx W[81], dW[81], rate_matrix[81], rate_direct[81];
+        to_matrix(N, (const cplx *)w, W);
+        /* W is Hermitian and the map inverts. */
+        cplx back[81];
+        from_matrix(N, W, back);
+        for (int i = 0; i < N; ++i)
+            for (int j = 0; j < N; ++j) assert_true(cabs(W[i * N + j] - conj(W[j * N + i])) < 1e-14);
+        assert_true(max_abs_diff((const double *)back, w, 2 * n) < 1e-15);
+        matrix_rate(N, W, dW);
+        from_matrix(N, dW, rate_matrix);
+        eq5_rate(N, (const cplx *)w, rate_direct);
+        assert_true(max_abs_diff((const double *)rate_matrix, (const double *)rate_direct, 2 * n) < 1e-14);
+    }
+}
+
+/* One step of size h against the matrix-form RK4 with tiny steps: the local
+ * error falls like h^(p+1) for a method of order p, prime and composite N. */
+static void test_one_step_against_matrix_rk4(void **state) {
+    (void)state;
+    const int Ns[] = {7, 9, 15};
+    const struct {
+        const char *method;
+        int order;
+    } methods[] = {{"leapfrog", 2}, {"triple-jump-4", 4}};
+    for (int t = 0; t < 3; ++t) {
+        const int N = Ns[t];
+        const size_t n = 2 * (size_t)N * N;
+        double w0[2 * 225], ours[2 * 225], ref[2 * 225];
+        random_field(N, 100 + N, w0);
+        for (int m = 0; m < 2; ++m) {
+            double err[2];
+            const double hs[2] = {0.2, 0.1};
+            for (int i = 0; i < 2; ++i) {
+                run(N, methods[m].method, w0, hs[i], 1, ours);
+                matrix_rk4(N, w0, hs[i], 40, ref);
+                err[i] = max_abs_diff(ours, ref, n);
+            }
+            const double order = log(err[0] / err[1]) / log(2.0) - 1;
+            printf("N = %2d %-14s one-step errors %.3e %.3e, local order + 1 = %.2f\n", N,
+                   methods[m].method, err[0], err[1], order + 1);
+            assert_true(fabs(order - methods[m].order) < 0.35);
+            assert_true(err[1] < 1e-3);
+        }
+    }
+}
+
+/* Measured global orders at N = 7: leapfrog 2, triple jump 4. */
+static void test_measured_orders(void **state) {
+    (void)state;
+    const int N = 7;
+    const size_t n = 2 * N * N;
+    double w0[2 * 49], ref[2 * 49], ours[2 * 49];
+    random_field(N, 3, w0);
+    for (size_t i = 0; i < n; ++i) w0[i] *= 4.0; /* O(1) dynamics over T = 1 */
+    const double T = 1.0;
+    matrix_rk4(N, w0, T, 2000, ref);
+    const struct {
+        const char *method;
+        int order;
+        int64_t steps[4];
+    } cases[] = {{"leapfrog", 2, {8, 16, 32, 64}}, {"triple-jump-4", 4, {4, 8, 16, 32}}};
+    for (int c = 0; c < 2; ++c) {
+        double hs[4], errs[4];
+        for (int i = 0; i < 4; ++i) {
+            run(N, cases[c].method, w0, T, cases[c].steps[i], ours);
+            hs[i] = T / (double)cases[c].steps[i];
+            errs[i] = max_abs_diff(ours, ref, n);
+        }
+        const double order = lpi_fit_order(hs, errs, 4);
+        printf("%-14s errors %.2e .. %.2e, measured order %.2f\n", cases[c].method, errs[0],
+               errs[3], order);
+        assert_true(fabs(order - cases[c].order) < 0.3);
+    }
+}
+
+/* ---- invariants -------------------------------------------------------- */
+
+static void spectrum_drift(int N, int64_t steps, double dt, const char *method) {
+    const size_t n = 2 * (size_t)N * N;
+    double *w = malloc(sizeof(double) * n);
+    double before[64], after[64];
+    random_field(N, 11 * N, w);
+    lpi_system *sys = sine_euler(N, w);
+    assert_int_equal(lpi_set_method(sys, method), LPI_OK);
+    assert_int_equal(lpi_casimir_count(sys), (size_t)N);
+    int status = lpi_casimirs(sys, before, N);
+    if (status == LPI_ERR_UNSUPPORTED) { /* built without LAPACK */
+        assert_non_null(strstr(lpi_last_error(sys), "LAPACK"));
+        lpi_destroy(sys);
+        free(w);
+        skip();
+    }
+    assert_int_equal(status, LPI_OK);
+    double H0, H1;
+    assert_int_equal(lpi_energy(sys, &H0), LPI_OK);
+    assert_int_equal(lpi_step(sys, dt, steps), LPI_OK);
+    assert_int_equal(lpi_casimirs(sys, after, N), LPI_OK);
+    assert_int_equal(lpi_energy(sys, &H1), LPI_OK);
+    double scale = 0, drift = 0;
+    for (int i = 0; i < N; ++i) {
+        scale = fmax(scale, fabs(before[i]));
+        drift = fmax(drift, fabs(after[i] - before[i]));
+        if (i) assert_true(after[i] >= after[i - 1]); /* sorted */
+    }
+    const double per_step = drift / scale / (double)steps;
+    printf("N = %d, %lld %s steps: spectrum drift %.2e relative, %.2e per step; energy error %.1e\n",
+           N, (long long)steps, method, drift / scale, per_step, fabs(H1 - H0) / H0);
+    assert_true(per_step < 5e-15); /* the paper's figure */
+    lpi_destroy(sys);
+    free(w);
+}
+
+static void test_spectrum_kept_n31(void **state) {
+    (void)state;
+    spectrum_drift(31, 10000, 0.01, "leapfrog");
+}
+
+static void test_spectrum_kept_n25_composite(void **state) {
+    (void)state;
+    spectrum_drift(25, 10000, 0.01, "leapfrog");
+}
+
+/* Modes all on one line through the origin: every piece is then either the
+ * line's own (which leaves it fixed) or sees b = 0: a steady state. */
+static void test_single_line_is_steady(void **state) {
+    (void)state;
+    const int N = 31;
+    const size_t n = 2 * N * N;
+    double w[2 * 961], out[2 * 961];
+    memset(w, 0, sizeof w);
+    const int k[2] = {2, 5};
+    for (int s = 1; s <= N / 2; ++s) {
+        const int a = mod(s * k[0], N), b = mod(s * k[1], N);
+        const double re = cos(s), im = sin(3.0 * s) / s;
+        w[2 * (a * N + b)] = re, w[2 * (a * N + b) + 1] = im;
+        w[2 * (mod(-a, N) * N + mod(-b, N))] = re, w[2 * (mod(-a, N) * N + mod(-b, N)) + 1] = -im;
+    }
+    w[0] = 0.25; /* the inert mean is kept as given */
+    lpi_system *sys = sine_euler(N, w);
+    assert_int_equal(lpi_step(sys, 0.1, 100), LPI_OK);
+    assert_int_equal(lpi_sine_euler_get_modes(sys, out, n), LPI_OK);
+    const double change = max_abs_diff(out, w, n);
+    printf("single-line field after 100 steps: max change %.2e\n", change);
+    assert_true(change < 1e-13);
+    assert_true(out[0] == 0.25 && out[1] == 0.0);
+    lpi_destroy(sys);
+}
+
+/* McLachlan 1993, Figure 2: N = 7, dt = 0.05, 10^5 steps, |w| = 1 and
+ * H(0) = 0.75. |w| is the norm over one mode of each pair +-m (w_0 = 0):
+ * over all modes sum |w_m|^2 = 2, and then H <= 1 allows H(0) = 0.75 (with the
+ * norm over all modes H <= 1/2 and the paper's H(0) could not be reached).
+ * The field mixes the |m| = 1 modes and the others in the proportion that
+ * gives H(0) = 0.75 exactly. */
+static void figure2_field(double *w) {
+    const int N = 7;
+    double low[2 * 49], high[2 * 49];
+    random_field(N, 2024, w);
+    memcpy(low, w, sizeof low);
+    memcpy(high, w, sizeof high);
+    double low_norm = 0, high_norm = 0, high_energy = 0; /* over the half plane */
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const int n2 = rep(a, N) * rep(a, N) + rep(b, N) * rep(b, N);
+            const int i = a * N + b;
+            const double p = w[2 * i] * w[2 * i] + w[2 * i + 1] * w[2 * i + 1];
+            if (n2 == 1) {
+                high[2 * i] = high[2 * i + 1] = 0;
+                low_norm += 0.5 * p;
+            } else {
+                low[2 * i] = low[2 * i + 1] = 0;
+                if (n2) high_norm += 0.5 * p, high_energy += 0.5 * p / n2;
+            }
+        }
+    /* alpha^2 + beta^2 = 1 and alpha^2 * 1 + beta^2 * e_high = 0.75 */
+    const double e_high = high_energy / high_norm;
+    const double alpha2 = (0.75 - e_high) / (1 - e_high);
+    const double alpha = sqrt(alpha2 / low_norm), beta = sqrt((1 - alpha2) / high_norm);
+    for (int i = 0; i < 2 * 49; ++i) w[i] = alpha * low[i] + beta * high[i];
+}
+
+static void test_paper_figure2(void **state) {
+    (void)state;
+    const int N = 7;
+    double w[2 * 49];
+    figure2_field(w);
+    lpi_system *sys = sine_euler(N, w);
+    double H0, enstrophy, traces[2];
+    assert_int_equal(lpi_energy(sys, &H0), LPI_OK);
+    assert_int_equal(lpi_sine_euler_enstrophy(sys, &enstrophy), LPI_OK);
+    assert_true(fabs(H0 - 0.75) < 1e-14);
+    assert_true(fabs(enstrophy - 1.0) < 1e-14); /* 1/2 sum over all = sum over half */
+    assert_int_equal(lpi_sine_euler_casimir_traces(sys, 2, traces), LPI_OK);
+    const double C2_start = traces[1];
+    assert_true(fabs(C2_start - 2.0) < 1e-13); /* (1/N) tr W^2 = sum |w_m|^2 */
+    double lambda0[7], lambda1[7];
+    const int have_spectrum = lpi_casimirs(sys, lambda0, N) == LPI_OK;
+
+    const int chunks = 100, per_chunk = 1000;
+    double worst[2] = {0, 0}; /* max |dH/H| over the first and the second half */
+    for (int c = 0; c < chunks; ++c) {
+        assert_int_equal(lpi_step(sys, 0.05, per_chunk), LPI_OK);
+        double H;
+        assert_int_equal(lpi_energy(sys, &H), LPI_OK);
+        const double rel = fabs(H - H0) / H0;
+        worst[c < chunks / 2] = fmax(worst[c < chunks / 2], rel);
+    }
+    assert_int_equal(lpi_sine_euler_casimir_traces(sys, 2, traces), LPI_OK);
+    const double steps = (double)chunks * per_chunk;
+    const double c2_per_step = fabs(traces[1] - C2_start) / C2_start / steps;
+    double spectrum_per_step = 0;
+    if (have_spectrum) {
+        assert_int_equal(lpi_casimirs(sys, lambda1, N), LPI_OK);
+        double scale = 0, drift = 0;
+        for (int i = 0; i < N; ++i)
+            scale = fmax(scale, fabs(lambda0[i])), drift = fmax(drift, fabs(lambda1[i] - lambda0[i]));
+        spectrum_per_step = drift / scale / steps;
+    }
+    printf("Figure 2 (N = 7, dt = 0.05, 1e5 steps, |w| = 1, H(0) = 0.75): max |dH/H| first half "
+           "%.3e, second half %.3e; C2 drift %.2e per step, spectrum drift %.2e per step\n",
+           worst[1], worst[0], c2_per_step, spectrum_per_step);
+    assert_true(worst[1] > 0 && worst[1] < 0.05);
+    assert_true(worst[0] < 1.5 * worst[1]); /* bounded: no secular growth */
+    assert_true(c2_per_step < 5e-16); /* the paper saw about 5e-15 */
+    assert_true(spectrum_per_step < 5e-16);
+    lpi_destroy(sys);
+}
+
+/* ---- state, grid, diagnostics ------------------------------------------- */
+
+static void test_modes_grid_and_state_round_trips(void **state) {
+    (void)state;
+    const int N = 9;
+    const size_t n = (size_t)N * N;
+    double w[2 * 81], back[2 * 81], grid[81], x[81], x2[81], direct[81];
+    random_field(N, 5, w);
+    w[0] = -0.5;
+    lpi_system *sys = sine_euler(N, w);
+    assert_int_equal(lpi_dim(sys), n);
+    assert_int_equal(lpi_sine_euler_get_modes(sys, back, 2 * n), LPI_OK);
+    assert_memory_equal(back, w, sizeof back);
+    /* the real parametrisation: get_state then set_state restores the modes */
+    assert_int_equal(lpi_get_state(sys, x, n), LPI_OK);
+    assert_true(x[0] == -0.5 && x[1] == w[2 * 1] && x[2] == w[2 * 1 + 1]); /* w_0, then w_(0,1) */
+    assert_int_equal(lpi_step(sys, 0.1, 3), LPI_OK);
+    assert_int_equal(lpi_set_state(sys, x, n), LPI_OK);
+    assert_int_equal(lpi_get_state(sys, x2, n), LPI_OK);
+    assert_memory_equal(x, x2, sizeof x);
+    assert_int_equal(lpi_sine_euler_get_modes(sys, back, 2 * n), LPI_OK);
+    assert_memory_equal(back, w, sizeof back);
+    /* the grid is sum_m w_m exp(i (m1 x + m2 y)) */
+    assert_int_equal(lpi_sine_euler_get_grid(sys, grid, n), LPI_OK);
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            cplx s = 0;
+            for (int m1 = 0; m1 < N; ++m1)
+                for (int m2 = 0; m2 < N; ++m2)
+                    s += ((const cplx *)w)[m1 * N + m2] * cexp(I * 2 * M_PI * (m1 * a + m2 * b) / N);
+            direct[a * N + b] = creal(s);
+        }
+    assert_true(max_abs_diff(grid, direct, n) < 1e-14);
+    assert_int_equal(lpi_sine_euler_set_grid(sys, grid, n), LPI_OK);
+    assert_int_equal(lpi_sine_euler_get_modes(sys, back, 2 * n), LPI_OK);
+    assert_true(max_abs_diff(back, w, 2 * n) < 1e-15);
+    int32_t size = 0;
+    assert_int_equal(lpi_sine_euler_size(sys, &size), LPI_OK);
+    assert_int_equal(size, N);
+    lpi_destroy(sys);
+}
+
+static void test_traces_match_spectrum(void **state) {
+    (void)state;
+    const int N = 11;
+    double w[2 * 121], lambda[11], traces[5];
+    random_field(N, 9, w);
+    w[0] = 0.3;
+    lpi_system *sys = sine_euler(N, w);
+    assert_int_equal(lpi_sine_euler_casimir_traces(sys, 5, traces), LPI_OK);
+    assert_true(fabs(traces[0] - 0.3) < 1e-15); /* (1/N) tr W = w_0 */
+    if (lpi_casimirs(sys, lambda, N) == LPI_OK) {
+        for (int k = 1; k <= 5; ++k) {
+            double s = 0;
+            for (int i = 0; i < N; ++i) s += pow(lambda[i], k);
+            assert_true(fabs(s / N - traces[k - 1]) < 1e-13 * (1 + fabs(traces[k - 1])));
+        }
+    } else {
+        assert_non_null(strstr(lpi_last_error(sys), "LAPACK"));
+    }
+    lpi_destroy(sys);
+}
+
+/* Results do not depend on the thread count, to the bit. */
+static void test_threads_bitwise(void **state) {
+    (void)state;
+    const int N = 61;
+    const size_t n = 2 * (size_t)N * N;
+    double *w = malloc(sizeof(double) * n), *one = malloc(sizeof(double) * n),
+           *two = malloc(sizeof(double) * n);
+    random_field(N, 1, w);
+    lpi_system *a = sine_euler(N, w), *b = sine_euler(N, w);
+    const int status = lpi_set_threads(b, 2);
+    if (status == LPI_ERR_UNSUPPORTED) {
+        assert_non_null(strstr(lpi_last_error(b), "OpenMP"));
+    } else {
+        assert_int_equal(status, LPI_OK);
+        assert_int_equal(lpi_step(a, 0.05, 3), LPI_OK);
+        assert_int_equal(lpi_step(b, 0.05, 3), LPI_OK);
+        assert_int_equal(lpi_sine_euler_get_modes(a, one, n), LPI_OK);
+        assert_int_equal(lpi_sine_euler_get_modes(b, two, n), LPI_OK);
+        assert_memory_equal(one, two, sizeof(double) * n);
+    }
+    lpi_destroy(a);
+    lpi_destroy(b);
+    free(w);
+    free(one);
+    free(two);
+}
+
+/* Separate handles on separate threads (plans are made concurrently; the
+ * library serialises FFTW's planner) give the same result as one thread, to
+ * round-off (FFTW_MEASURE may pick another plan when timings differ). */
+typedef struct {
+    int N;
+    double *out;
+} worker_job;
+
+static void *worker(void *arg) {
+    worker_job *job = arg;
+    const size_t n = 2 * (size_t)job->N * job->N;
+    double *w = malloc(sizeof(double) * n);
+    random_field(job->N, 77, w);
+    lpi_system *sys = NULL;
+    if (lpi_sine_euler_create(&sys, job->N) == LPI_OK && lpi_sine_euler_set_modes(sys, w, n) == LPI_OK &&
+        lpi_step(sys, 0.05, 5) == LPI_OK)
+        lpi_sine_euler_get_modes(sys, job->out, n);
+    lpi_destroy(sys);
+    free(w);
+    return NULL;
+}
+
+static void test_handles_on_threads(void **state) {
+    (void)state;
+    enum { workers = 4 };
+    const int Ns[workers] = {27, 29, 27, 29};
+    double *outs[workers];
+    pthread_t threads[workers];
+    worker_job jobs[workers];
+    for (int i = 0; i < workers; ++i) {
+        outs[i] = calloc(2 * (size_t)Ns[i] * Ns[i], sizeof(double));
+        jobs[i] = (worker_job){Ns[i], outs[i]};
+        assert_int_equal(pthread_create(&threads[i], NULL, worker, &jobs[i]), 0);
+    }
+    for (int i = 0; i < workers; ++i) assert_int_equal(pthread_join(threads[i], NULL), 0);
+    for (int i = 0; i < workers; ++i) {
+        const size_t n = 2 * (size_t)Ns[i] * Ns[i];
+        double *alone = calloc(n, sizeof(double));
+        worker_job job = {Ns[i], alone};
+        worker(&job);
+        assert_true(max_abs_diff(alone, outs[i], n) < 1e-13);
+        assert_true(fabs(outs[i][2]) + fabs(outs[i][3]) > 0); /* the worker did run */
+        free(alone);
+        free(outs[i]);
+    }
+}
+
+static void test_wisdom(void **state) {
+    (void)state;
+    size_t length = 0;
+    int status = lpi_fftw_wisdom_export_string(NULL, 0, &length);
+    assert_int_equal(status, LPI_ERR_SIZE);
+    char *text = malloc(length + 1);
+    assert_int_equal(lpi_fftw_wisdom_export_string(text, length + 1, &length), LPI_OK);
+    assert_int_equal(strlen(text), length);
+    assert_int_equal(lpi_fftw_wisdom_import_string(text), LPI_OK);
+    free(text);
+    LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_string("not wisdom"), LPI_ERR_INVALID,
+                     "lpi_fftw_wisdom_import_string");
+    LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_file("/nonexistent/wisdom"), LPI_ERR_INVALID,
+                     "lpi_fftw_wisdom_import_file");
+    LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_file(NULL), LPI_ERR_NULL,
+                     "lpi_fftw_wisdom_import_file");
+}
+
+/* ---- bad input ----------------------------------------------------------- */
+
+static void test_bad_input(void **state) {
+    (void)state;
+    lpi_system *sys = (lpi_system *)0x1;
+    const int32_t bad_N[] = {4, 2, 1, 0, -3, 100};
+    for (size_t i = 0; i < sizeof bad_N / sizeof bad_N[0]; ++i) {
+        sys = (lpi_system *)0x1;
+        LPI_ASSERT_FAILS(NULL, lpi_sine_euler_create(&sys, bad_N[i]), LPI_ERR_INVALID,
+                         "lpi_sine_euler_create");
+        assert_null(sys);
+    }
+    LPI_ASSERT_FAILS(NULL, lpi_sine_euler_create(NULL, 7), LPI_ERR_NULL, "lpi_sine_euler_create");
+
+    const int N = 7;
+    const size_t n = (size_t)N * N;
+    double w[2 * 49], bad[2 * 49], grid[49];
+    random_field(N, 42, w);
+    sys = sine_euler(N, w);
+    assert_int_equal(lpi_step(sys, 0.1, 2), LPI_OK); /* a nonzero time to keep */
+
+    memcpy(bad, w, sizeof w);
+    bad[2 * (1 * N + 2) + 1] += 1e-3; /* w_(1,2) no longer conj(w_(-1,-2)) */
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_modes(sys, bad, 2 * n), LPI_ERR_INVALID,
+                     "lpi_sine_euler_set_modes");
+    assert_non_null(strstr(lpi_last_error(sys), "Hermitian"));
+    memcpy(bad, w, sizeof w);
+    bad[1] = 0.5; /* w_0 not real */
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_modes(sys, bad, 2 * n), LPI_ERR_INVALID,
+                     "lpi_sine_euler_set_modes");
+    memcpy(bad, w, sizeof w);
+    bad[17] = NAN;
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_modes(sys, bad, 2 * n), LPI_ERR_NONFINITE,
+                     "lpi_sine_euler_set_modes");
+    bad[17] = INFINITY;
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_modes(sys, bad, 2 * n), LPI_ERR_NONFINITE,
+                     "lpi_sine_euler_set_modes");
+    /* a tiny asymmetry (round-off of an FFT) is accepted and symmetrised */
+    memcpy(bad, w, sizeof w);
+    bad[2 * (1 * N + 2)] += 1e-17;
+    lpi_system *other = sine_euler(N, bad);
+    lpi_destroy(other);
+
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_modes(sys, w, 2 * n - 1), LPI_ERR_SIZE,
+                     "lpi_sine_euler_set_modes");
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_modes(sys, w, n), LPI_ERR_SIZE, "lpi_sine_euler_set_modes");
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_modes(sys, NULL, 2 * n), LPI_ERR_NULL,
+                     "lpi_sine_euler_set_modes");
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_get_modes(sys, bad, 2 * n + 2), LPI_ERR_SIZE,
+                     "lpi_sine_euler_get_modes");
+    for (size_t i = 0; i < n; ++i) grid[i] = (double)i;
+    grid[5] = NAN;
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_grid(sys, grid, n), LPI_ERR_NONFINITE,
+                     "lpi_sine_euler_set_grid");
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_grid(sys, grid, n + 1), LPI_ERR_SIZE,
+                     "lpi_sine_euler_set_grid");
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_get_grid(sys, grid, 2 * n), LPI_ERR_SIZE,
+                     "lpi_sine_euler_get_grid");
+    double x[49];
+    assert_int_equal(lpi_get_state(sys, x, n), LPI_OK);
+    x[3] = NAN;
+    LPI_ASSERT_FAILS(sys, lpi_set_state(sys, x, n), LPI_ERR_NONFINITE, "lpi_set_state");
+    LPI_ASSERT_FAILS(sys, lpi_set_state(sys, x, 2 * n), LPI_ERR_SIZE, "lpi_set_state");
+    double traces[3];
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_casimir_traces(sys, 0, traces), LPI_ERR_INVALID,
+                     "lpi_sine_euler_casimir_traces");
+    LPI_ASSERT_FAILS(sys, lpi_set_threads(sys, 0), LPI_ERR_INVALID, "lpi_set_threads");
+    double lambda[8];
+    LPI_ASSERT_FAILS(sys, lpi_casimirs(sys, lambda, 8), LPI_ERR_SIZE, "lpi_casimirs");
+    /* a non-finite step size is refused */
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, INFINITY, 1), LPI_ERR_NONFINITE, "lpi_step");
+    lpi_destroy(sys);
+
+    /* sine-Euler calls on another kind of system */
+    lpi_system *body = NULL;
+    assert_int_equal(lpi_rigid_body_create(&body, 1, 2, 3), LPI_OK);
+    LPI_ASSERT_FAILS(body, lpi_sine_euler_get_modes(body, w, 2 * n), LPI_ERR_INVALID,
+                     "lpi_sine_euler_get_modes");
+    assert_non_null(strstr(lpi_last_error(body), "rigid-body"));
+    LPI_ASSERT_FAILS(body, lpi_set_threads(body, 2), LPI_ERR_UNSUPPORTED, "lpi_set_threads");
+    assert_int_equal(lpi_set_threads(body, 1), LPI_OK);
+    lpi_destroy(body);
+    LPI_ASSERT_FAILS(NULL, lpi_sine_euler_enstrophy(NULL, traces), LPI_ERR_NULL,
+                     "lpi_sine_euler_enstrophy");
+}
+
+/* A build without FFTW: creation reports the missing library. */
+static void test_without_fftw(void **state) {
+    (void)state;
+    lpi_system *sys = NULL;
+    LPI_ASSERT_FAILS(NULL, lpi_sine_euler_create(&sys, 7), LPI_ERR_UNSUPPORTED,
+                     "lpi_sine_euler_create");
+    assert_non_null(strstr(lpi_last_error(NULL), "FFTW"));
+    size_t length;
+    LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_export_string(NULL, 0, &length), LPI_ERR_UNSUPPORTED,
+                     "lpi_fftw_wisdom_export_string");
+}
+
+int main(void) {
+    lpi_system *probe = NULL;
+    const int have_fftw = lpi_sine_euler_create(&probe, 3) == LPI_OK;
+    lpi_destroy(probe);
+    if (!have_fftw) {
+        const struct CMUnitTest tests[] = {cmocka_unit_test(test_without_fftw)};
+        return cmocka_run_group_tests(tests, NULL, NULL);
+    }
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_matrix_form_is_eq5),
+        cmocka_unit_test(test_one_step_against_matrix_rk4),
+        cmocka_unit_test(test_measured_orders),
+        cmocka_unit_test(test_spectrum_kept_n31),
+        cmocka_unit_test(test_spectrum_kept_n25_composite),
+        cmocka_unit_test(test_single_line_is_steady),
+        cmocka_unit_test(test_paper_figure2),
+        cmocka_unit_test(test_modes_grid_and_state_round_trips),
+        cmocka_unit_test(test_traces_match_spectrum),
+        cmocka_unit_test(test_threads_bitwise),
+        cmocka_unit_test(test_handles_on_threads),
+        cmocka_unit_test(test_wisdom),
+        cmocka_unit_test(test_bad_input),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

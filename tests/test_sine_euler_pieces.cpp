@@ -1,0 +1,72 @@
+// White-box: for prime and composite N, the pieces (directions of the
+// projective line over Z_N) own every nonzero mode exactly once, so their
+// energies sum to H; their number is N prod_{p | N} (1 + 1/p).
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "lpi_config.h"
+#include "models/sine_euler.hpp"
+
+static int failures = 0;
+#define CHECK(cond)                                                         \
+    do {                                                                    \
+        if (!(cond)) {                                                      \
+            std::printf("%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond); \
+            ++failures;                                                     \
+        }                                                                   \
+    } while (0)
+
+static std::size_t projective_line_size(int N) {
+    double count = N;
+    int n = N;
+    for (int p = 2; p <= n; ++p)
+        if (n % p == 0) {
+            count *= 1.0 + 1.0 / p;
+            while (n % p == 0) n /= p;
+        }
+    return static_cast<std::size_t>(std::lround(count));
+}
+
+int main() {
+#if !LPI_HAVE_FFTW
+    std::puts("built without FFTW: sine-Euler is left out");
+    return 0;
+#else
+    for (int N : {3, 7, 9, 15, 25, 27, 45, 49}) {
+        auto model = lpi::make_sine_euler(N);
+        auto &se = dynamic_cast<lpi::SineEulerModel &>(*model);
+        CHECK(model->piece_count() == projective_line_size(N));
+        // Every nonzero mode alone: exactly one piece carries its energy.
+        std::vector<double> state(2 * N * N, 0.0);
+        for (int i = 1; i < N * N; ++i) {
+            const int a = i / N, b = i % N;
+            const int minus = ((N - a) % N) * N + (N - b) % N;
+            std::fill(state.begin(), state.end(), 0.0);
+            state[2 * i] = 1.0;
+            state[2 * minus] = 1.0;
+            int owners = 0;
+            for (std::size_t k = 0; k < model->piece_count(); ++k)
+                owners += se.piece_energy(k, state.data()) != 0.0;
+            CHECK(owners == 1);
+        }
+        // A full field: the pieces' energies sum to H.
+        unsigned seed = 1;
+        for (int i = 0; i < 2 * N * N; ++i) {
+            seed = seed * 1103515245u + 12345u;
+            state[i] = (seed >> 8) / 16777216.0 - 0.5;
+        }
+        std::vector<double> x(N * N);
+        model->to_public(state.data(), x.data());
+        model->from_public(x.data(), state.data());  // make it Hermitian
+        double sum = 0.0;
+        for (std::size_t k = 0; k < model->piece_count(); ++k) sum += se.piece_energy(k, state.data());
+        const double H = model->energy(state.data());
+        CHECK(std::fabs(sum - H) <= 1e-13 * H);
+        std::printf("N = %2d: %3zu pieces, sum of piece energies - H = %.1e\n", N,
+                    model->piece_count(), sum - H);
+    }
+    return failures ? EXIT_FAILURE : EXIT_SUCCESS;
+#endif
+}
