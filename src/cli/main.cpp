@@ -1,6 +1,7 @@
 // lpi: the liepoisson command.
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -14,10 +15,11 @@ namespace {
 
 void print_usage(FILE *to) {
     std::fprintf(to,
-                 "usage: lpi report [SCENE...] [--out DIR]\n"
+                 "usage: lpi report [SCENE...] [--out DIR] [--N N]\n"
                  "           error against CPU time for every applicable method over a sweep of\n"
                  "           step sizes; prints a table and writes CSV and PNG files to DIR\n"
                  "           (default ./lpi-report). Without SCENE: the default scenes.\n"
+                 "           --N sets the sine-Euler scene's N (odd, default 31).\n"
                  "       lpi --version | --help\n"
                  "scenes:\n");
     for (const Scene &s : builtin_scenes())
@@ -27,10 +29,13 @@ void print_usage(FILE *to) {
 
 int report_command(int argc, char **argv) {
     ReportOptions options;
+    SceneOptions scene_options;
     std::vector<std::string> names;
     for (int a = 0; a < argc; ++a) {
         if (std::strcmp(argv[a], "--out") == 0 && a + 1 < argc) {
             options.out_dir = argv[++a];
+        } else if (std::strcmp(argv[a], "--N") == 0 && a + 1 < argc) {
+            scene_options.sine_euler_n = std::atoi(argv[++a]);
         } else if (std::strcmp(argv[a], "--help") == 0) {
             print_usage(stdout);
             return 0;
@@ -41,7 +46,7 @@ int report_command(int argc, char **argv) {
             names.push_back(argv[a]);
         }
     }
-    const std::vector<Scene> all = builtin_scenes();
+    const std::vector<Scene> all = builtin_scenes(scene_options);
     std::vector<const Scene *> chosen;
     for (const std::string &name : names) {
         auto it = std::find_if(all.begin(), all.end(), [&](const Scene &s) { return s.name == name; });

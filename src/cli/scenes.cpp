@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "fields.hpp"
+
 namespace lpi_cli {
 
 namespace {
@@ -28,6 +30,15 @@ int product_dh(double u, double *out, void *) {
     return 0;
 }
 
+std::string sine_euler_unavailable() {
+    lpi_system *probe = nullptr;
+    if (lpi_sine_euler_create(&probe, 3) == LPI_OK) {
+        lpi_destroy(probe);
+        return "";
+    }
+    return lpi_last_error(nullptr);
+}
+
 Handle with_state(Handle h, const std::vector<double> &x) {
     check(lpi_set_state(h.get(), x.data(), x.size()), h.get(), "set state");
     return h;
@@ -35,7 +46,7 @@ Handle with_state(Handle h, const std::vector<double> &x) {
 
 }  // namespace
 
-std::vector<Scene> builtin_scenes() {
+std::vector<Scene> builtin_scenes(const SceneOptions &options) {
     std::vector<Scene> scenes;
     {
         Scene s;
@@ -86,6 +97,35 @@ std::vector<Scene> builtin_scenes() {
         s.steps = {0.05, 0.025, 0.0125, 0.00625, 0.003125};
         s.reference_method = "kahan-li-8";
         s.reference_step = 5e-4;
+        scenes.push_back(s);
+    }
+    {
+        Scene s;
+        const int N = options.sine_euler_n;
+        s.name = "sine-euler";
+        s.description = "sine-Euler (Zeitlin su(N) 2D Euler), N = " + std::to_string(N) +
+                        ", smooth random field, sum |w|^2 = 1 (--N to change N)";
+        s.create = [N] {
+            Handle h;
+            check(lpi_sine_euler_create(h.out(), N), nullptr, "create sine-Euler");
+            const std::vector<double> w = smooth_random_field(N, 3.0, 7);
+            check(lpi_sine_euler_set_modes(h.get(), w.data(), w.size()), h.get(), "set modes");
+            return h;
+        };
+        s.unavailable = sine_euler_unavailable;
+        s.final_time = 10.0;
+        s.steps = {0.4, 0.2, 0.1, 0.05, 0.025};
+        s.reference_method = "kahan-li-8";
+        s.reference_step = 0.02;
+        scenes.push_back(s);
+    }
+    {
+        Scene s;
+        s.name = "figure2";
+        s.description = "the paper's Figure 2: sine-Euler N = 7, leapfrog, dt = 0.05, 10^5 steps, "
+                        "|w| = 1, H(0) = 0.75";
+        s.unavailable = sine_euler_unavailable;
+        s.custom_run = run_figure2;
         scenes.push_back(s);
     }
     return scenes;

@@ -22,8 +22,20 @@ struct Scene {
     std::string reference_method;
     double reference_step = 0.0;
     bool in_default_report = true;
+    // Why the scene cannot run in this build ("" when it can).
+    std::function<std::string()> unavailable = [] { return std::string(); };
+    // A scene that is not a step-size sweep runs this instead (figure2).
+    std::function<void(const std::string &out_dir)> custom_run;
 };
 
-std::vector<Scene> builtin_scenes();
+struct SceneOptions {
+    int sine_euler_n = 31;  // lpi report sine-euler --N
+};
+
+std::vector<Scene> builtin_scenes(const SceneOptions &options = {});
+
+// The Figure 2 scene: a long leapfrog run, energy error and Casimir drift
+// against time, written as CSV and PNG under out_dir.
+void run_figure2(const std::string &out_dir);
 
 }  // namespace lpi_cli

@@ -1,0 +1,78 @@
+#include "fields.hpp"
+
+#include <cmath>
+
+namespace lpi_cli {
+
+namespace {
+
+// Representative of a mod N in -M..M.
+int centred(int a, int N) { return a > N / 2 ? a - N : a; }
+
+// splitmix64: a small, well-mixed deterministic generator.
+double uniform(std::uint64_t &state) {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    z ^= z >> 31;
+    return static_cast<double>(z >> 11) * 0x1.0p-53;
+}
+
+}  // namespace
+
+std::vector<double> smooth_random_field(int N, double k0, std::uint64_t seed) {
+    std::vector<double> w(2 * static_cast<std::size_t>(N) * N, 0.0);
+    double norm = 0.0;
+    for (int a = 0; a < N; ++a) {
+        for (int b = 0; b < N; ++b) {
+            const int m1 = centred(a, N), m2 = centred(b, N);
+            // Draw each pair +-m once, from its member in the upper half plane.
+            if (!(m1 > 0 || (m1 == 0 && m2 > 0))) continue;
+            const double amplitude = std::exp(-(m1 * m1 + m2 * m2) / (2.0 * k0 * k0)) *
+                                     (0.5 + uniform(seed));
+            const double phase = 2.0 * 3.14159265358979323846 * uniform(seed);
+            const std::size_t i = static_cast<std::size_t>(a) * N + b;
+            const std::size_t j = static_cast<std::size_t>((N - a) % N) * N + (N - b) % N;
+            w[2 * i] = amplitude * std::cos(phase);
+            w[2 * i + 1] = amplitude * std::sin(phase);
+            w[2 * j] = w[2 * i];
+            w[2 * j + 1] = -w[2 * i + 1];
+            norm += 2.0 * amplitude * amplitude;
+        }
+    }
+    for (double &v : w) v /= std::sqrt(norm);
+    return w;
+}
+
+std::vector<double> figure2_field() {
+    const int N = 7;
+    std::vector<double> w = smooth_random_field(N, 10.0, 1993);  // nearly flat spectrum
+    // Split the half-plane norm and energy into |m| = 1 and the rest.
+    double low_norm = 0.0, high_norm = 0.0, high_energy = 0.0;
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const int n2 = centred(a, N) * centred(a, N) + centred(b, N) * centred(b, N);
+            const std::size_t i = static_cast<std::size_t>(a) * N + b;
+            const double p = 0.5 * (w[2 * i] * w[2 * i] + w[2 * i + 1] * w[2 * i + 1]);
+            if (n2 == 1)
+                low_norm += p;
+            else if (n2 > 0)
+                high_norm += p, high_energy += p / n2;
+        }
+    // H = 1/2 sum |w|^2/|m|^2 = (half plane) alpha^2 + beta^2 e_high with
+    // alpha^2 + beta^2 = 1: solve for H = 0.75.
+    const double e_high = high_energy / high_norm;
+    const double alpha2 = (0.75 - e_high) / (1.0 - e_high);
+    const double alpha = std::sqrt(alpha2 / low_norm), beta = std::sqrt((1.0 - alpha2) / high_norm);
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const int n2 = centred(a, N) * centred(a, N) + centred(b, N) * centred(b, N);
+            const std::size_t i = static_cast<std::size_t>(a) * N + b;
+            const double f = n2 == 1 ? alpha : beta;
+            w[2 * i] *= f;
+            w[2 * i + 1] *= f;
+        }
+    return w;
+}
+
+}  // namespace lpi_cli

@@ -1,0 +1,19 @@
+// Initial vorticity fields for the sine-Euler scenes, as N x N complex modes
+// in the library's FFT order (entry a*N + b holds mode (a, b) mod N).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace lpi_cli {
+
+// A smooth field with random phases and amplitudes exp(-|m|^2 / (2 k0^2)),
+// Hermitian (w_{-m} = conj w_m), w_0 = 0, scaled so that sum |w_m|^2 = 1.
+std::vector<double> smooth_random_field(int N, double k0, std::uint64_t seed);
+
+// The paper's Figure 2 field (N = 7): |w| = 1 over one mode of each pair +-m
+// (sum over all modes = 2) and H(0) = 0.75 exactly, by mixing the |m| = 1
+// modes of a random field with the others in the right proportion.
+std::vector<double> figure2_field();
+
+}  // namespace lpi_cli
