@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "report.hpp"
+#include "run.hpp"
 #include "scenes.hpp"
 
 using namespace lpi_cli;
@@ -20,6 +21,7 @@ void print_usage(FILE *to) {
                  "           step sizes; prints a table and writes CSV and PNG files to DIR\n"
                  "           (default ./lpi-report). Without SCENE: the default scenes.\n"
                  "           --N sets the sine-Euler scene's N (odd, default 31).\n"
+                 "       lpi run SCENE [options]   integrate one scene; lpi run --help for the options\n"
                  "       lpi --version | --help\n"
                  "scenes:\n");
     for (const Scene &s : builtin_scenes())
@@ -83,6 +85,7 @@ int main(int argc, char **argv) {
         return 0;
     }
     if (command == "report") return report_command(argc - 2, argv + 2);
+    if (command == "run") return run_command(argc - 2, argv + 2);
     std::fprintf(stderr, "lpi: unknown command '%s'\n", command.c_str());
     print_usage(stderr);
     return 2;

@@ -1,6 +1,7 @@
 #include "scenes.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "fields.hpp"
 
@@ -30,6 +31,12 @@ int product_dh(double u, double *out, void *) {
     return 0;
 }
 
+std::string format_number(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return text;
+}
+
 std::string sine_euler_unavailable() {
     lpi_system *probe = nullptr;
     if (lpi_sine_euler_create(&probe, 3) == LPI_OK) {
@@ -51,10 +58,12 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
     {
         Scene s;
         s.name = "rigid-body";
-        s.description = "free rigid body, I = (1, 2, 3), m(0) = (1, 0.5, -0.3)";
-        s.create = [] {
+        const double I1 = options.inertia[0], I2 = options.inertia[1], I3 = options.inertia[2];
+        s.description = "free rigid body, I = (" + format_number(I1) + ", " + format_number(I2) + ", " +
+                        format_number(I3) + "), m(0) = (1, 0.5, -0.3)";
+        s.create = [I1, I2, I3] {
             Handle h;
-            check(lpi_rigid_body_create(h.out(), 1.0, 2.0, 3.0), nullptr, "create rigid body");
+            check(lpi_rigid_body_create(h.out(), I1, I2, I3), nullptr, "create rigid body");
             return with_state(std::move(h), {1.0, 0.5, -0.3});
         };
         s.final_time = 100.0;

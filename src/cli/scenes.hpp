@@ -30,6 +30,7 @@ struct Scene {
 
 struct SceneOptions {
     int sine_euler_n = 31;  // lpi report sine-euler --N
+    double inertia[3] = {1.0, 2.0, 3.0};  // lpi run rigid-body --inertia
 };
 
 std::vector<Scene> builtin_scenes(const SceneOptions &options = {});
