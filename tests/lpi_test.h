@@ -72,6 +72,15 @@ static inline void lpi_test_rk4(lpi_test_field f, const void *ctx, size_t n, dou
     }
 }
 
+/* Euler's equations of the free rigid body, dm/dt = m x (m / I); ctx = I. */
+static inline void lpi_test_rigid_body_field(const double *m, double *dm, const void *ctx) {
+    const double *inertia = (const double *)ctx;
+    const double w[3] = {m[0] / inertia[0], m[1] / inertia[1], m[2] / inertia[2]};
+    dm[0] = m[1] * w[2] - m[2] * w[1];
+    dm[1] = m[2] * w[0] - m[0] * w[2];
+    dm[2] = m[0] * w[1] - m[1] * w[0];
+}
+
 /* Least-squares slope of log(error) against log(step). */
 static inline double lpi_fit_order(const double *steps, const double *errors, int count) {
     double sx = 0, sy = 0, sxx = 0, sxy = 0;

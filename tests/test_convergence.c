@@ -5,14 +5,6 @@
 
 static const double kInertia[3] = {1.0, 2.0, 3.0};
 
-static void rigid_body_field(const double *m, double *dm, const void *ctx) {
-    const double *I = ctx;
-    const double w[3] = {m[0] / I[0], m[1] / I[1], m[2] / I[2]};
-    dm[0] = m[1] * w[2] - m[2] * w[1];
-    dm[1] = m[2] * w[0] - m[0] * w[2];
-    dm[2] = m[0] * w[1] - m[1] * w[0];
-}
-
 static void pendulum_field(const double *x, double *dx, const void *ctx) {
     (void)ctx; /* J(x) grad H with H = x3^2/2 + x2 */
     dx[0] = -x[1] * x[2];
@@ -41,7 +33,7 @@ static void test_rigid_body_orders(void **state) {
     (void)state;
     const double m0[3] = {1.0, 0.5, -0.3}, T = 2.0;
     double reference[3] = {m0[0], m0[1], m0[2]};
-    lpi_test_rk4(rigid_body_field, kInertia, 3, reference, T, 200000);
+    lpi_test_rk4(lpi_test_rigid_body_field, kInertia, 3, reference, T, 200000);
     const char *splits[] = {"casimir-shift", "axes"};
     for (int s = 0; s < 2; ++s) {
         lpi_system *sys = NULL;
@@ -73,7 +65,7 @@ static void test_rk4_baseline_matches_reference(void **state) {
     (void)state;
     const double m0[3] = {1.0, 0.5, -0.3}, T = 2.0;
     double reference[3] = {m0[0], m0[1], m0[2]};
-    lpi_test_rk4(rigid_body_field, kInertia, 3, reference, T, 200);
+    lpi_test_rk4(lpi_test_rigid_body_field, kInertia, 3, reference, T, 200);
     lpi_system *sys = NULL;
     assert_int_equal(lpi_rigid_body_create(&sys, 1.0, 2.0, 3.0), LPI_OK);
     assert_true(lpi_test_error(sys, "rk4", m0, T, 200, reference) < 1e-14);

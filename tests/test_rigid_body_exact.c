@@ -3,21 +3,13 @@
  * rotations, every ordering of the inertias. */
 #include "lpi_test.h"
 
-static void rigid_body_field(const double *m, double *dm, const void *ctx) {
-    const double *I = ctx;
-    const double w[3] = {m[0] / I[0], m[1] / I[1], m[2] / I[2]};
-    dm[0] = m[1] * w[2] - m[2] * w[1];
-    dm[1] = m[2] * w[0] - m[0] * w[2];
-    dm[2] = m[0] * w[1] - m[1] * w[0];
-}
-
 static double exact_error(const double I[3], const double m0[3], double t, int64_t rk4_steps) {
     lpi_system *sys = NULL;
     assert_int_equal(lpi_rigid_body_create(&sys, I[0], I[1], I[2]), LPI_OK);
     assert_int_equal(lpi_set_state(sys, m0, 3), LPI_OK);
     double exact[3], reference[3] = {m0[0], m0[1], m0[2]};
     assert_int_equal(lpi_rigid_body_exact(sys, t, exact), LPI_OK);
-    lpi_test_rk4(rigid_body_field, I, 3, reference, t, rk4_steps);
+    lpi_test_rk4(lpi_test_rigid_body_field, I, 3, reference, t, rk4_steps);
     lpi_destroy(sys);
     return lpi_test_distance(exact, reference, 3);
 }
