@@ -1,0 +1,827 @@
+! liepoisson for Fortran 2003+: the module liepoisson.
+!
+! Two layers over the C library (include/liepoisson.h):
+!   c_lpi_<name>  bind(C) interfaces of every public function, exactly as in C;
+!   lpi_<name>    Fortran-friendly wrappers: character strings in and out,
+!                 assumed-shape arrays (their size is passed as the length),
+!                 and an optional integer status argument. When status is
+!                 absent, a failure stops the program with the library's
+!                 message (as Fortran I/O does without iostat=); when present,
+!                 it receives LPI_OK or the negative LPI_ERR_* code and
+!                 lpi_last_error(sys) gives the message.
+! Handles are type(c_ptr). Index sets and bracket indices are 0-based, as in C.
+! Sine-Euler modes and grids are arrays w(0:N-1, 0:N-1) with w(a, b) = mode
+! (a, b) (resp. the vorticity at (2 pi a/N, 2 pi b/N)); the wrappers transpose
+! to and from the C row-major layout.
+! Callbacks are bind(C) functions matching the abstract interfaces
+! lpi_gradient_fn, lpi_energy_fn, lpi_casimir_fn and lpi_scalar_fn.
+module liepoisson
+    use, intrinsic :: iso_c_binding
+    implicit none
+    private
+
+    ! Status codes: the values are part of the C ABI (append-only).
+    integer(c_int), parameter, public :: LPI_OK = 0, LPI_ERR_NULL = -1, LPI_ERR_INVALID = -2, &
+        LPI_ERR_SIZE = -3, LPI_ERR_NONFINITE = -4, LPI_ERR_NOT_ABELIAN = -5, &
+        LPI_ERR_UNSUPPORTED = -6, LPI_ERR_NO_MEMORY = -7, LPI_ERR_INTERNAL = -8, &
+        LPI_ERR_CALLBACK = -9, LPI_ERR_NO_CONVERGENCE = -10
+
+    ! ---- callback types ------------------------------------------------------
+    abstract interface
+        integer(c_int) function lpi_gradient_fn(n, x_sigma, grad, user) bind(C)
+            import :: c_int, c_size_t, c_double, c_ptr
+            integer(c_size_t), value :: n
+            real(c_double), intent(in) :: x_sigma(n)
+            real(c_double), intent(out) :: grad(n)
+            type(c_ptr), value :: user
+        end function
+        integer(c_int) function lpi_energy_fn(n, x_sigma, h, user) bind(C)
+            import :: c_int, c_size_t, c_double, c_ptr
+            integer(c_size_t), value :: n
+            real(c_double), intent(in) :: x_sigma(n)
+            real(c_double), intent(out) :: h
+            type(c_ptr), value :: user
+        end function
+        integer(c_int) function lpi_casimir_fn(dim, x, out, user) bind(C)
+            import :: c_int, c_size_t, c_double, c_ptr
+            integer(c_size_t), value :: dim
+            real(c_double), intent(in) :: x(dim)
+            real(c_double), intent(out) :: out
+            type(c_ptr), value :: user
+        end function
+        integer(c_int) function lpi_scalar_fn(u, out, user) bind(C)
+            import :: c_int, c_double, c_ptr
+            real(c_double), value :: u
+            real(c_double), intent(out) :: out
+            type(c_ptr), value :: user
+        end function
+    end interface
+    public :: lpi_gradient_fn, lpi_energy_fn, lpi_casimir_fn, lpi_scalar_fn
+
+    ! ---- the C functions, one interface each ----------------------------------
+    interface
+        ! version, status codes, methods
+        type(c_ptr) function c_lpi_version_string() bind(C, name="lpi_version_string")
+            import :: c_ptr
+        end function
+        type(c_ptr) function c_lpi_status_name(status) bind(C, name="lpi_status_name")
+            import :: c_ptr, c_int
+            integer(c_int), value :: status
+        end function
+        type(c_ptr) function c_lpi_status_message(status) bind(C, name="lpi_status_message")
+            import :: c_ptr, c_int
+            integer(c_int), value :: status
+        end function
+        integer(c_int) function c_lpi_method_count() bind(C, name="lpi_method_count")
+            import :: c_int
+        end function
+        type(c_ptr) function c_lpi_method_name(i) bind(C, name="lpi_method_name")
+            import :: c_ptr, c_int
+            integer(c_int), value :: i
+        end function
+        integer(c_int) function c_lpi_method_order(i) bind(C, name="lpi_method_order")
+            import :: c_int
+            integer(c_int), value :: i
+        end function
+        integer(c_int) function c_lpi_method_is_poisson(i) bind(C, name="lpi_method_is_poisson")
+            import :: c_int
+            integer(c_int), value :: i
+        end function
+        integer(c_int) function c_lpi_method_stages(i) bind(C, name="lpi_method_stages")
+            import :: c_int
+            integer(c_int), value :: i
+        end function
+        type(c_ptr) function c_lpi_method_reference(i) bind(C, name="lpi_method_reference")
+            import :: c_ptr, c_int
+            integer(c_int), value :: i
+        end function
+        ! systems
+        integer(c_int) function c_lpi_rigid_body_create(out, i1, i2, i3) &
+                bind(C, name="lpi_rigid_body_create")
+            import :: c_int, c_ptr, c_double
+            type(c_ptr), intent(out) :: out
+            real(c_double), value :: i1, i2, i3
+        end function
+        integer(c_int) function c_lpi_rigid_body_exact(sys, t, out) bind(C, name="lpi_rigid_body_exact")
+            import :: c_int, c_ptr, c_double
+            type(c_ptr), value :: sys
+            real(c_double), value :: t
+            real(c_double), intent(out) :: out(3)
+        end function
+        integer(c_int) function c_lpi_pendulum_create(out) bind(C, name="lpi_pendulum_create")
+            import :: c_int, c_ptr
+            type(c_ptr), intent(out) :: out
+        end function
+        subroutine c_lpi_destroy(sys) bind(C, name="lpi_destroy")
+            import :: c_ptr
+            type(c_ptr), value :: sys
+        end subroutine
+        integer(c_int) function c_lpi_set_method(sys, name) bind(C, name="lpi_set_method")
+            import :: c_int, c_ptr, c_char
+            type(c_ptr), value :: sys
+            character(kind=c_char), intent(in) :: name(*)
+        end function
+        integer(c_int) function c_lpi_set_split(sys, name) bind(C, name="lpi_set_split")
+            import :: c_int, c_ptr, c_char
+            type(c_ptr), value :: sys
+            character(kind=c_char), intent(in) :: name(*)
+        end function
+        integer(c_size_t) function c_lpi_dim(sys) bind(C, name="lpi_dim")
+            import :: c_size_t, c_ptr
+            type(c_ptr), value :: sys
+        end function
+        integer(c_int) function c_lpi_set_state(sys, x, n) bind(C, name="lpi_set_state")
+            import :: c_int, c_ptr, c_double, c_size_t
+            type(c_ptr), value :: sys
+            real(c_double), intent(in) :: x(*)
+            integer(c_size_t), value :: n
+        end function
+        integer(c_int) function c_lpi_get_state(sys, x, n) bind(C, name="lpi_get_state")
+            import :: c_int, c_ptr, c_double, c_size_t
+            type(c_ptr), value :: sys
+            real(c_double), intent(inout) :: x(*)
+            integer(c_size_t), value :: n
+        end function
+        integer(c_int) function c_lpi_step(sys, dt, nsteps) bind(C, name="lpi_step")
+            import :: c_int, c_ptr, c_double, c_int64_t
+            type(c_ptr), value :: sys
+            real(c_double), value :: dt
+            integer(c_int64_t), value :: nsteps
+        end function
+        real(c_double) function c_lpi_time(sys) bind(C, name="lpi_time")
+            import :: c_double, c_ptr
+            type(c_ptr), value :: sys
+        end function
+        integer(c_int) function c_lpi_energy(sys, out) bind(C, name="lpi_energy")
+            import :: c_int, c_ptr, c_double
+            type(c_ptr), value :: sys
+            real(c_double), intent(out) :: out
+        end function
+        integer(c_size_t) function c_lpi_casimir_count(sys) bind(C, name="lpi_casimir_count")
+            import :: c_size_t, c_ptr
+            type(c_ptr), value :: sys
+        end function
+        integer(c_int) function c_lpi_casimirs(sys, out, n) bind(C, name="lpi_casimirs")
+            import :: c_int, c_ptr, c_double, c_size_t
+            type(c_ptr), value :: sys
+            real(c_double), intent(inout) :: out(*)
+            integer(c_size_t), value :: n
+        end function
+        type(c_ptr) function c_lpi_last_error(sys) bind(C, name="lpi_last_error")
+            import :: c_ptr
+            type(c_ptr), value :: sys
+        end function
+        ! composition methods, implicit baselines
+        integer(c_int) function c_lpi_set_composition(sys, n, gammas) bind(C, name="lpi_set_composition")
+            import :: c_int, c_ptr, c_double, c_size_t
+            type(c_ptr), value :: sys
+            integer(c_size_t), value :: n
+            real(c_double), intent(in) :: gammas(*)
+        end function
+        integer(c_int) function c_lpi_flows_per_step(sys, out) bind(C, name="lpi_flows_per_step")
+            import :: c_int, c_ptr, c_size_t
+            type(c_ptr), value :: sys
+            integer(c_size_t), intent(out) :: out
+        end function
+        integer(c_int) function c_lpi_set_implicit_options(sys, tolerance, max_iterations) &
+                bind(C, name="lpi_set_implicit_options")
+            import :: c_int, c_ptr, c_double, c_int32_t
+            type(c_ptr), value :: sys
+            real(c_double), value :: tolerance
+            integer(c_int32_t), value :: max_iterations
+        end function
+        ! generic systems and the moment algebra
+        integer(c_int) function c_lpi_generic_create(out, dim, nnz, i, j, k, c) &
+                bind(C, name="lpi_generic_create")
+            import :: c_int, c_ptr, c_size_t, c_int32_t, c_double
+            type(c_ptr), intent(out) :: out
+            integer(c_size_t), value :: dim, nnz
+            integer(c_int32_t), intent(in) :: i(*), j(*), k(*)
+            real(c_double), intent(in) :: c(*)
+        end function
+        integer(c_int) function c_lpi_add_piece(sys, n, indices, grad, energy, user) &
+                bind(C, name="lpi_add_piece")
+            import :: c_int, c_ptr, c_size_t, c_int32_t, c_funptr
+            type(c_ptr), value :: sys
+            integer(c_size_t), value :: n
+            integer(c_int32_t), intent(in) :: indices(*)
+            type(c_funptr), value :: grad, energy
+            type(c_ptr), value :: user
+        end function
+        integer(c_int) function c_lpi_add_casimir(sys, fn, user) bind(C, name="lpi_add_casimir")
+            import :: c_int, c_ptr, c_funptr
+            type(c_ptr), value :: sys
+            type(c_funptr), value :: fn
+            type(c_ptr), value :: user
+        end function
+        integer(c_int) function c_lpi_poisson_rank(sys, x, n, rank) bind(C, name="lpi_poisson_rank")
+            import :: c_int, c_ptr, c_double, c_size_t
+            type(c_ptr), value :: sys
+            real(c_double), intent(in) :: x(*)
+            integer(c_size_t), value :: n
+            integer(c_size_t), intent(out) :: rank
+        end function
+        integer(c_int) function c_lpi_moments_create(out) bind(C, name="lpi_moments_create")
+            import :: c_int, c_ptr
+            type(c_ptr), intent(out) :: out
+        end function
+        integer(c_int) function c_lpi_moments_add_product_piece(sys, h, dh, user) &
+                bind(C, name="lpi_moments_add_product_piece")
+            import :: c_int, c_ptr, c_funptr
+            type(c_ptr), value :: sys
+            type(c_funptr), value :: h, dh
+            type(c_ptr), value :: user
+        end function
+        ! sine-Euler, threads, FFTW wisdom
+        integer(c_int) function c_lpi_sine_euler_create(out, n) bind(C, name="lpi_sine_euler_create")
+            import :: c_int, c_ptr, c_int32_t
+            type(c_ptr), intent(out) :: out
+            integer(c_int32_t), value :: n
+        end function
+        integer(c_int) function c_lpi_sine_euler_size(sys, n) bind(C, name="lpi_sine_euler_size")
+            import :: c_int, c_ptr, c_int32_t
+            type(c_ptr), value :: sys
+            integer(c_int32_t), intent(out) :: n
+        end function
+        integer(c_int) function c_lpi_sine_euler_set_modes(sys, re_im, n) &
+                bind(C, name="lpi_sine_euler_set_modes")
+            import :: c_int, c_ptr, c_double, c_size_t
+            type(c_ptr), value :: sys
+            real(c_double), intent(in) :: re_im(*)
+            integer(c_size_t), value :: n
+        end function
+        integer(c_int) function c_lpi_sine_euler_get_modes(sys, re_im, n) &
+                bind(C, name="lpi_sine_euler_get_modes")
+            import :: c_int, c_ptr, c_double, c_size_t
+            type(c_ptr), value :: sys
+            real(c_double), intent(inout) :: re_im(*)
+            integer(c_size_t), value :: n
+        end function
+        integer(c_int) function c_lpi_sine_euler_set_grid(sys, w, n) bind(C, name="lpi_sine_euler_set_grid")
+            import :: c_int, c_ptr, c_double, c_size_t
+            type(c_ptr), value :: sys
+            real(c_double), intent(in) :: w(*)
+            integer(c_size_t), value :: n
+        end function
+        integer(c_int) function c_lpi_sine_euler_get_grid(sys, w, n) bind(C, name="lpi_sine_euler_get_grid")
+            import :: c_int, c_ptr, c_double, c_size_t
+            type(c_ptr), value :: sys
+            real(c_double), intent(inout) :: w(*)
+            integer(c_size_t), value :: n
+        end function
+        integer(c_int) function c_lpi_sine_euler_enstrophy(sys, out) bind(C, name="lpi_sine_euler_enstrophy")
+            import :: c_int, c_ptr, c_double
+            type(c_ptr), value :: sys
+            real(c_double), intent(out) :: out
+        end function
+        integer(c_int) function c_lpi_sine_euler_casimir_traces(sys, kmax, out) &
+                bind(C, name="lpi_sine_euler_casimir_traces")
+            import :: c_int, c_ptr, c_int32_t, c_double
+            type(c_ptr), value :: sys
+            integer(c_int32_t), value :: kmax
+            real(c_double), intent(inout) :: out(*)
+        end function
+        integer(c_int) function c_lpi_sine_euler_fft_floor(sys, nsteps, seconds_per_step, &
+                transforms_per_step) bind(C, name="lpi_sine_euler_fft_floor")
+            import :: c_int, c_ptr, c_int64_t, c_double
+            type(c_ptr), value :: sys
+            integer(c_int64_t), value :: nsteps
+            real(c_double), intent(out) :: seconds_per_step, transforms_per_step
+        end function
+        integer(c_int) function c_lpi_set_threads(sys, n) bind(C, name="lpi_set_threads")
+            import :: c_int, c_ptr, c_int32_t
+            type(c_ptr), value :: sys
+            integer(c_int32_t), value :: n
+        end function
+        integer(c_int) function c_lpi_fftw_wisdom_import_file(path) bind(C, name="lpi_fftw_wisdom_import_file")
+            import :: c_int, c_char
+            character(kind=c_char), intent(in) :: path(*)
+        end function
+        integer(c_int) function c_lpi_fftw_wisdom_export_file(path) bind(C, name="lpi_fftw_wisdom_export_file")
+            import :: c_int, c_char
+            character(kind=c_char), intent(in) :: path(*)
+        end function
+        integer(c_int) function c_lpi_fftw_wisdom_import_string(wisdom) &
+                bind(C, name="lpi_fftw_wisdom_import_string")
+            import :: c_int, c_char
+            character(kind=c_char), intent(in) :: wisdom(*)
+        end function
+        integer(c_int) function c_lpi_fftw_wisdom_export_string(buf, size, length) &
+                bind(C, name="lpi_fftw_wisdom_export_string")
+            import :: c_int, c_ptr, c_size_t
+            type(c_ptr), value :: buf
+            integer(c_size_t), value :: size
+            integer(c_size_t), intent(out) :: length
+        end function
+        ! from the C library, to read C strings
+        integer(c_size_t) function c_strlen(s) bind(C, name="strlen")
+            import :: c_size_t, c_ptr
+            type(c_ptr), value :: s
+        end function
+    end interface
+
+    public :: c_lpi_version_string, c_lpi_status_name, c_lpi_status_message, c_lpi_method_count, &
+        c_lpi_method_name, c_lpi_method_order, c_lpi_method_is_poisson, c_lpi_method_stages, &
+        c_lpi_method_reference, c_lpi_rigid_body_create, c_lpi_rigid_body_exact, &
+        c_lpi_pendulum_create, c_lpi_destroy, c_lpi_set_method, c_lpi_set_split, c_lpi_dim, &
+        c_lpi_set_state, c_lpi_get_state, c_lpi_step, c_lpi_time, c_lpi_energy, &
+        c_lpi_casimir_count, c_lpi_casimirs, c_lpi_last_error, c_lpi_set_composition, &
+        c_lpi_flows_per_step, c_lpi_set_implicit_options, c_lpi_generic_create, c_lpi_add_piece, &
+        c_lpi_add_casimir, c_lpi_poisson_rank, c_lpi_moments_create, &
+        c_lpi_moments_add_product_piece, c_lpi_sine_euler_create, c_lpi_sine_euler_size, &
+        c_lpi_sine_euler_set_modes, c_lpi_sine_euler_get_modes, c_lpi_sine_euler_set_grid, &
+        c_lpi_sine_euler_get_grid, c_lpi_sine_euler_enstrophy, c_lpi_sine_euler_casimir_traces, &
+        c_lpi_sine_euler_fft_floor, c_lpi_set_threads, c_lpi_fftw_wisdom_import_file, &
+        c_lpi_fftw_wisdom_export_file, c_lpi_fftw_wisdom_import_string, &
+        c_lpi_fftw_wisdom_export_string
+
+    ! lpi_step takes a default or 64-bit step count.
+    interface lpi_step
+        module procedure lpi_step_i4, lpi_step_i8
+    end interface
+
+    public :: lpi_version_string, lpi_status_name, lpi_status_message, lpi_method_count, &
+        lpi_method_name, lpi_method_order, lpi_method_is_poisson, lpi_method_stages, &
+        lpi_method_reference, lpi_rigid_body_create, lpi_rigid_body_exact, lpi_pendulum_create, &
+        lpi_destroy, lpi_set_method, lpi_set_split, lpi_dim, lpi_set_state, lpi_get_state, &
+        lpi_step, lpi_time, lpi_energy, lpi_casimir_count, lpi_casimirs, lpi_last_error, &
+        lpi_set_composition, lpi_flows_per_step, lpi_set_implicit_options, lpi_generic_create, &
+        lpi_add_piece, lpi_add_casimir, lpi_poisson_rank, lpi_moments_create, &
+        lpi_moments_add_product_piece, lpi_sine_euler_create, lpi_sine_euler_size, &
+        lpi_sine_euler_set_modes, lpi_sine_euler_get_modes, lpi_sine_euler_set_grid, &
+        lpi_sine_euler_get_grid, lpi_sine_euler_enstrophy, lpi_sine_euler_casimir_traces, &
+        lpi_sine_euler_fft_floor, lpi_set_threads, lpi_fftw_wisdom_import_file, &
+        lpi_fftw_wisdom_export_file, lpi_fftw_wisdom_import_string, lpi_fftw_wisdom_export_string
+
+contains
+
+    ! ---- helpers ----------------------------------------------------------------
+
+    ! A NUL-terminated C string as a Fortran string ("" for NULL).
+    function f_string(p) result(s)
+        type(c_ptr), intent(in) :: p
+        character(len=:), allocatable :: s
+        character(kind=c_char), pointer :: chars(:)
+        integer :: n, q
+        if (.not. c_associated(p)) then
+            s = ""
+            return
+        end if
+        n = int(c_strlen(p))
+        call c_f_pointer(p, chars, [n])
+        allocate (character(len=n) :: s)
+        do q = 1, n
+            s(q:q) = chars(q)
+        end do
+    end function
+
+    function c_string(s) result(c)
+        character(len=*), intent(in) :: s
+        character(kind=c_char, len=len_trim(s) + 1) :: c
+        c = trim(s)//c_null_char
+    end function
+
+    ! Hands st to status when present; otherwise a failure stops the program.
+    subroutine finish(st, sys, status)
+        integer(c_int), intent(in) :: st
+        type(c_ptr), intent(in) :: sys
+        integer, intent(out), optional :: status
+        if (present(status)) then
+            status = st
+        else if (st /= LPI_OK) then
+            error stop "liepoisson: "//f_string(c_lpi_status_name(st))//": "//f_string(c_lpi_last_error(sys))
+        end if
+    end subroutine
+
+    ! ---- version, status codes, methods ----------------------------------------
+
+    function lpi_version_string() result(s)
+        character(len=:), allocatable :: s
+        s = f_string(c_lpi_version_string())
+    end function
+
+    function lpi_status_name(status) result(s)
+        integer, intent(in) :: status
+        character(len=:), allocatable :: s
+        s = f_string(c_lpi_status_name(int(status, c_int)))
+    end function
+
+    function lpi_status_message(status) result(s)
+        integer, intent(in) :: status
+        character(len=:), allocatable :: s
+        s = f_string(c_lpi_status_message(int(status, c_int)))
+    end function
+
+    integer function lpi_method_count()
+        lpi_method_count = c_lpi_method_count()
+    end function
+
+    ! Methods are numbered 0 .. lpi_method_count() - 1, as in C; "" out of range.
+    function lpi_method_name(i) result(s)
+        integer, intent(in) :: i
+        character(len=:), allocatable :: s
+        s = f_string(c_lpi_method_name(int(i, c_int)))
+    end function
+
+    integer function lpi_method_order(i)
+        integer, intent(in) :: i
+        lpi_method_order = c_lpi_method_order(int(i, c_int))
+    end function
+
+    integer function lpi_method_is_poisson(i)
+        integer, intent(in) :: i
+        lpi_method_is_poisson = c_lpi_method_is_poisson(int(i, c_int))
+    end function
+
+    integer function lpi_method_stages(i)
+        integer, intent(in) :: i
+        lpi_method_stages = c_lpi_method_stages(int(i, c_int))
+    end function
+
+    function lpi_method_reference(i) result(s)
+        integer, intent(in) :: i
+        character(len=:), allocatable :: s
+        s = f_string(c_lpi_method_reference(int(i, c_int)))
+    end function
+
+    ! ---- systems ------------------------------------------------------------------
+
+    subroutine lpi_rigid_body_create(sys, i1, i2, i3, status)
+        type(c_ptr), intent(out) :: sys
+        real(c_double), intent(in) :: i1, i2, i3
+        integer, intent(out), optional :: status
+        call finish(c_lpi_rigid_body_create(sys, i1, i2, i3), c_null_ptr, status)
+    end subroutine
+
+    subroutine lpi_rigid_body_exact(sys, t, m, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(in) :: t
+        real(c_double), intent(out) :: m(3)
+        integer, intent(out), optional :: status
+        call finish(c_lpi_rigid_body_exact(sys, t, m), sys, status)
+    end subroutine
+
+    subroutine lpi_pendulum_create(sys, status)
+        type(c_ptr), intent(out) :: sys
+        integer, intent(out), optional :: status
+        call finish(c_lpi_pendulum_create(sys), c_null_ptr, status)
+    end subroutine
+
+    ! Releases the handle and sets sys to c_null_ptr (a null handle is a no-op).
+    subroutine lpi_destroy(sys)
+        type(c_ptr), intent(inout) :: sys
+        call c_lpi_destroy(sys)
+        sys = c_null_ptr
+    end subroutine
+
+    subroutine lpi_set_method(sys, name, status)
+        type(c_ptr), intent(in) :: sys
+        character(len=*), intent(in) :: name
+        integer, intent(out), optional :: status
+        call finish(c_lpi_set_method(sys, c_string(name)), sys, status)
+    end subroutine
+
+    subroutine lpi_set_split(sys, name, status)
+        type(c_ptr), intent(in) :: sys
+        character(len=*), intent(in) :: name
+        integer, intent(out), optional :: status
+        call finish(c_lpi_set_split(sys, c_string(name)), sys, status)
+    end subroutine
+
+    integer function lpi_dim(sys)
+        type(c_ptr), intent(in) :: sys
+        lpi_dim = int(c_lpi_dim(sys))
+    end function
+
+    ! size(x) must equal lpi_dim(sys).
+    subroutine lpi_set_state(sys, x, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(in) :: x(:)
+        integer, intent(out), optional :: status
+        call finish(c_lpi_set_state(sys, x, size(x, kind=c_size_t)), sys, status)
+    end subroutine
+
+    subroutine lpi_get_state(sys, x, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(inout) :: x(:)
+        integer, intent(out), optional :: status
+        call finish(c_lpi_get_state(sys, x, size(x, kind=c_size_t)), sys, status)
+    end subroutine
+
+    subroutine lpi_step_i4(sys, dt, nsteps, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(in) :: dt
+        integer(c_int32_t), intent(in) :: nsteps
+        integer, intent(out), optional :: status
+        call finish(c_lpi_step(sys, dt, int(nsteps, c_int64_t)), sys, status)
+    end subroutine
+
+    subroutine lpi_step_i8(sys, dt, nsteps, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(in) :: dt
+        integer(c_int64_t), intent(in) :: nsteps
+        integer, intent(out), optional :: status
+        call finish(c_lpi_step(sys, dt, nsteps), sys, status)
+    end subroutine
+
+    real(c_double) function lpi_time(sys)
+        type(c_ptr), intent(in) :: sys
+        lpi_time = c_lpi_time(sys)
+    end function
+
+    subroutine lpi_energy(sys, h, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(out) :: h
+        integer, intent(out), optional :: status
+        call finish(c_lpi_energy(sys, h), sys, status)
+    end subroutine
+
+    integer function lpi_casimir_count(sys)
+        type(c_ptr), intent(in) :: sys
+        lpi_casimir_count = int(c_lpi_casimir_count(sys))
+    end function
+
+    ! size(c) must equal lpi_casimir_count(sys).
+    subroutine lpi_casimirs(sys, c, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(inout) :: c(:)
+        integer, intent(out), optional :: status
+        call finish(c_lpi_casimirs(sys, c, size(c, kind=c_size_t)), sys, status)
+    end subroutine
+
+    ! The message of the last failure on sys; c_null_ptr gives the calling
+    ! thread's last failure of a call without a handle (a failed create).
+    function lpi_last_error(sys) result(s)
+        type(c_ptr), intent(in) :: sys
+        character(len=:), allocatable :: s
+        s = f_string(c_lpi_last_error(sys))
+    end function
+
+    ! ---- composition methods, implicit baselines ---------------------------------
+
+    subroutine lpi_set_composition(sys, gammas, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(in) :: gammas(:)
+        integer, intent(out), optional :: status
+        call finish(c_lpi_set_composition(sys, size(gammas, kind=c_size_t), gammas), sys, status)
+    end subroutine
+
+    subroutine lpi_flows_per_step(sys, flows, status)
+        type(c_ptr), intent(in) :: sys
+        integer, intent(out) :: flows
+        integer, intent(out), optional :: status
+        integer(c_size_t) :: n
+        integer(c_int) :: st
+        n = 0
+        st = c_lpi_flows_per_step(sys, n)
+        flows = int(n)
+        call finish(st, sys, status)
+    end subroutine
+
+    subroutine lpi_set_implicit_options(sys, tolerance, max_iterations, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(in) :: tolerance
+        integer, intent(in) :: max_iterations
+        integer, intent(out), optional :: status
+        call finish(c_lpi_set_implicit_options(sys, tolerance, int(max_iterations, c_int32_t)), &
+                    sys, status)
+    end subroutine
+
+    ! ---- generic systems and the moment algebra ------------------------------------
+
+    ! {x_i, x_j} = sum c x_k over the entries (i(e), j(e), k(e), c(e)), 0-based.
+    subroutine lpi_generic_create(sys, dim, i, j, k, c, status)
+        type(c_ptr), intent(out) :: sys
+        integer, intent(in) :: dim
+        integer(c_int32_t), intent(in) :: i(:), j(:), k(:)
+        real(c_double), intent(in) :: c(:)
+        integer, intent(out), optional :: status
+        if (size(j) /= size(i) .or. size(k) /= size(i) .or. size(c) /= size(i)) then
+            ! Checked here: the C function cannot see the four lengths.
+            sys = c_null_ptr
+            if (.not. present(status)) error stop "liepoisson: lpi_generic_create: i, j, k and c differ in length"
+            status = LPI_ERR_SIZE
+            return
+        end if
+        call finish(c_lpi_generic_create(sys, int(dim, c_size_t), size(i, kind=c_size_t), i, j, k, c), &
+                    c_null_ptr, status)
+    end subroutine
+
+    ! Appends the piece on the 0-based abelian index set indices.
+    subroutine lpi_add_piece(sys, indices, grad, energy, user, status)
+        type(c_ptr), intent(in) :: sys
+        integer(c_int32_t), intent(in) :: indices(:)
+        procedure(lpi_gradient_fn) :: grad
+        procedure(lpi_energy_fn) :: energy
+        type(c_ptr), intent(in), optional :: user
+        integer, intent(out), optional :: status
+        type(c_ptr) :: u
+        u = c_null_ptr
+        if (present(user)) u = user
+        call finish(c_lpi_add_piece(sys, size(indices, kind=c_size_t), indices, c_funloc(grad), &
+                                    c_funloc(energy), u), sys, status)
+    end subroutine
+
+    subroutine lpi_add_casimir(sys, fn, user, status)
+        type(c_ptr), intent(in) :: sys
+        procedure(lpi_casimir_fn) :: fn
+        type(c_ptr), intent(in), optional :: user
+        integer, intent(out), optional :: status
+        type(c_ptr) :: u
+        u = c_null_ptr
+        if (present(user)) u = user
+        call finish(c_lpi_add_casimir(sys, c_funloc(fn), u), sys, status)
+    end subroutine
+
+    subroutine lpi_poisson_rank(sys, x, rank, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(in) :: x(:)
+        integer, intent(out) :: rank
+        integer, intent(out), optional :: status
+        integer(c_size_t) :: r
+        integer(c_int) :: st
+        r = 0
+        st = c_lpi_poisson_rank(sys, x, size(x, kind=c_size_t), r)
+        rank = int(r)
+        call finish(st, sys, status)
+    end subroutine
+
+    subroutine lpi_moments_create(sys, status)
+        type(c_ptr), intent(out) :: sys
+        integer, intent(out), optional :: status
+        call finish(c_lpi_moments_create(sys), c_null_ptr, status)
+    end subroutine
+
+    subroutine lpi_moments_add_product_piece(sys, h, dh, user, status)
+        type(c_ptr), intent(in) :: sys
+        procedure(lpi_scalar_fn) :: h, dh
+        type(c_ptr), intent(in), optional :: user
+        integer, intent(out), optional :: status
+        type(c_ptr) :: u
+        u = c_null_ptr
+        if (present(user)) u = user
+        call finish(c_lpi_moments_add_product_piece(sys, c_funloc(h), c_funloc(dh), u), sys, status)
+    end subroutine
+
+    ! ---- sine-Euler, threads, FFTW wisdom ---------------------------------------------
+
+    subroutine lpi_sine_euler_create(sys, n, status)
+        type(c_ptr), intent(out) :: sys
+        integer, intent(in) :: n
+        integer, intent(out), optional :: status
+        call finish(c_lpi_sine_euler_create(sys, int(n, c_int32_t)), c_null_ptr, status)
+    end subroutine
+
+    subroutine lpi_sine_euler_size(sys, n, status)
+        type(c_ptr), intent(in) :: sys
+        integer, intent(out) :: n
+        integer, intent(out), optional :: status
+        integer(c_int32_t) :: m
+        integer(c_int) :: st
+        m = 0
+        st = c_lpi_sine_euler_size(sys, m)
+        n = int(m)
+        call finish(st, sys, status)
+    end subroutine
+
+    ! w(a, b) is mode (a, b) mod N (lower bounds 0 or 1 alike: position counts).
+    subroutine lpi_sine_euler_set_modes(sys, w, status)
+        type(c_ptr), intent(in) :: sys
+        complex(c_double_complex), intent(in) :: w(:, :)
+        integer, intent(out), optional :: status
+        real(c_double), allocatable :: buf(:)
+        integer :: a, b, n1, n2, q
+        n1 = size(w, 1)
+        n2 = size(w, 2)
+        allocate (buf(2 * n1 * n2))
+        do a = 1, n1
+            do b = 1, n2
+                q = 2 * ((a - 1) * n2 + (b - 1))
+                buf(q + 1) = real(w(a, b), c_double)
+                buf(q + 2) = aimag(w(a, b))
+            end do
+        end do
+        call finish(c_lpi_sine_euler_set_modes(sys, buf, size(buf, kind=c_size_t)), sys, status)
+    end subroutine
+
+    subroutine lpi_sine_euler_get_modes(sys, w, status)
+        type(c_ptr), intent(in) :: sys
+        complex(c_double_complex), intent(inout) :: w(:, :)
+        integer, intent(out), optional :: status
+        real(c_double), allocatable :: buf(:)
+        integer(c_int) :: st
+        integer :: a, b, n1, n2, q
+        n1 = size(w, 1)
+        n2 = size(w, 2)
+        allocate (buf(2 * n1 * n2))
+        st = c_lpi_sine_euler_get_modes(sys, buf, size(buf, kind=c_size_t))
+        if (st == LPI_OK) then
+            do a = 1, n1
+                do b = 1, n2
+                    q = 2 * ((a - 1) * n2 + (b - 1))
+                    w(a, b) = cmplx(buf(q + 1), buf(q + 2), c_double_complex)
+                end do
+            end do
+        end if
+        call finish(st, sys, status)
+    end subroutine
+
+    ! w(a, b) is the vorticity at (2 pi a / N, 2 pi b / N).
+    subroutine lpi_sine_euler_set_grid(sys, w, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(in) :: w(:, :)
+        integer, intent(out), optional :: status
+        real(c_double), allocatable :: t(:, :)
+        allocate (t(size(w, 2), size(w, 1)))
+        t = transpose(w)
+        call finish(c_lpi_sine_euler_set_grid(sys, t, size(t, kind=c_size_t)), sys, status)
+    end subroutine
+
+    subroutine lpi_sine_euler_get_grid(sys, w, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(inout) :: w(:, :)
+        integer, intent(out), optional :: status
+        real(c_double), allocatable :: t(:, :)
+        integer(c_int) :: st
+        allocate (t(size(w, 2), size(w, 1)))
+        st = c_lpi_sine_euler_get_grid(sys, t, size(t, kind=c_size_t))
+        if (st == LPI_OK) w = transpose(t)
+        call finish(st, sys, status)
+    end subroutine
+
+    subroutine lpi_sine_euler_enstrophy(sys, e, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(out) :: e
+        integer, intent(out), optional :: status
+        call finish(c_lpi_sine_euler_enstrophy(sys, e), sys, status)
+    end subroutine
+
+    ! traces(k) = (1/N) tr W^k for k = 1 .. size(traces).
+    subroutine lpi_sine_euler_casimir_traces(sys, traces, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(inout) :: traces(:)
+        integer, intent(out), optional :: status
+        call finish(c_lpi_sine_euler_casimir_traces(sys, size(traces, kind=c_int32_t), traces), &
+                    sys, status)
+    end subroutine
+
+    subroutine lpi_sine_euler_fft_floor(sys, nsteps, seconds_per_step, transforms_per_step, status)
+        type(c_ptr), intent(in) :: sys
+        integer, intent(in) :: nsteps
+        real(c_double), intent(out) :: seconds_per_step, transforms_per_step
+        integer, intent(out), optional :: status
+        call finish(c_lpi_sine_euler_fft_floor(sys, int(nsteps, c_int64_t), seconds_per_step, &
+                                               transforms_per_step), sys, status)
+    end subroutine
+
+    subroutine lpi_set_threads(sys, n, status)
+        type(c_ptr), intent(in) :: sys
+        integer, intent(in) :: n
+        integer, intent(out), optional :: status
+        call finish(c_lpi_set_threads(sys, int(n, c_int32_t)), sys, status)
+    end subroutine
+
+    subroutine lpi_fftw_wisdom_import_file(path, status)
+        character(len=*), intent(in) :: path
+        integer, intent(out), optional :: status
+        call finish(c_lpi_fftw_wisdom_import_file(c_string(path)), c_null_ptr, status)
+    end subroutine
+
+    subroutine lpi_fftw_wisdom_export_file(path, status)
+        character(len=*), intent(in) :: path
+        integer, intent(out), optional :: status
+        call finish(c_lpi_fftw_wisdom_export_file(c_string(path)), c_null_ptr, status)
+    end subroutine
+
+    subroutine lpi_fftw_wisdom_import_string(wisdom, status)
+        character(len=*), intent(in) :: wisdom
+        integer, intent(out), optional :: status
+        call finish(c_lpi_fftw_wisdom_import_string(c_string(wisdom)), c_null_ptr, status)
+    end subroutine
+
+    ! The process's FFTW wisdom as one string.
+    subroutine lpi_fftw_wisdom_export_string(wisdom, status)
+        character(len=:), allocatable, intent(out) :: wisdom
+        integer, intent(out), optional :: status
+        character(kind=c_char), allocatable, target :: buf(:)
+        integer(c_size_t) :: length
+        integer(c_int) :: st
+        integer :: q
+        wisdom = ""
+        length = 0
+        st = c_lpi_fftw_wisdom_export_string(c_null_ptr, 0_c_size_t, length)
+        if (st == LPI_ERR_SIZE) then
+            allocate (buf(length + 1))
+            st = c_lpi_fftw_wisdom_export_string(c_loc(buf), size(buf, kind=c_size_t), length)
+            if (st == LPI_OK) then
+                deallocate (wisdom)
+                allocate (character(len=int(length)) :: wisdom)
+                do q = 1, int(length)
+                    wisdom(q:q) = buf(q)
+                end do
+            end if
+        end if
+        call finish(st, c_null_ptr, status)
+    end subroutine
+
+end module liepoisson

@@ -1,0 +1,264 @@
+! Test of the Fortran binding: statuses, the rigid body's Casimir, errors with
+! state unchanged, Fortran callbacks against the built-in model, and sine-Euler
+! (modes, grid orientation, Casimirs) when the library has FFTW.
+module test_callbacks
+    use, intrinsic :: iso_c_binding
+    implicit none
+    real(c_double), parameter :: inertia(3) = [1.0_c_double, 2.0_c_double, 3.0_c_double]
+contains
+    integer(c_int) function axis_grad(n, x, g, user) bind(C)
+        integer(c_size_t), value :: n
+        real(c_double), intent(in) :: x(n)
+        real(c_double), intent(out) :: g(n)
+        type(c_ptr), value :: user
+        real(c_double), pointer :: inv
+        call c_f_pointer(user, inv)
+        g(1) = x(1) * inv
+        axis_grad = 0
+    end function
+    integer(c_int) function axis_energy(n, x, h, user) bind(C)
+        integer(c_size_t), value :: n
+        real(c_double), intent(in) :: x(n)
+        real(c_double), intent(out) :: h
+        type(c_ptr), value :: user
+        real(c_double), pointer :: inv
+        call c_f_pointer(user, inv)
+        h = 0.5_c_double * x(1)**2 * inv
+        axis_energy = 0
+    end function
+    integer(c_int) function squared_norm(dim, x, out, user) bind(C)
+        integer(c_size_t), value :: dim
+        real(c_double), intent(in) :: x(dim)
+        real(c_double), intent(out) :: out
+        type(c_ptr), value :: user
+        out = sum(x**2)
+        squared_norm = 0
+        if (c_associated(user)) squared_norm = 1  ! a failing callback when given any user pointer
+    end function
+end module
+
+program test_liepoisson
+    use, intrinsic :: iso_c_binding
+    use liepoisson
+    use test_callbacks
+    implicit none
+    integer :: failures = 0
+
+    call test_statuses()
+    call test_rigid_body()
+    call test_errors()
+    call test_generic()
+    call test_sine_euler()
+    if (failures > 0) then
+        print '(i0, a)', failures, " check(s) failed"
+        stop 1
+    end if
+    print '(a)', "fortran binding: all checks passed"
+
+contains
+
+    subroutine check(ok, what)
+        logical, intent(in) :: ok
+        character(len=*), intent(in) :: what
+        if (.not. ok) then
+            failures = failures + 1
+            print '(a, a)', "FAILED: ", what
+        end if
+    end subroutine
+
+    subroutine test_statuses()
+        integer :: i
+        logical :: found
+        call check(len(lpi_version_string()) >= 5, "version string")
+        call check(lpi_status_name(LPI_OK) == "LPI_OK", "LPI_OK")
+        call check(lpi_status_name(LPI_ERR_SIZE) == "LPI_ERR_SIZE", "LPI_ERR_SIZE")
+        call check(lpi_status_name(LPI_ERR_CALLBACK) == "LPI_ERR_CALLBACK", "LPI_ERR_CALLBACK")
+        call check(lpi_status_name(LPI_ERR_NO_CONVERGENCE) == "LPI_ERR_NO_CONVERGENCE", &
+                   "LPI_ERR_NO_CONVERGENCE")
+        call check(lpi_status_name(LPI_ERR_NO_CONVERGENCE - 100) == "LPI_UNKNOWN_STATUS", "unknown")
+        call check(len(lpi_status_message(LPI_ERR_NULL)) > 0, "status message")
+        found = .false.
+        do i = 0, lpi_method_count() - 1
+            if (lpi_method_name(i) == "leapfrog") then
+                found = .true.
+                call check(lpi_method_order(i) == 2, "leapfrog order")
+                call check(lpi_method_is_poisson(i) == 1, "leapfrog is Poisson")
+                call check(lpi_method_stages(i) == 1, "leapfrog stages")
+                call check(len(lpi_method_reference(i)) > 0, "leapfrog reference")
+            end if
+        end do
+        call check(found, "leapfrog listed")
+        call check(lpi_method_name(lpi_method_count()) == "", "method out of range")
+    end subroutine
+
+    subroutine test_rigid_body()
+        type(c_ptr) :: sys
+        real(c_double) :: m(3), c0(1), c1(1), exact(3), h
+        integer :: flows
+        call lpi_rigid_body_create(sys, 1.0_c_double, 2.0_c_double, 3.0_c_double)
+        call check(lpi_dim(sys) == 3, "rigid body dim")
+        call check(lpi_casimir_count(sys) == 1, "rigid body casimir count")
+        call lpi_set_method(sys, "triple-jump-4")
+        call lpi_set_state(sys, [1.0_c_double, 0.5_c_double, -0.3_c_double])
+        call lpi_casimirs(sys, c0)
+        call lpi_rigid_body_exact(sys, 100.0_c_double, exact)
+        call lpi_step(sys, 0.01_c_double, 10000)
+        call lpi_step(sys, 0.0_c_double + 0.01_c_double, 0_c_int64_t)
+        call lpi_casimirs(sys, c1)
+        call lpi_get_state(sys, m)
+        call lpi_energy(sys, h)
+        print '(a, es10.3, a, es10.3)', "rigid body, triple-jump-4, 1e4 steps: |m|^2 drift ", &
+            abs(c1(1) - c0(1)) / c0(1), ", error vs exact ", maxval(abs(m - exact))
+        call check(abs(c1(1) - c0(1)) < 1e-13_c_double * c0(1), "Casimir kept to round-off")
+        call check(maxval(abs(m - exact)) < 1e-6_c_double, "agrees with the exact solution")
+        call check(abs(lpi_time(sys) - 100.0_c_double) < 1e-9_c_double, "time")
+        call lpi_set_composition(sys, [0.5_c_double, 0.5_c_double])
+        call lpi_flows_per_step(sys, flows)
+        call check(flows > 0, "flows per step")
+        call lpi_destroy(sys)
+        call check(.not. c_associated(sys), "destroy nulls the handle")
+        call lpi_destroy(sys)  ! no-op
+    end subroutine
+
+    subroutine test_errors()
+        type(c_ptr) :: sys
+        real(c_double) :: before(3), after(3)
+        integer :: status
+        character(len=:), allocatable :: msg
+        call lpi_rigid_body_create(sys, -1.0_c_double, 1.0_c_double, 1.0_c_double, status)
+        call check(status == LPI_ERR_INVALID, "negative inertia refused")
+        call check(.not. c_associated(sys), "no handle after a failed create")
+        call check(index(lpi_last_error(c_null_ptr), "lpi_rigid_body_create") > 0, "thread message")
+
+        call lpi_pendulum_create(sys)
+        call lpi_set_state(sys, [0.6_c_double, -0.8_c_double, 1.2_c_double])
+        call lpi_step(sys, 0.1_c_double, 10)
+        call lpi_get_state(sys, before)
+        call lpi_set_state(sys, [1.0_c_double, 2.0_c_double], status)
+        call check(status == LPI_ERR_SIZE, "wrong length: LPI_ERR_SIZE")
+        msg = lpi_last_error(sys)
+        call check(index(msg, "lpi_set_state") > 0, "message names lpi_set_state: "//msg)
+        call lpi_step(sys, ieee_nan(), 1, status)
+        call check(status == LPI_ERR_NONFINITE, "NaN dt: LPI_ERR_NONFINITE")
+        call lpi_set_method(sys, "no-such-method   ", status)
+        call check(status == LPI_ERR_INVALID, "unknown method")
+        call check(index(lpi_last_error(sys), "no-such-method'") > 0, "trailing blanks trimmed")
+        call lpi_set_threads(sys, 2, status)
+        call check(status == LPI_ERR_UNSUPPORTED, "threads on the pendulum")
+        call lpi_get_state(sys, after)
+        call check(all(before == after), "state unchanged after failed calls")
+        call lpi_set_method(sys, "leapfrog   ")
+        call lpi_set_split(sys, "standard-map")
+        call lpi_set_implicit_options(sys, 1e-12_c_double, 50)
+        call lpi_destroy(sys)
+    end subroutine
+
+    function ieee_nan() result(x)
+        use, intrinsic :: ieee_arithmetic
+        real(c_double) :: x
+        x = ieee_value(x, ieee_quiet_nan)
+    end function
+
+    subroutine test_generic()
+        type(c_ptr) :: gen, ref
+        real(c_double), target, save :: inverse(3)
+        real(c_double) :: xg(3), xr(3), c(1), c2(2), worst
+        integer(c_int32_t) :: k
+        integer :: rank, q, status
+        integer, target :: anything
+        inverse = 1.0_c_double / inertia
+        call lpi_generic_create(gen, 3, [0, 0, 1], [1, 2, 2], [2, 1, 0], &
+                                [-1.0_c_double, 1.0_c_double, -1.0_c_double])
+        do k = 0, 2
+            call lpi_add_piece(gen, [k], axis_grad, axis_energy, c_loc(inverse(k + 1)))
+        end do
+        call lpi_add_casimir(gen, squared_norm)
+        call lpi_poisson_rank(gen, [1.0_c_double, 0.5_c_double, -0.3_c_double], rank)
+        call check(rank == 2, "so(3) Poisson rank 2")
+        call lpi_rigid_body_create(ref, inertia(1), inertia(2), inertia(3))
+        call lpi_set_split(ref, "axes")
+        call lpi_set_state(gen, [1.0_c_double, 0.5_c_double, -0.3_c_double])
+        call lpi_set_state(ref, [1.0_c_double, 0.5_c_double, -0.3_c_double])
+        worst = 0
+        do q = 1, 10
+            call lpi_step(gen, 0.05_c_double, 100)
+            call lpi_step(ref, 0.05_c_double, 100)
+            call lpi_get_state(gen, xg)
+            call lpi_get_state(ref, xr)
+            worst = max(worst, maxval(abs(xg - xr)))
+        end do
+        print '(a, es10.3)', "generic so(3) with Fortran callbacks vs built-in, 1000 steps: ", worst
+        call check(worst < 5e-13_c_double, "generic matches built-in")
+        call lpi_casimirs(gen, c)
+        call check(abs(c(1) - 1.34_c_double) < 1e-13_c_double, "user Casimir")
+        ! A callback reporting failure: LPI_ERR_CALLBACK.
+        call lpi_add_casimir(gen, squared_norm, c_loc(anything))
+        call lpi_casimirs(gen, c2, status)
+        call check(status == LPI_ERR_CALLBACK, "failing callback: LPI_ERR_CALLBACK")
+        call lpi_generic_create(gen, 3, [0, 0], [1, 2], [2], [1.0_c_double], status)
+        call check(status == LPI_ERR_SIZE, "bracket arrays of different lengths")
+        call lpi_destroy(ref)
+        call lpi_moments_create(ref)
+        call check(lpi_casimir_count(ref) == 2, "moments: two Casimirs")
+        call lpi_destroy(ref)
+    end subroutine
+
+    subroutine test_sine_euler()
+        integer, parameter :: n = 7
+        real(c_double), parameter :: pi = 3.14159265358979323846_c_double
+        type(c_ptr) :: sys
+        complex(c_double_complex) :: w(0:n - 1, 0:n - 1), back(0:n - 1, 0:n - 1), s
+        real(c_double) :: grid(0:n - 1, 0:n - 1), grid2(0:n - 1, 0:n - 1), t0(4), t1(4), e
+        integer :: status, a, b, m1, m2, size_n
+        character(len=:), allocatable :: wisdom
+        call lpi_sine_euler_create(sys, n, status)
+        if (status == LPI_ERR_UNSUPPORTED) then
+            print '(a)', "sine-Euler: library built without FFTW, skipped"
+            return
+        end if
+        call check(status == LPI_OK, "sine-Euler create")
+        call lpi_sine_euler_size(sys, size_n)
+        call check(size_n == n, "sine-Euler size")
+        call random_seed()
+        call random_number(grid)
+        grid = grid - 0.5_c_double
+        call lpi_sine_euler_set_grid(sys, grid)
+        call lpi_sine_euler_get_modes(sys, w)
+        do a = 0, n - 1
+            do b = 0, n - 1
+                call check(abs(w(a, b) - conjg(w(modulo(-a, n), modulo(-b, n)))) < 1e-14_c_double, &
+                           "modes Hermitian")
+            end do
+        end do
+        ! Orientation: grid(a, b) = sum_m w(m1, m2) exp(i (m1 x_a + m2 y_b)).
+        s = 0
+        do m1 = 0, n - 1
+            do m2 = 0, n - 1
+                s = s + w(m1, m2) * exp(cmplx(0, 2 * pi * (m1 * 1 + m2 * 3) / n, c_double_complex))
+            end do
+        end do
+        call check(abs(s - grid(1, 3)) < 1e-12_c_double, "grid(a, b) is at (2 pi a/N, 2 pi b/N)")
+        call lpi_sine_euler_set_modes(sys, w)
+        call lpi_sine_euler_get_modes(sys, back)
+        call check(all(back == w), "modes round trip")
+        call lpi_sine_euler_get_grid(sys, grid2)
+        call check(maxval(abs(grid2 - grid)) < 1e-13_c_double, "grid round trip")
+        call lpi_sine_euler_casimir_traces(sys, t0)
+        call lpi_sine_euler_enstrophy(sys, e)
+        call lpi_step(sys, 0.01_c_double, 50)
+        call lpi_sine_euler_casimir_traces(sys, t1)
+        print '(a, es10.3)', "sine-Euler N = 7, 50 leapfrog steps: max tr W^k drift ", maxval(abs(t1 - t0))
+        call check(maxval(abs(t1 - t0)) < 1e-12_c_double * max(1.0_c_double, maxval(abs(t0))), &
+                   "sine-Euler Casimirs kept")
+        back(1, 2) = back(1, 2) + (0.0_c_double, 0.5_c_double)
+        call lpi_sine_euler_set_modes(sys, back, status)
+        call check(status == LPI_ERR_INVALID, "non-Hermitian modes refused")
+        call lpi_fftw_wisdom_export_string(wisdom)
+        call check(index(wisdom, "fftw") > 0, "wisdom exported")
+        call lpi_fftw_wisdom_import_string(wisdom)
+        call lpi_fftw_wisdom_import_string("not wisdom", status)
+        call check(status == LPI_ERR_INVALID, "bad wisdom refused")
+        call lpi_destroy(sys)
+    end subroutine
+
+end program

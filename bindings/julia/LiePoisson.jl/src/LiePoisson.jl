@@ -1,0 +1,387 @@
+"""
+    LiePoisson
+
+Julia binding of libliepoisson: explicit, Casimir-preserving integration of
+Lie-Poisson systems. Two layers:
+
+* `LiePoisson.C`: one `ccall` wrapper per public C function, same name and
+  arguments as in `liepoisson.h` (returns the C result, e.g. a status).
+* the high-level API: `RigidBody`, `Pendulum`, `Generic`, `Moments`,
+  `SineEuler`, `step!`, `state`, `set_state!`, `energy`, `casimirs`, ...
+  Failures throw `LiePoissonError` (status, status name, message).
+
+The library is opened when the module is loaded: the path in the environment
+variable `LIEPOISSON_LIBRARY`, else `libliepoisson.so.0` from the system's
+library path.
+"""
+module LiePoisson
+
+using Libdl
+
+const _lib = Ref{Ptr{Cvoid}}(C_NULL)
+
+function __init__()
+    path = get(ENV, "LIEPOISSON_LIBRARY", "")
+    _lib[] = Libdl.dlopen(isempty(path) ? "libliepoisson.so.0" : path)
+end
+
+_sym(name::Symbol) = Libdl.dlsym(_lib[], name)
+
+# ---- the C functions, one wrapper each ----------------------------------------
+module C
+import ..LiePoisson: _sym
+const Sys = Ptr{Cvoid}   # lpi_system *
+
+# version, status codes, methods
+lpi_version_string() = ccall(_sym(:lpi_version_string), Cstring, ())
+lpi_status_name(status) = ccall(_sym(:lpi_status_name), Cstring, (Cint,), status)
+lpi_status_message(status) = ccall(_sym(:lpi_status_message), Cstring, (Cint,), status)
+lpi_method_count() = ccall(_sym(:lpi_method_count), Cint, ())
+lpi_method_name(i) = ccall(_sym(:lpi_method_name), Ptr{Cchar}, (Cint,), i)
+lpi_method_order(i) = ccall(_sym(:lpi_method_order), Cint, (Cint,), i)
+lpi_method_is_poisson(i) = ccall(_sym(:lpi_method_is_poisson), Cint, (Cint,), i)
+lpi_method_stages(i) = ccall(_sym(:lpi_method_stages), Cint, (Cint,), i)
+lpi_method_reference(i) = ccall(_sym(:lpi_method_reference), Ptr{Cchar}, (Cint,), i)
+# systems
+lpi_rigid_body_create(out, I1, I2, I3) =
+    ccall(_sym(:lpi_rigid_body_create), Cint, (Ptr{Sys}, Cdouble, Cdouble, Cdouble), out, I1, I2, I3)
+lpi_rigid_body_exact(sys, t, out) =
+    ccall(_sym(:lpi_rigid_body_exact), Cint, (Sys, Cdouble, Ptr{Cdouble}), sys, t, out)
+lpi_pendulum_create(out) = ccall(_sym(:lpi_pendulum_create), Cint, (Ptr{Sys},), out)
+lpi_destroy(sys) = ccall(_sym(:lpi_destroy), Cvoid, (Sys,), sys)
+lpi_set_method(sys, name) = ccall(_sym(:lpi_set_method), Cint, (Sys, Cstring), sys, name)
+lpi_set_split(sys, name) = ccall(_sym(:lpi_set_split), Cint, (Sys, Cstring), sys, name)
+lpi_dim(sys) = ccall(_sym(:lpi_dim), Csize_t, (Sys,), sys)
+lpi_set_state(sys, x, n) = ccall(_sym(:lpi_set_state), Cint, (Sys, Ptr{Cdouble}, Csize_t), sys, x, n)
+lpi_get_state(sys, x, n) = ccall(_sym(:lpi_get_state), Cint, (Sys, Ptr{Cdouble}, Csize_t), sys, x, n)
+lpi_step(sys, dt, nsteps) = ccall(_sym(:lpi_step), Cint, (Sys, Cdouble, Int64), sys, dt, nsteps)
+lpi_time(sys) = ccall(_sym(:lpi_time), Cdouble, (Sys,), sys)
+lpi_energy(sys, out) = ccall(_sym(:lpi_energy), Cint, (Sys, Ptr{Cdouble}), sys, out)
+lpi_casimir_count(sys) = ccall(_sym(:lpi_casimir_count), Csize_t, (Sys,), sys)
+lpi_casimirs(sys, out, n) = ccall(_sym(:lpi_casimirs), Cint, (Sys, Ptr{Cdouble}, Csize_t), sys, out, n)
+lpi_last_error(sys) = ccall(_sym(:lpi_last_error), Cstring, (Sys,), sys)
+# composition methods, implicit baselines
+lpi_set_composition(sys, n, gammas) =
+    ccall(_sym(:lpi_set_composition), Cint, (Sys, Csize_t, Ptr{Cdouble}), sys, n, gammas)
+lpi_flows_per_step(sys, out) = ccall(_sym(:lpi_flows_per_step), Cint, (Sys, Ptr{Csize_t}), sys, out)
+lpi_set_implicit_options(sys, tolerance, max_iterations) =
+    ccall(_sym(:lpi_set_implicit_options), Cint, (Sys, Cdouble, Int32), sys, tolerance, max_iterations)
+# generic systems and the moment algebra
+lpi_generic_create(out, dim, nnz, i, j, k, c) =
+    ccall(_sym(:lpi_generic_create), Cint,
+          (Ptr{Sys}, Csize_t, Csize_t, Ptr{Int32}, Ptr{Int32}, Ptr{Int32}, Ptr{Cdouble}),
+          out, dim, nnz, i, j, k, c)
+lpi_add_piece(sys, n, indices, grad, energy, user) =
+    ccall(_sym(:lpi_add_piece), Cint, (Sys, Csize_t, Ptr{Int32}, Ptr{Cvoid}, Ptr{Cvoid}, Ptr{Cvoid}),
+          sys, n, indices, grad, energy, user)
+lpi_add_casimir(sys, fn, user) =
+    ccall(_sym(:lpi_add_casimir), Cint, (Sys, Ptr{Cvoid}, Ptr{Cvoid}), sys, fn, user)
+lpi_poisson_rank(sys, x, n, rank) =
+    ccall(_sym(:lpi_poisson_rank), Cint, (Sys, Ptr{Cdouble}, Csize_t, Ptr{Csize_t}), sys, x, n, rank)
+lpi_moments_create(out) = ccall(_sym(:lpi_moments_create), Cint, (Ptr{Sys},), out)
+lpi_moments_add_product_piece(sys, h, dh, user) =
+    ccall(_sym(:lpi_moments_add_product_piece), Cint, (Sys, Ptr{Cvoid}, Ptr{Cvoid}, Ptr{Cvoid}),
+          sys, h, dh, user)
+# sine-Euler, threads, FFTW wisdom
+lpi_sine_euler_create(out, N) = ccall(_sym(:lpi_sine_euler_create), Cint, (Ptr{Sys}, Int32), out, N)
+lpi_sine_euler_size(sys, N) = ccall(_sym(:lpi_sine_euler_size), Cint, (Sys, Ptr{Int32}), sys, N)
+lpi_sine_euler_set_modes(sys, re_im, n) =
+    ccall(_sym(:lpi_sine_euler_set_modes), Cint, (Sys, Ptr{Cdouble}, Csize_t), sys, re_im, n)
+lpi_sine_euler_get_modes(sys, re_im, n) =
+    ccall(_sym(:lpi_sine_euler_get_modes), Cint, (Sys, Ptr{Cdouble}, Csize_t), sys, re_im, n)
+lpi_sine_euler_set_grid(sys, w, n) =
+    ccall(_sym(:lpi_sine_euler_set_grid), Cint, (Sys, Ptr{Cdouble}, Csize_t), sys, w, n)
+lpi_sine_euler_get_grid(sys, w, n) =
+    ccall(_sym(:lpi_sine_euler_get_grid), Cint, (Sys, Ptr{Cdouble}, Csize_t), sys, w, n)
+lpi_sine_euler_enstrophy(sys, out) =
+    ccall(_sym(:lpi_sine_euler_enstrophy), Cint, (Sys, Ptr{Cdouble}), sys, out)
+lpi_sine_euler_casimir_traces(sys, kmax, out) =
+    ccall(_sym(:lpi_sine_euler_casimir_traces), Cint, (Sys, Int32, Ptr{Cdouble}), sys, kmax, out)
+lpi_sine_euler_fft_floor(sys, nsteps, seconds, transforms) =
+    ccall(_sym(:lpi_sine_euler_fft_floor), Cint, (Sys, Int64, Ptr{Cdouble}, Ptr{Cdouble}),
+          sys, nsteps, seconds, transforms)
+lpi_set_threads(sys, n) = ccall(_sym(:lpi_set_threads), Cint, (Sys, Int32), sys, n)
+lpi_fftw_wisdom_import_file(path) = ccall(_sym(:lpi_fftw_wisdom_import_file), Cint, (Cstring,), path)
+lpi_fftw_wisdom_export_file(path) = ccall(_sym(:lpi_fftw_wisdom_export_file), Cint, (Cstring,), path)
+lpi_fftw_wisdom_import_string(w) = ccall(_sym(:lpi_fftw_wisdom_import_string), Cint, (Cstring,), w)
+lpi_fftw_wisdom_export_string(buf, size, length) =
+    ccall(_sym(:lpi_fftw_wisdom_export_string), Cint, (Ptr{UInt8}, Csize_t, Ptr{Csize_t}),
+          buf, size, length)
+end # module C
+
+# ---- errors --------------------------------------------------------------------
+
+"""A failed call: `status` (negative code), `name` ("LPI_ERR_SIZE"), `message`."""
+struct LiePoissonError <: Exception
+    status::Int
+    name::String
+    message::String
+end
+Base.showerror(io::IO, e::LiePoissonError) = print(io, e.name, ": ", e.message)
+
+status_name(status::Integer) = unsafe_string(C.lpi_status_name(status))
+status_message(status::Integer) = unsafe_string(C.lpi_status_message(status))
+version() = VersionNumber(unsafe_string(C.lpi_version_string()))
+
+function _check(status, handle::Ptr{Cvoid} = C_NULL, cause = nothing)
+    status == 0 && return nothing
+    message = unsafe_string(C.lpi_last_error(handle))
+    # Julia has no exception chaining: a callback's exception joins the message.
+    cause === nothing || (message *= " (callback threw: " * sprint(showerror, cause) * ")")
+    throw(LiePoissonError(status, status_name(status), message))
+end
+
+_cstring_or_empty(p::Ptr{Cchar}) = p == C_NULL ? "" : unsafe_string(p)
+
+"""All registered methods as named tuples (name, order, stages, reference, is_poisson)."""
+function methods()
+    [(name = _cstring_or_empty(C.lpi_method_name(i)), order = Int(C.lpi_method_order(i)),
+      stages = Int(C.lpi_method_stages(i)), reference = _cstring_or_empty(C.lpi_method_reference(i)),
+      is_poisson = C.lpi_method_is_poisson(i) == 1) for i in 0:C.lpi_method_count()-1]
+end
+
+# ---- systems --------------------------------------------------------------------
+
+# Callbacks: one C trampoline per signature; `user` points at a _Callback that
+# holds the Julia function and records an exception instead of unwinding into C.
+mutable struct _Callback
+    f::Any
+    owner::Any         # the System's pending-exception list
+end
+
+"""A handle to an integrated system; released by `close` or the finaliser."""
+mutable struct System
+    handle::Ptr{Cvoid}
+    callbacks::Vector{_Callback}
+    pending::Vector{Any}
+    function System(create::Function)
+        out = Ref{Ptr{Cvoid}}(C_NULL)
+        _check(create(out))
+        sys = new(out[], _Callback[], Any[])
+        finalizer(close, sys)
+    end
+end
+
+function Base.close(sys::System)
+    if sys.handle != C_NULL
+        C.lpi_destroy(sys.handle)
+        sys.handle = C_NULL
+    end
+    nothing
+end
+
+function _h(sys::System)
+    sys.handle == C_NULL && throw(ArgumentError("operation on a closed liepoisson system"))
+    sys.handle
+end
+
+# Calls f(handle) and throws on failure (with a callback's exception attached).
+function _call(f, sys::System)
+    empty!(sys.pending)
+    status = GC.@preserve sys f(_h(sys))
+    if status != 0
+        cause = isempty(sys.pending) ? nothing : sys.pending[1]
+        empty!(sys.pending)
+        _check(status, sys.handle, cause)
+    end
+    nothing
+end
+
+RigidBody(I1, I2, I3) = System(out -> C.lpi_rigid_body_create(out, I1, I2, I3))
+Pendulum() = System(out -> C.lpi_pendulum_create(out))
+Moments() = System(out -> C.lpi_moments_create(out))
+SineEuler(N::Integer) = System(out -> C.lpi_sine_euler_create(out, N))
+
+"""Generic(dim, brackets): {x_i, x_j} = sum c x_k over (i, j, k, c), 0-based."""
+function Generic(dim::Integer, brackets = Tuple{Int,Int,Int,Float64}[])
+    i = Int32[b[1] for b in brackets]; j = Int32[b[2] for b in brackets]
+    k = Int32[b[3] for b in brackets]; c = Float64[b[4] for b in brackets]
+    System(out -> C.lpi_generic_create(out, dim, length(c), i, j, k, c))
+end
+
+set_method!(sys::System, name::AbstractString) = _call(h -> C.lpi_set_method(h, name), sys)
+set_split!(sys::System, name::AbstractString) = _call(h -> C.lpi_set_split(h, name), sys)
+set_composition!(sys::System, gammas::AbstractVector{<:Real}) =
+    (g = Vector{Float64}(gammas); _call(h -> C.lpi_set_composition(h, length(g), g), sys))
+function flows_per_step(sys::System)
+    out = Ref{Csize_t}(0); _call(h -> C.lpi_flows_per_step(h, out), sys); Int(out[])
+end
+set_implicit_options!(sys::System; tolerance = 1e-13, max_iterations = 100) =
+    _call(h -> C.lpi_set_implicit_options(h, tolerance, max_iterations), sys)
+set_threads!(sys::System, n::Integer) = _call(h -> C.lpi_set_threads(h, n), sys)
+
+dim(sys::System) = Int(C.lpi_dim(_h(sys)))
+function state(sys::System)
+    x = Vector{Float64}(undef, dim(sys)); _call(h -> C.lpi_get_state(h, x, length(x)), sys); x
+end
+function set_state!(sys::System, x::AbstractVector{<:Real})
+    v = Vector{Float64}(x)  # no copy when x already is a Vector{Float64}
+    _call(h -> C.lpi_set_state(h, v, length(v)), sys)
+end
+step!(sys::System, dt::Real, nsteps::Integer = 1) = _call(h -> C.lpi_step(h, dt, nsteps), sys)
+Base.time(sys::System) = C.lpi_time(_h(sys))
+energy(sys::System) = (out = Ref{Float64}(0.0); _call(h -> C.lpi_energy(h, out), sys); out[])
+casimir_count(sys::System) = Int(C.lpi_casimir_count(_h(sys)))
+function casimirs(sys::System)
+    out = Vector{Float64}(undef, casimir_count(sys))
+    _call(h -> C.lpi_casimirs(h, out, length(out)), sys); out
+end
+last_error(sys::System) = unsafe_string(C.lpi_last_error(_h(sys)))
+function exact(sys::System, t::Real)
+    out = Vector{Float64}(undef, 3); _call(h -> C.lpi_rigid_body_exact(h, t, out), sys); out
+end
+function poisson_rank(sys::System, x::AbstractVector{<:Real} = state(sys))
+    v = Vector{Float64}(x); out = Ref{Csize_t}(0)
+    _call(h -> C.lpi_poisson_rank(h, v, length(v), out), sys); Int(out[])
+end
+
+function _vector_trampoline(n::Csize_t, x::Ptr{Cdouble}, out::Ptr{Cdouble}, user::Ptr{Cvoid})::Cint
+    cb = unsafe_pointer_to_objref(user)::_Callback
+    try
+        g = cb.f(copy(unsafe_wrap(Array, x, n)))
+        length(g) == n || error("gradient returned $(length(g)) values for $n indices")
+        for q in 1:n
+            unsafe_store!(out, Float64(g[q]), q)
+        end
+        return Cint(0)
+    catch e
+        isempty(cb.owner) && push!(cb.owner, e)
+        return Cint(1)
+    end
+end
+function _scalar_of_vector_trampoline(n::Csize_t, x::Ptr{Cdouble}, out::Ptr{Cdouble},
+                                      user::Ptr{Cvoid})::Cint
+    cb = unsafe_pointer_to_objref(user)::_Callback
+    try
+        unsafe_store!(out, Float64(cb.f(copy(unsafe_wrap(Array, x, n)))))
+        return Cint(0)
+    catch e
+        isempty(cb.owner) && push!(cb.owner, e)
+        return Cint(1)
+    end
+end
+function _scalar_trampoline(u::Cdouble, out::Ptr{Cdouble}, user::Ptr{Cvoid})::Cint
+    cb = unsafe_pointer_to_objref(user)::_Callback
+    try
+        unsafe_store!(out, Float64(cb.f(u)))
+        return Cint(0)
+    catch e
+        isempty(cb.owner) && push!(cb.owner, e)
+        return Cint(1)
+    end
+end
+
+_vector_ptr() = @cfunction(_vector_trampoline, Cint, (Csize_t, Ptr{Cdouble}, Ptr{Cdouble}, Ptr{Cvoid}))
+_scalar_of_vector_ptr() =
+    @cfunction(_scalar_of_vector_trampoline, Cint, (Csize_t, Ptr{Cdouble}, Ptr{Cdouble}, Ptr{Cvoid}))
+_scalar_ptr() = @cfunction(_scalar_trampoline, Cint, (Cdouble, Ptr{Cdouble}, Ptr{Cvoid}))
+
+function _keep!(sys::System, f)
+    cb = _Callback(f, sys.pending)
+    push!(sys.callbacks, cb)   # alive as long as the system
+    cb
+end
+
+"""add_piece!(sys, indices, gradient, energy): the piece on the 0-based abelian set
+`indices`; gradient(x_sigma) returns n values and energy(x_sigma) a number. The
+gradient and energy share one user pointer each: two pieces of state are kept."""
+function add_piece!(sys::System, indices::AbstractVector{<:Integer}, gradient, energy)
+    idx = Vector{Int32}(indices)
+    g = _keep!(sys, gradient); e = _keep!(sys, energy)
+    # The C function takes one user pointer for both callbacks: a pair dispatches.
+    pair = _keep!(sys, (g, e))
+    _call(h -> C.lpi_add_piece(h, length(idx), idx, _pair_grad_ptr(), _pair_energy_ptr(),
+                               pointer_from_objref(pair)), sys)
+end
+function _pair_grad(n::Csize_t, x::Ptr{Cdouble}, out::Ptr{Cdouble}, user::Ptr{Cvoid})::Cint
+    g, _ = (unsafe_pointer_to_objref(user)::_Callback).f
+    _vector_trampoline(n, x, out, pointer_from_objref(g))
+end
+function _pair_energy(n::Csize_t, x::Ptr{Cdouble}, out::Ptr{Cdouble}, user::Ptr{Cvoid})::Cint
+    _, e = (unsafe_pointer_to_objref(user)::_Callback).f
+    _scalar_of_vector_trampoline(n, x, out, pointer_from_objref(e))
+end
+_pair_grad_ptr() = @cfunction(_pair_grad, Cint, (Csize_t, Ptr{Cdouble}, Ptr{Cdouble}, Ptr{Cvoid}))
+_pair_energy_ptr() = @cfunction(_pair_energy, Cint, (Csize_t, Ptr{Cdouble}, Ptr{Cdouble}, Ptr{Cvoid}))
+
+"""add_casimir!(sys, f): declares the Casimir f(x) of the full state."""
+function add_casimir!(sys::System, f)
+    cb = _keep!(sys, f)
+    _call(h -> C.lpi_add_casimir(h, _scalar_of_vector_ptr(), pointer_from_objref(cb)), sys)
+end
+
+"""add_product_piece!(sys, H, dH): the moment piece H(x1 x3) with H'(u) = dH(u)."""
+function add_product_piece!(sys::System, H, dH)
+    pair = _keep!(sys, (_keep!(sys, H), _keep!(sys, dH)))
+    _call(h -> C.lpi_moments_add_product_piece(h, _pair_h_ptr(), _pair_dh_ptr(),
+                                               pointer_from_objref(pair)), sys)
+end
+function _pair_h(u::Cdouble, out::Ptr{Cdouble}, user::Ptr{Cvoid})::Cint
+    a, _ = (unsafe_pointer_to_objref(user)::_Callback).f
+    _scalar_trampoline(u, out, pointer_from_objref(a))
+end
+function _pair_dh(u::Cdouble, out::Ptr{Cdouble}, user::Ptr{Cvoid})::Cint
+    _, b = (unsafe_pointer_to_objref(user)::_Callback).f
+    _scalar_trampoline(u, out, pointer_from_objref(b))
+end
+_pair_h_ptr() = @cfunction(_pair_h, Cint, (Cdouble, Ptr{Cdouble}, Ptr{Cvoid}))
+_pair_dh_ptr() = @cfunction(_pair_dh, Cint, (Cdouble, Ptr{Cdouble}, Ptr{Cvoid}))
+
+# ---- sine-Euler -----------------------------------------------------------------
+# Julia is column-major: modes(sys)[a+1, b+1] is mode (a, b); the C layout is
+# row-major [a*N + b], so arrays are transposed on the way in and out.
+
+function sine_euler_size(sys::System)
+    out = Ref{Int32}(0); _call(h -> C.lpi_sine_euler_size(h, out), sys); Int(out[])
+end
+function modes(sys::System)
+    N = sine_euler_size(sys)
+    buf = Matrix{ComplexF64}(undef, N, N)   # interleaved re, im in memory
+    _call(h -> C.lpi_sine_euler_get_modes(h, Ptr{Cdouble}(pointer(buf)), 2 * N * N), sys)
+    permutedims(buf)
+end
+function set_modes!(sys::System, w::AbstractMatrix{<:Number})
+    buf = Matrix{ComplexF64}(permutedims(w))
+    _call(h -> C.lpi_sine_euler_set_modes(h, Ptr{Cdouble}(pointer(buf)), 2 * length(buf)), sys)
+end
+function grid(sys::System)
+    N = sine_euler_size(sys)
+    buf = Matrix{Float64}(undef, N, N)
+    _call(h -> C.lpi_sine_euler_get_grid(h, buf, N * N), sys)
+    permutedims(buf)
+end
+function set_grid!(sys::System, w::AbstractMatrix{<:Real})
+    buf = Matrix{Float64}(permutedims(w))
+    _call(h -> C.lpi_sine_euler_set_grid(h, buf, length(buf)), sys)
+end
+enstrophy(sys::System) = (out = Ref{Float64}(0.0); _call(h -> C.lpi_sine_euler_enstrophy(h, out), sys); out[])
+function casimir_traces(sys::System, kmax::Integer)
+    out = Vector{Float64}(undef, max(kmax, 1))
+    _call(h -> C.lpi_sine_euler_casimir_traces(h, kmax, out), sys); out[1:kmax]
+end
+function fft_floor(sys::System, nsteps::Integer)
+    s = Ref{Float64}(0.0); t = Ref{Float64}(0.0)
+    _call(h -> C.lpi_sine_euler_fft_floor(h, nsteps, s, t), sys)
+    (seconds_per_step = s[], transforms_per_step = t[])
+end
+
+# ---- FFTW wisdom (process-wide) ------------------------------------------------------
+fftw_wisdom_import_file(path::AbstractString) = _check(C.lpi_fftw_wisdom_import_file(path))
+fftw_wisdom_export_file(path::AbstractString) = _check(C.lpi_fftw_wisdom_export_file(path))
+fftw_wisdom_import_string(w::AbstractString) = _check(C.lpi_fftw_wisdom_import_string(w))
+function fftw_wisdom_export_string()
+    len = Ref{Csize_t}(0)
+    st = C.lpi_fftw_wisdom_export_string(C_NULL, 0, len)
+    st == -3 || _check(st)   # LPI_ERR_SIZE: the length is known
+    buf = Vector{UInt8}(undef, len[] + 1)
+    _check(C.lpi_fftw_wisdom_export_string(buf, length(buf), len))
+    String(buf[1:len[]])
+end
+
+export LiePoissonError, RigidBody, Pendulum, Generic, Moments, SineEuler, System,
+    set_method!, set_split!, set_composition!, flows_per_step, set_implicit_options!,
+    set_threads!, dim, state, set_state!, step!, energy, casimir_count, casimirs, last_error,
+    exact, poisson_rank, add_piece!, add_casimir!, add_product_piece!, sine_euler_size, modes,
+    set_modes!, grid, set_grid!, enstrophy, casimir_traces, fft_floor
+
+end # module

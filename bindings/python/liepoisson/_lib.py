@@ -1,0 +1,133 @@
+"""Finding libliepoisson and declaring its C functions for ctypes.
+
+The library is searched for in this order:
+  1. the path in the environment variable LIEPOISSON_LIBRARY;
+  2. a build tree beside the sources (bindings/python/../../build);
+  3. the system's library path (ctypes.util.find_library).
+"""
+import ctypes
+import ctypes.util
+import os
+from ctypes import (CFUNCTYPE, POINTER, c_char_p, c_double, c_int, c_int32, c_int64,
+                    c_size_t, c_void_p)
+
+SONAME_MAJOR = 0
+
+c_double_p = POINTER(c_double)
+c_int32_p = POINTER(c_int32)
+c_size_t_p = POINTER(c_size_t)
+c_handle = c_void_p              # lpi_system * (opaque)
+c_handle_p = POINTER(c_void_p)   # lpi_system **
+
+# The callback types of include/liepoisson.h.
+GRADIENT_FN = CFUNCTYPE(c_int, c_size_t, c_double_p, c_double_p, c_void_p)
+ENERGY_FN = CFUNCTYPE(c_int, c_size_t, c_double_p, c_double_p, c_void_p)
+CASIMIR_FN = CFUNCTYPE(c_int, c_size_t, c_double_p, c_double_p, c_void_p)
+SCALAR_FN = CFUNCTYPE(c_int, c_double, c_double_p, c_void_p)
+
+# Every public function of include/liepoisson.h: name -> (restype, argtypes).
+# A function added to the header gets one row here (tests/check_bindings.sh
+# reports any that is missing).
+PROTOTYPES = {
+    # version, status codes, methods
+    "lpi_version_string": (c_char_p, []),
+    "lpi_status_name": (c_char_p, [c_int]),
+    "lpi_status_message": (c_char_p, [c_int]),
+    "lpi_method_count": (c_int, []),
+    "lpi_method_name": (c_char_p, [c_int]),
+    "lpi_method_order": (c_int, [c_int]),
+    "lpi_method_is_poisson": (c_int, [c_int]),
+    "lpi_method_stages": (c_int, [c_int]),
+    "lpi_method_reference": (c_char_p, [c_int]),
+    # systems
+    "lpi_rigid_body_create": (c_int, [c_handle_p, c_double, c_double, c_double]),
+    "lpi_rigid_body_exact": (c_int, [c_handle, c_double, c_double_p]),
+    "lpi_pendulum_create": (c_int, [c_handle_p]),
+    "lpi_destroy": (None, [c_handle]),
+    "lpi_set_method": (c_int, [c_handle, c_char_p]),
+    "lpi_set_split": (c_int, [c_handle, c_char_p]),
+    "lpi_dim": (c_size_t, [c_handle]),
+    "lpi_set_state": (c_int, [c_handle, c_double_p, c_size_t]),
+    "lpi_get_state": (c_int, [c_handle, c_double_p, c_size_t]),
+    "lpi_step": (c_int, [c_handle, c_double, c_int64]),
+    "lpi_time": (c_double, [c_handle]),
+    "lpi_energy": (c_int, [c_handle, c_double_p]),
+    "lpi_casimir_count": (c_size_t, [c_handle]),
+    "lpi_casimirs": (c_int, [c_handle, c_double_p, c_size_t]),
+    "lpi_last_error": (c_char_p, [c_handle]),
+    # composition methods, implicit baselines
+    "lpi_set_composition": (c_int, [c_handle, c_size_t, c_double_p]),
+    "lpi_flows_per_step": (c_int, [c_handle, c_size_t_p]),
+    "lpi_set_implicit_options": (c_int, [c_handle, c_double, c_int32]),
+    # generic systems and the moment algebra
+    "lpi_generic_create": (c_int, [c_handle_p, c_size_t, c_size_t, c_int32_p, c_int32_p,
+                                   c_int32_p, c_double_p]),
+    "lpi_add_piece": (c_int, [c_handle, c_size_t, c_int32_p, GRADIENT_FN, ENERGY_FN, c_void_p]),
+    "lpi_add_casimir": (c_int, [c_handle, CASIMIR_FN, c_void_p]),
+    "lpi_poisson_rank": (c_int, [c_handle, c_double_p, c_size_t, c_size_t_p]),
+    "lpi_moments_create": (c_int, [c_handle_p]),
+    "lpi_moments_add_product_piece": (c_int, [c_handle, SCALAR_FN, SCALAR_FN, c_void_p]),
+    # sine-Euler, threads, FFTW wisdom
+    "lpi_sine_euler_create": (c_int, [c_handle_p, c_int32]),
+    "lpi_sine_euler_size": (c_int, [c_handle, c_int32_p]),
+    "lpi_sine_euler_set_modes": (c_int, [c_handle, c_double_p, c_size_t]),
+    "lpi_sine_euler_get_modes": (c_int, [c_handle, c_double_p, c_size_t]),
+    "lpi_sine_euler_set_grid": (c_int, [c_handle, c_double_p, c_size_t]),
+    "lpi_sine_euler_get_grid": (c_int, [c_handle, c_double_p, c_size_t]),
+    "lpi_sine_euler_enstrophy": (c_int, [c_handle, c_double_p]),
+    "lpi_sine_euler_casimir_traces": (c_int, [c_handle, c_int32, c_double_p]),
+    "lpi_sine_euler_fft_floor": (c_int, [c_handle, c_int64, c_double_p, c_double_p]),
+    "lpi_set_threads": (c_int, [c_handle, c_int32]),
+    "lpi_fftw_wisdom_import_file": (c_int, [c_char_p]),
+    "lpi_fftw_wisdom_export_file": (c_int, [c_char_p]),
+    "lpi_fftw_wisdom_import_string": (c_int, [c_char_p]),
+    "lpi_fftw_wisdom_export_string": (c_int, [c_char_p, c_size_t, c_size_t_p]),
+}
+
+
+def _candidates():
+    env = os.environ.get("LIEPOISSON_LIBRARY")
+    if env:
+        # An explicit choice is final: a wrong path is an error, not a fallback.
+        yield env
+        return
+    here = os.path.dirname(os.path.abspath(__file__))
+    for build in (os.path.join(here, "..", "..", "..", "build"),):
+        yield os.path.normpath(os.path.join(build, "libliepoisson.so.%d" % SONAME_MAJOR))
+    found = ctypes.util.find_library("liepoisson")
+    if found:
+        yield found
+    yield "libliepoisson.so.%d" % SONAME_MAJOR
+
+
+def _load():
+    tried = []
+    env = os.environ.get("LIEPOISSON_LIBRARY")
+    for path in _candidates():
+        if os.sep in path and not os.path.exists(path) and not env:
+            tried.append(path + " (absent)")
+            continue
+        try:
+            return ctypes.CDLL(path)
+        except OSError as e:
+            tried.append("%s (%s)" % (path, e))
+    raise ImportError("liepoisson: cannot load libliepoisson; set LIEPOISSON_LIBRARY to its path. "
+                      "Tried: " + "; ".join(tried))
+
+
+def _declare(lib):
+    missing = []
+    for name, (restype, argtypes) in PROTOTYPES.items():
+        try:
+            fn = getattr(lib, name)
+        except AttributeError:
+            missing.append(name)
+            continue
+        fn.restype = restype
+        fn.argtypes = argtypes
+    return missing
+
+
+lib = _load()
+#: Functions this binding declares that the loaded library lacks (an older library).
+MISSING = _declare(lib)
