@@ -33,23 +33,6 @@ using cplx = std::complex<double>;
 
 int rep(int a, int N) { return a > N / 2 ? a - N : a; }
 
-// Keeps the mode array Hermitian (w_-m = conj(w_m)) after a matrix-form step,
-// where round-off of the transforms breaks it slightly, and restores the
-// inert mode w_0 exactly.
-void symmetrise_modes(int N, const double *w0, double *modes) {
-    cplx *w = reinterpret_cast<cplx *>(modes);
-    for (int a = 0; a < N; ++a)
-        for (int b = 0; b < N; ++b) {
-            const int m = a * N + b, minus = ((N - a) % N) * N + (N - b) % N;
-            if (minus <= m) continue;
-            const cplx mean = 0.5 * (w[m] + std::conj(w[minus]));
-            w[m] = mean;
-            w[minus] = std::conj(mean);
-        }
-    modes[0] = w0[0];
-    modes[1] = w0[1];
-}
-
 // ---- direct-eq5: RK4 on the modes with eq. 5 summed term by term ------------
 
 class DirectEq5 final : public Integrator {
@@ -123,6 +106,23 @@ extern "C" void zgemm_(const char *transa, const char *transb, const int *m, con
                        const int *k, const cplx *alpha, const cplx *a, const int *lda,
                        const cplx *b, const int *ldb, const cplx *beta, cplx *c, const int *ldc,
                        std::size_t transa_len, std::size_t transb_len);
+
+// Keeps the mode array Hermitian (w_-m = conj(w_m)) after a matrix-form step,
+// where round-off of the transforms breaks it slightly, and restores the
+// inert mode w_0 exactly.
+void symmetrise_modes(int N, const double *w0, double *modes) {
+    cplx *w = reinterpret_cast<cplx *>(modes);
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const int m = a * N + b, minus = ((N - a) % N) * N + (N - b) % N;
+            if (minus <= m) continue;
+            const cplx mean = 0.5 * (w[m] + std::conj(w[minus]));
+            w[m] = mean;
+            w[minus] = std::conj(mean);
+        }
+    modes[0] = w0[0];
+    modes[1] = w0[1];
+}
 
 // C = A B for N x N column-major matrices.
 void multiply(int N, const cplx *A, const cplx *B, cplx *C) {
