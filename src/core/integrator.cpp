@@ -5,6 +5,7 @@
 
 #include "../reference/implicit_midpoint.hpp"
 #include "../reference/runge_kutta4.hpp"
+#include "../reference/sine_euler_matrix_methods.hpp"
 #include "error.hpp"
 
 namespace lpi {
@@ -72,6 +73,10 @@ std::unique_ptr<Integrator> make_integrator(const Method &method, const Model &m
         return std::make_unique<RungeKutta4>(model.state_size());
     case MethodKind::ImplicitMidpoint:
         return std::make_unique<ImplicitMidpoint>(model.state_size(), implicit);
+    case MethodKind::IsospectralMidpoint:
+    case MethodKind::RungeKutta4Matrix:
+    case MethodKind::DirectEq5:
+        return make_sine_euler_matrix_integrator(method, model, implicit);
     }
     fail(LPI_ERR_INTERNAL, "unhandled method kind for '" + method.name + "'");
 }

@@ -168,6 +168,44 @@ std::vector<Method> make_table() {
     midpoint.poisson = false;
     midpoint.kind = MethodKind::ImplicitMidpoint;
     table.push_back(midpoint);
+
+    // The sine-Euler matrix-form baselines (other systems refuse them).
+    // isomp is a Lie-Poisson integrator in exact arithmetic, but solved by
+    // fixed-point iteration it keeps the Casimirs only to the iteration's
+    // tolerance, not to round-off: a baseline here.
+    Method isomp;
+    isomp.name = "isomp";
+    isomp.order = 2;
+    isomp.stages = 1;
+    isomp.reference = "isospectral midpoint method on the matrix form of sine-Euler, fixed-point "
+                      "iteration, BLAS-3 (K. Modin and M. Viviani, Found. Comput. Math. 20 (2020) "
+                      "889; M. Viviani, BIT Numer. Math. 60 (2020) 741); Casimirs kept to the "
+                      "iteration tolerance; sine-Euler only";
+    isomp.poisson = false;
+    isomp.kind = MethodKind::IsospectralMidpoint;
+    table.push_back(isomp);
+
+    Method rk4_matrix;
+    rk4_matrix.name = "rk4-matrix";
+    rk4_matrix.order = 4;
+    rk4_matrix.stages = 1;
+    rk4_matrix.reference = "classical Runge-Kutta on the matrix form dW/dt = (i/(2 eps)) [P, W] "
+                           "of sine-Euler (V. Zeitlin, Physica D 49 (1991) 353), BLAS-3; not a "
+                           "Poisson map; sine-Euler only";
+    rk4_matrix.poisson = false;
+    rk4_matrix.kind = MethodKind::RungeKutta4Matrix;
+    table.push_back(rk4_matrix);
+
+    Method direct;
+    direct.name = "direct-eq5";
+    direct.order = 4;
+    direct.stages = 1;
+    direct.reference = "classical Runge-Kutta on McLachlan 1993 eq. (5) summed term by term, "
+                       "O(N^4) per evaluation: a correctness reference; sine-Euler with N <= 31 "
+                       "only";
+    direct.poisson = false;
+    direct.kind = MethodKind::DirectEq5;
+    table.push_back(direct);
     return table;
 }
 
@@ -305,6 +343,9 @@ std::vector<Flow> build_flow_program(const Method &method, std::size_t pieces) {
         break;
     case MethodKind::RungeKutta4:
     case MethodKind::ImplicitMidpoint:
+    case MethodKind::IsospectralMidpoint:
+    case MethodKind::RungeKutta4Matrix:
+    case MethodKind::DirectEq5:
         fail(LPI_ERR_INTERNAL, "build_flow_program called for a non-splitting method");
     }
     std::vector<Flow> merged;

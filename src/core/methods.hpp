@@ -15,6 +15,10 @@ enum class MethodKind {
     SymmetricComposition,// leapfrog stages with weights gammas (sum 1, symmetric)
     RungeKutta4,         // classical RK4 on the full vector field (not Poisson)
     ImplicitMidpoint,    // implicit midpoint rule on the full vector field (not Poisson)
+    // Sine-Euler only (src/reference/sine_euler_matrix_methods.hpp):
+    IsospectralMidpoint, // isomp on the matrix form dW/dt = [B(W), W]
+    RungeKutta4Matrix,   // classical RK4 on the matrix form
+    DirectEq5,           // classical RK4 on eq. 5 summed directly, O(N^4), small N
 };
 
 struct Method {

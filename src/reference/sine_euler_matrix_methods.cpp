@@ -1,0 +1,429 @@
+// Matrix-form baselines for sine-Euler (see the header).
+//
+// Conventions (design notes, section 1): W = sum_m w_m J_m is Hermitian,
+// eq. 5 is dW/dt = [B, W] with B = i f P, f = 1/(2 eps), eps = 2 pi/N and
+// P = sum_{n != 0} w_n / |n|^2 J_n (Hermitian, so B is anti-Hermitian).
+// Entry (a, a + m2) of W is sum_m1 w_(m1,m2) exp(2 pi i m1 k / N) with
+// k = 2a + m2 (mod N): each cyclic diagonal m2 of W, indexed by k, is a DFT of
+// the modes with that m2. So modes <-> matrix is 2N FFTs of length N, and
+// P(W) is, diagonal by diagonal, a DFT, a division by |m|^2 and a DFT back.
+// Matrices are stored column-major, as BLAS wants them.
+#include "sine_euler_matrix_methods.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "../core/error.hpp"
+#include "../models/sine_euler.hpp"
+#include "lpi_config.h"
+
+#if LPI_HAVE_FFTW
+#include <fftw3.h>
+#endif
+
+namespace lpi {
+
+namespace {
+
+using cplx = std::complex<double>;
+
+int rep(int a, int N) { return a > N / 2 ? a - N : a; }
+
+// ---- direct-eq5: RK4 on the modes with eq. 5 summed term by term ------------
+
+class DirectEq5 final : public Integrator {
+public:
+    explicit DirectEq5(int N)
+        : N_(N), sine_(N), weight_(static_cast<std::size_t>(N) * N),
+          k1_(2 * weight_.size()), k2_(k1_.size()), k3_(k1_.size()), k4_(k1_.size()),
+          stage_(k1_.size()) {
+        const double two_pi = 2.0 * std::acos(-1.0), eps = two_pi / N;
+        // sin(eps m x n) depends on m x n only mod N.
+        for (int j = 0; j < N; ++j) sine_[j] = std::sin(two_pi * j / N) / eps;
+        for (int a = 0; a < N; ++a)
+            for (int b = 0; b < N; ++b) {
+                const int ra = rep(a, N), rb = rep(b, N), norm2 = ra * ra + rb * rb;
+                weight_[a * N + b] = norm2 ? 1.0 / norm2 : 0.0;
+            }
+    }
+
+    // The same arithmetic as RungeKutta4, so the two agree to round-off.
+    bool advance(Model &, double *x, double dt, std::int64_t n) override {
+        const std::size_t size = k1_.size();
+        for (std::int64_t step = 0; step < n; ++step) {
+            rate(x, k1_.data());
+            for (std::size_t i = 0; i < size; ++i) stage_[i] = x[i] + 0.5 * dt * k1_[i];
+            rate(stage_.data(), k2_.data());
+            for (std::size_t i = 0; i < size; ++i) stage_[i] = x[i] + 0.5 * dt * k2_[i];
+            rate(stage_.data(), k3_.data());
+            for (std::size_t i = 0; i < size; ++i) stage_[i] = x[i] + dt * k3_[i];
+            rate(stage_.data(), k4_.data());
+            for (std::size_t i = 0; i < size; ++i)
+                x[i] += dt / 6.0 * (k1_[i] + 2.0 * k2_[i] + 2.0 * k3_[i] + k4_[i]);
+            if ((step + 1) % kFiniteCheckInterval == 0 && !all_finite(x, size)) return false;
+        }
+        return all_finite(x, size);
+    }
+
+    std::size_t evaluations_per_step() const override { return 4; }
+
+private:
+    // dw_m/dt = sum_{n != 0} sin(eps m x n) / (eps |n|^2) w_{m+n} w_{-n}  (eq. 5)
+    void rate(const double *modes, double *out) const {
+        const int N = N_;
+        const cplx *w = reinterpret_cast<const cplx *>(modes);
+        cplx *r = reinterpret_cast<cplx *>(out);
+        for (int m1 = 0; m1 < N; ++m1)
+            for (int m2 = 0; m2 < N; ++m2) {
+                cplx sum = 0.0;
+                for (int n1 = 0; n1 < N; ++n1) {
+                    const int row = (m1 + n1) % N, minus1 = (N - n1) % N;
+                    // cross = m1 n2 - m2 n1 (mod N), advanced by m1 with n2.
+                    int cross = (N - (m2 * n1) % N) % N;
+                    for (int n2 = 0; n2 < N; ++n2) {
+                        const double c = sine_[cross] * weight_[n1 * N + n2];
+                        sum += c * w[row * N + (m2 + n2) % N] * w[minus1 * N + (N - n2) % N];
+                        cross += m1;
+                        if (cross >= N) cross -= N;
+                    }
+                }
+                r[m1 * N + m2] = sum;
+            }
+    }
+
+    int N_;
+    std::vector<double> sine_, weight_;
+    std::vector<double> k1_, k2_, k3_, k4_, stage_;
+};
+
+#if LPI_HAVE_FFTW && LPI_HAVE_LAPACK
+
+extern "C" void zgemm_(const char *transa, const char *transb, const int *m, const int *n,
+                       const int *k, const cplx *alpha, const cplx *a, const int *lda,
+                       const cplx *b, const int *ldb, const cplx *beta, cplx *c, const int *ldc,
+                       std::size_t transa_len, std::size_t transb_len);
+
+// Keeps the mode array Hermitian (w_-m = conj(w_m)) after a matrix-form step,
+// where round-off of the transforms breaks it slightly, and restores the
+// inert mode w_0 exactly.
+void symmetrise_modes(int N, const double *w0, double *modes) {
+    cplx *w = reinterpret_cast<cplx *>(modes);
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const int m = a * N + b, minus = ((N - a) % N) * N + (N - b) % N;
+            if (minus <= m) continue;
+            const cplx mean = 0.5 * (w[m] + std::conj(w[minus]));
+            w[m] = mean;
+            w[minus] = std::conj(mean);
+        }
+    modes[0] = w0[0];
+    modes[1] = w0[1];
+}
+
+// C = A B for N x N column-major matrices.
+void multiply(int N, const cplx *A, const cplx *B, cplx *C) {
+    const char no = 'N';
+    const cplx one = 1.0, zero = 0.0;
+    zgemm_(&no, &no, &N, &N, &N, &one, A, &N, B, &N, &zero, C, &N, 1, 1);
+}
+
+// The transforms between modes and the matrix W, and W -> P(W).
+class MatrixForm {
+public:
+    explicit MatrixForm(int N)
+        : N_(N), index_(static_cast<std::size_t>(N) * N), inverse_laplacian_(index_.size()) {
+        const int half = (N + 1) / 2;  // the inverse of 2 mod N (N odd)
+        for (int m2 = 0; m2 < N; ++m2)
+            for (int k = 0; k < N; ++k) {
+                const int a = static_cast<int>((static_cast<long>(k - m2 + N) * half) % N);
+                const int b = (a + m2) % N;
+                index_[m2 * N + k] = a + b * N;
+            }
+        for (int m2 = 0; m2 < N; ++m2)
+            for (int m1 = 0; m1 < N; ++m1) {
+                const int r1 = rep(m1, N), r2 = rep(m2, N), norm2 = r1 * r1 + r2 * r2;
+                inverse_laplacian_[m2 * N + m1] = norm2 ? 1.0 / (static_cast<double>(N) * norm2) : 0.0;
+            }
+        std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+        buffer_ = fftw_alloc_complex(index_.size());
+        if (!buffer_) fail(LPI_ERR_NO_MEMORY, "cannot allocate the matrix-form FFT buffer");
+        // N transforms of length N over the rows of buffer_ (one per diagonal).
+        forward_ = fftw_plan_many_dft(1, &N_, N_, buffer_, nullptr, 1, N_, buffer_, nullptr, 1, N_,
+                                      FFTW_FORWARD, FFTW_ESTIMATE);
+        backward_ = fftw_plan_many_dft(1, &N_, N_, buffer_, nullptr, 1, N_, buffer_, nullptr, 1,
+                                       N_, FFTW_BACKWARD, FFTW_ESTIMATE);
+        if (!forward_ || !backward_) {
+            release();
+            fail(LPI_ERR_INTERNAL, "FFTW could not plan the matrix-form transforms");
+        }
+    }
+    ~MatrixForm() {
+        std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+        release();
+    }
+    MatrixForm(const MatrixForm &) = delete;
+    MatrixForm &operator=(const MatrixForm &) = delete;
+
+    void to_matrix(const double *modes, cplx *W) {
+        const int N = N_;
+        const cplx *w = reinterpret_cast<const cplx *>(modes);
+        cplx *x = reinterpret_cast<cplx *>(buffer_);
+        for (int m1 = 0; m1 < N; ++m1)
+            for (int m2 = 0; m2 < N; ++m2) x[m2 * N + m1] = w[m1 * N + m2];
+        fftw_execute(backward_);
+        scatter(W);
+    }
+
+    void to_modes(const cplx *W, double *modes) {
+        const int N = N_;
+        gather(W);
+        fftw_execute(forward_);
+        const cplx *x = reinterpret_cast<const cplx *>(buffer_);
+        cplx *w = reinterpret_cast<cplx *>(modes);
+        const double scale = 1.0 / N;
+        for (int m1 = 0; m1 < N; ++m1)
+            for (int m2 = 0; m2 < N; ++m2) w[m1 * N + m2] = scale * x[m2 * N + m1];
+    }
+
+    // P = sum_{n != 0} w_n / |n|^2 J_n for W = sum_n w_n J_n.
+    void stream(const cplx *W, cplx *P) {
+        gather(W);
+        fftw_execute(forward_);
+        cplx *x = reinterpret_cast<cplx *>(buffer_);
+        for (std::size_t i = 0; i < index_.size(); ++i) x[i] *= inverse_laplacian_[i];
+        fftw_execute(backward_);
+        scatter(P);
+    }
+
+private:
+    void gather(const cplx *W) {
+        cplx *x = reinterpret_cast<cplx *>(buffer_);
+        for (std::size_t i = 0; i < index_.size(); ++i) x[i] = W[index_[i]];
+    }
+    void scatter(cplx *W) const {
+        const cplx *x = reinterpret_cast<const cplx *>(buffer_);
+        for (std::size_t i = 0; i < index_.size(); ++i) W[index_[i]] = x[i];
+    }
+    void release() {
+        if (forward_) fftw_destroy_plan(forward_);
+        if (backward_) fftw_destroy_plan(backward_);
+        if (buffer_) fftw_free(buffer_);
+        forward_ = backward_ = nullptr;
+        buffer_ = nullptr;
+    }
+
+    int N_;
+    std::vector<int> index_;                // [m2 * N + k] -> entry (a, a + m2) of W
+    std::vector<double> inverse_laplacian_;  // [m2 * N + m1] = 1 / (N |m|^2), 0 at m = 0
+    fftw_complex *buffer_ = nullptr;
+    fftw_plan forward_ = nullptr, backward_ = nullptr;
+};
+
+bool matrix_finite(const std::vector<cplx> &W) {
+    return all_finite(reinterpret_cast<const double *>(W.data()), 2 * W.size());
+}
+
+// What both matrix-form methods share: the transforms, W, and the step
+// between the mode array (the model's working layout) and W, done once per
+// advance so every step stays in matrix form.
+class MatrixIntegrator : public Integrator {
+protected:
+    explicit MatrixIntegrator(int N)
+        : N_(N), size_(static_cast<std::size_t>(N) * N), form_(N), W_(size_), P_(size_),
+          X_(size_), f_(N / (4.0 * std::acos(-1.0))) {}
+
+    // One step of size dt on W_ (s: its index within the run).
+    virtual void step(double dt, std::int64_t s) = 0;
+
+    bool run(double *state, double dt, std::int64_t n) {
+        const double w0[2] = {state[0], state[1]};
+        form_.to_matrix(state, W_.data());
+        for (std::int64_t s = 0; s < n; ++s) {
+            step(dt, s);
+            if ((s + 1) % kFiniteCheckInterval == 0 && !matrix_finite(W_)) return false;
+        }
+        if (!matrix_finite(W_)) return false;
+        form_.to_modes(W_.data(), state);
+        symmetrise_modes(N_, w0, state);
+        return all_finite(state, 2 * size_);
+    }
+
+    // Out = i f (X - X^dagger): the Hermitian [B, W] when X = P W, since
+    // W P = (P W)^dagger for Hermitian P and W.
+    void commutator(const cplx *X, cplx *out) const {
+        const int N = N_;
+        const cplx factor(0.0, f_);
+        for (int j = 0; j < N; ++j)
+            for (int i = 0; i < N; ++i)
+                out[i + j * N] = factor * (X[i + j * N] - std::conj(X[j + i * N]));
+    }
+
+    int N_;
+    std::size_t size_;
+    MatrixForm form_;
+    std::vector<cplx> W_, P_, X_;
+    double f_;  // 1 / (2 eps) = N / (4 pi)
+};
+
+// Classical RK4 on dW/dt = [B(W), W]: one P(W) and one zgemm per stage.
+class RungeKutta4Matrix final : public MatrixIntegrator {
+public:
+    explicit RungeKutta4Matrix(int N)
+        : MatrixIntegrator(N), k1_(size_), k2_(size_), k3_(size_), k4_(size_), stage_(size_) {}
+
+    bool advance(Model &, double *state, double dt, std::int64_t n) override {
+        return run(state, dt, n);
+    }
+    std::size_t evaluations_per_step() const override { return 4; }
+
+private:
+    void rate(const cplx *W, cplx *out) {
+        form_.stream(W, P_.data());
+        multiply(N_, P_.data(), W, X_.data());
+        commutator(X_.data(), out);
+    }
+
+    void step(double dt, std::int64_t) override {
+        cplx *W = W_.data();
+        rate(W, k1_.data());
+        for (std::size_t i = 0; i < size_; ++i) stage_[i] = W[i] + 0.5 * dt * k1_[i];
+        rate(stage_.data(), k2_.data());
+        for (std::size_t i = 0; i < size_; ++i) stage_[i] = W[i] + 0.5 * dt * k2_[i];
+        rate(stage_.data(), k3_.data());
+        for (std::size_t i = 0; i < size_; ++i) stage_[i] = W[i] + dt * k3_[i];
+        rate(stage_.data(), k4_.data());
+        for (std::size_t i = 0; i < size_; ++i)
+            W[i] += dt / 6.0 * (k1_[i] + 2.0 * k2_[i] + 2.0 * k3_[i] + k4_[i]);
+    }
+
+    std::vector<cplx> k1_, k2_, k3_, k4_, stage_;
+};
+
+// The isospectral midpoint method for dW/dt = [B(W), W] (K. Modin and
+// M. Viviani, "Lie-Poisson methods for isospectral flows", Found. Comput.
+// Math. 20 (2020) 889; M. Viviani, "A minimal-variable symplectic method for
+// isospectral flows", BIT 60 (2020) 741):
+//   W_n     = (I - h/2 B(Wt)) Wt (I + h/2 B(Wt)),
+//   W_{n+1} = (I + h/2 B(Wt)) Wt (I - h/2 B(Wt)).
+// Expanding the first, Wt = W_n + h/2 [B, Wt] + h^2/4 B Wt B, solved by
+// fixed-point iteration; subtracting, W_{n+1} = W_n + h [B, Wt]. W_{n+1} is
+// then a Cayley-transform conjugate of W_n: isospectral up to the iteration's
+// tolerance. Each iteration: one P(Wt), two zgemm (P Wt and P Wt P).
+class IsospectralMidpoint final : public MatrixIntegrator {
+public:
+    IsospectralMidpoint(int N, ImplicitSettings settings)
+        : MatrixIntegrator(N), settings_(settings), mid_(size_), next_(size_), C_(size_),
+          Y_(size_) {}
+
+    bool advance(Model &, double *state, double dt, std::int64_t n) override {
+        iterations_ = 0;
+        const bool ok = run(state, dt, n);
+        average_iterations_ = static_cast<double>(iterations_) / static_cast<double>(n);
+        return ok;
+    }
+
+    // P(W) evaluations (with two zgemm each) per step, averaged over the last advance.
+    std::size_t evaluations_per_step() const override {
+        return static_cast<std::size_t>(std::ceil(std::max(1.0, average_iterations_)));
+    }
+
+private:
+    void step(double h, std::int64_t s) override {
+        const int N = N_;
+        cplx *W = W_.data(), *mid = mid_.data(), *next = next_.data();
+        double scale = 1.0;
+        for (std::size_t i = 0; i < size_; ++i)
+            scale = std::max({scale, std::fabs(W[i].real()), std::fabs(W[i].imag())});
+        // Start from the previous midpoint reflected through W_n (error
+        // O(h^2), one iteration fewer than starting from W_n), except on the
+        // first step of a run.
+        if (s == 0)
+            std::copy(W, W + size_, mid);
+        else
+            for (std::size_t i = 0; i < size_; ++i) mid[i] = 2.0 * W[i] - mid[i];
+        // B Wt B = -f^2 P Wt P, symmetrised so Wt stays exactly Hermitian.
+        const double quad = -0.25 * h * h * f_ * f_;
+        bool converged = false;
+        for (int k = 0; k < settings_.max_iterations && !converged; ++k) {
+            form_.stream(mid, P_.data());
+            multiply(N, P_.data(), mid, X_.data());
+            multiply(N, X_.data(), P_.data(), Y_.data());
+            commutator(X_.data(), C_.data());
+            ++iterations_;
+            double change = 0.0;
+            for (int j = 0; j < N; ++j)
+                for (int i = 0; i < N; ++i) {
+                    const std::size_t e = i + static_cast<std::size_t>(j) * N;
+                    const cplx sym = 0.5 * (Y_[e] + std::conj(Y_[j + static_cast<std::size_t>(i) * N]));
+                    next[e] = W[e] + 0.5 * h * C_[e] + quad * sym;
+                    const double d = std::max(std::fabs(next[e].real() - mid[e].real()),
+                                              std::fabs(next[e].imag() - mid[e].imag()));
+                    if (d > change || std::isnan(d)) change = d;  // a NaN, once seen, stays
+                }
+            if (!std::isfinite(change))
+                fail(LPI_ERR_NO_CONVERGENCE,
+                     "isomp: fixed-point iteration diverged at step " + std::to_string(s) +
+                         " (dt too large for the iteration); state rolled back");
+            converged = change <= settings_.tolerance * scale;
+            std::swap(mid_, next_);
+            mid = mid_.data();
+            next = next_.data();
+        }
+        if (!converged)
+            fail(LPI_ERR_NO_CONVERGENCE,
+                 "isomp: fixed-point iteration did not converge in " +
+                     std::to_string(settings_.max_iterations) + " iterations at step " +
+                     std::to_string(s) + " (dt too large for the iteration, or raise the limit "
+                     "with lpi_set_implicit_options); state rolled back");
+        // W_{n+1} = W_n + h [B(Wt), Wt] with the last iterate's commutator.
+        for (std::size_t i = 0; i < size_; ++i) W[i] += h * C_[i];
+    }
+
+    ImplicitSettings settings_;
+    std::vector<cplx> mid_, next_, C_, Y_;
+    std::int64_t iterations_ = 0;
+    double average_iterations_ = 0.0;
+};
+
+#endif  // LPI_HAVE_FFTW && LPI_HAVE_LAPACK
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_sine_euler_matrix_integrator(const Method &method,
+                                                              const Model &model,
+                                                              const ImplicitSettings &implicit) {
+    const auto *sine_euler = dynamic_cast<const SineEulerModel *>(&model);
+    if (!sine_euler)
+        fail(LPI_ERR_UNSUPPORTED, "method '" + method.name + "' integrates the matrix form of "
+                                  "sine-Euler and applies to sine-Euler systems only (this "
+                                  "system is " + model.kind() + ")");
+    const int N = sine_euler->order();
+    if (method.kind == MethodKind::DirectEq5) {
+        if (N > kDirectEq5MaxN)
+            fail(LPI_ERR_UNSUPPORTED,
+                 "method 'direct-eq5' sums eq. 5 term by term (O(N^4) per evaluation) as a "
+                 "correctness reference and accepts N <= " + std::to_string(kDirectEq5MaxN) +
+                     " only, this system has N = " + std::to_string(N) +
+                     " (use rk4, rk4-matrix or a splitting method)");
+        return std::make_unique<DirectEq5>(N);
+    }
+#if LPI_HAVE_FFTW && LPI_HAVE_LAPACK
+    if (method.kind == MethodKind::IsospectralMidpoint)
+        return std::make_unique<IsospectralMidpoint>(N, implicit);
+    if (method.kind == MethodKind::RungeKutta4Matrix) return std::make_unique<RungeKutta4Matrix>(N);
+#else
+    (void)implicit;
+    if (method.kind == MethodKind::IsospectralMidpoint ||
+        method.kind == MethodKind::RungeKutta4Matrix)
+        fail(LPI_ERR_UNSUPPORTED, "method '" + method.name + "' needs BLAS (zgemm, e.g. "
+                                  "OpenBLAS) and FFTW3; this build lacks " +
+                                  std::string(LPI_HAVE_LAPACK ? "FFTW3" : "BLAS/LAPACK"));
+#endif
+    fail(LPI_ERR_INTERNAL, "method '" + method.name + "' is not a sine-Euler matrix method");
+}
+
+}  // namespace lpi
