@@ -205,6 +205,7 @@ void run_report(const Scene &scene, const ReportOptions &options) {
     else
         std::printf("   reference: %s with dt = %g; error = |x(T) - x_ref(T)|\n",
                     scene.reference_method.c_str(), scene.reference_step);
+    if (!scene.exclusion_reason.empty()) std::printf("   %s\n", scene.exclusion_reason.c_str());
     std::printf("%-24s %9s %9s %11s %11s %11s %11s %10s  %s\n", "method", "dt", "steps", "cpu [s]",
                 "error", "max|dH/H|", "max|dC/C|", "ns/step", "status");
 
@@ -214,6 +215,9 @@ void run_report(const Scene &scene, const ReportOptions &options) {
     const double history_dt = scene.steps[scene.steps.size() / 2];
     for (int i = 0; i < lpi_method_count(); ++i) {
         const char *method = lpi_method_name(i);
+        if (std::find(scene.excluded_methods.begin(), scene.excluded_methods.end(), method) !=
+            scene.excluded_methods.end())
+            continue;
         {
             Handle probe = scene.create();
             if (lpi_set_method(probe.get(), method) != LPI_OK) continue;  // not applicable here

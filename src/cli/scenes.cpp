@@ -122,6 +122,8 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
             return h;
         };
         s.unavailable = sine_euler_unavailable;
+        s.excluded_methods = {"direct-eq5"};
+        s.exclusion_reason = "direct-eq5 (O(N^4), a correctness reference) is left out";
         s.final_time = 10.0;
         s.steps = {0.4, 0.2, 0.1, 0.05, 0.025};
         s.reference_method = "kahan-li-8";

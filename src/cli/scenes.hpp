@@ -22,6 +22,9 @@ struct Scene {
     std::string reference_method;
     double reference_step = 0.0;
     bool in_default_report = true;
+    // Methods left out of the sweep, with the reason printed.
+    std::vector<std::string> excluded_methods;
+    std::string exclusion_reason;
     // Why the scene cannot run in this build ("" when it can).
     std::function<std::string()> unavailable = [] { return std::string(); };
     // A scene that is not a step-size sweep runs this instead (figure2).
