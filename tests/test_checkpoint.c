@@ -304,6 +304,21 @@ static void test_foreign_newer_other_order(void **state) {
     assert_refused(copy, size, NULL);
     free(copy), free(buf);
     lpi_destroy(sys);
+
+    /* A crafted N far beyond the stored state is refused before anything of
+     * that size is allocated. */
+    sys = sine_euler(9);
+    if (!sys) return;
+    buf = save(sys, &size);
+    copy = malloc(size);
+    memcpy(copy, buf, size);
+    assert_memory_equal(copy + 28, "sine-euler", 10);
+    const double huge = 46339;
+    memcpy(copy + 42, &huge, 8);
+    reseal(copy, size);
+    assert_refused(copy, size, "the state has 162 values");
+    free(copy), free(buf);
+    lpi_destroy(sys);
 }
 
 /* Generic and moment systems carry user callbacks: refused, saying why. */

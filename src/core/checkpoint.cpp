@@ -104,9 +104,18 @@ std::uint64_t load_u64(const unsigned char *p) {
 
 std::string io_reason(int error) { return std::generic_category().message(error); }
 
-// The models a checkpoint can name, rebuilt from their parameters.
+// The models a checkpoint can name, rebuilt from their parameters. The
+// state length is checked first: a crafted file must not make the library
+// allocate a model far larger than the file.
 std::unique_ptr<Model> make_model_for_checkpoint(const std::string &kind,
-                                                 const std::vector<double> &p) {
+                                                 const std::vector<double> &p,
+                                                 std::size_t state_length) {
+    auto expect_state = [&](double expected) {
+        if (static_cast<double>(state_length) != expected)
+            fail(LPI_ERR_FORMAT, "the state has " + std::to_string(state_length) + " values, a " +
+                                     kind + " system of these parameters has " +
+                                     std::to_string(static_cast<std::uint64_t>(expected)));
+    };
     auto need = [&](std::size_t n) {
         if (p.size() != n)
             fail(LPI_ERR_FORMAT, "a " + kind + " system has " + std::to_string(n) +
@@ -115,10 +124,12 @@ std::unique_ptr<Model> make_model_for_checkpoint(const std::string &kind,
     try {
         if (kind == "rigid-body") {
             need(3);
+            expect_state(6);
             return make_rigid_body(p[0], p[1], p[2]);
         }
         if (kind == "pendulum") {
             need(0);
+            expect_state(6);
             return make_pendulum();
         }
         if (kind == "sine-euler") {
@@ -126,6 +137,7 @@ std::unique_ptr<Model> make_model_for_checkpoint(const std::string &kind,
             if (!(p[0] >= 0 && p[0] <= std::numeric_limits<std::int32_t>::max()) ||
                 p[0] != std::floor(p[0]))
                 fail(LPI_ERR_FORMAT, "sine-euler N is not an integer");
+            expect_state(2.0 * p[0] * p[0]);
             return make_sine_euler(static_cast<int>(p[0]));
         }
     } catch (const Error &e) {
@@ -225,7 +237,7 @@ Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size) {
     if (r.left() != 0)
         fail(LPI_ERR_FORMAT, std::to_string(r.left()) + " unread bytes at the end of the payload");
 
-    cp.model = make_model_for_checkpoint(kind, parameters);
+    cp.model = make_model_for_checkpoint(kind, parameters, cp.state.size());
     try {
         cp.model->set_split(split);
     } catch (const Error &e) {
