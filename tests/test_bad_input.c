@@ -746,7 +746,7 @@ static void test_bad_input_table(void **state) {
     remove("never.lpi");
     for (int t = 0; t < TARGETS; ++t) lpi_destroy(handles[t]);
     printf("bad input: %d cases run (%d status cases, %d sentinel cases), %d skipped "
-           "(built without FFTW)\n", run, run - sentinels, sentinels, skipped);
+           "(they need FFTW)\n", run, run - sentinels, sentinels, skipped);
 }
 
 int main(int argc, char **argv) {

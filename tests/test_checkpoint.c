@@ -422,6 +422,12 @@ static void test_files(void **state) {
     assert_non_null(strstr(lpi_last_error(NULL), "truncated"));
     assert_null(copy);
 
+    /* An empty file. */
+    f = fopen(path, "wb");
+    fclose(f);
+    LPI_ASSERT_FAILS(NULL, lpi_load(&copy, path), LPI_ERR_FORMAT, "lpi_load");
+    assert_non_null(strstr(lpi_last_error(NULL), "truncated: 0 bytes"));
+
     rmdir(sub);
     unlink(path);
     assert_int_equal(rmdir(dir), 0);

@@ -195,7 +195,7 @@ std::vector<unsigned char> encode_checkpoint(const System &system) {
 Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size) {
     // The header, in the order that gives the most useful message.
     const std::size_t magic_seen = size < sizeof kMagic ? size : sizeof kMagic;
-    if (std::memcmp(data, kMagic, magic_seen) != 0)
+    if (magic_seen > 0 && std::memcmp(data, kMagic, magic_seen) != 0)
         fail(LPI_ERR_FORMAT, "not a liepoisson checkpoint (wrong magic bytes)");
     if (size < kHeaderSize + kChecksumSize)
         fail(LPI_ERR_FORMAT, "truncated: " + std::to_string(size) +
