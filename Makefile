@@ -3,6 +3,7 @@
 #   make            build            make check   build and run every test
 #   make run        the demonstration report      make bench   the benchmarks
 #   make install PREFIX=/usr/local [DESTDIR=...]  make clean
+#   make abi-baseline   rewrite abi/ from this build (an intended ABI change)
 BUILD      ?= build
 BUILD_TYPE ?= Release
 PREFIX     ?= /usr/local
@@ -10,7 +11,7 @@ JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_ARGS ?=
 VERSION    := $(shell sed -n 's/^\#define LPI_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\).*/\2/p' include/liepoisson.h | paste -sd.)
 
-.PHONY: all build deps configure check run bench install clean version
+.PHONY: all build deps configure check run bench install clean version abi-baseline
 
 all: build
 
@@ -35,6 +36,9 @@ bench: build
 
 install: build
 	@DESTDIR="$(DESTDIR)" cmake --install $(BUILD) --prefix $(PREFIX)
+
+abi-baseline: build
+	@tests/check_abi.sh --update . $(BUILD)/libliepoisson.so
 
 clean:
 	@rm -rf $(BUILD)

@@ -47,7 +47,9 @@ extern "C" {
     X(LPI_ERR_NO_MEMORY, -7, "out of memory")                                       \
     X(LPI_ERR_INTERNAL, -8, "internal error (please report it)")                   \
     X(LPI_ERR_CALLBACK, -9, "a user callback reported failure")                     \
-    X(LPI_ERR_NO_CONVERGENCE, -10, "an implicit method's iteration did not converge")
+    X(LPI_ERR_NO_CONVERGENCE, -10, "an implicit method's iteration did not converge") \
+    X(LPI_ERR_IO, -11, "a file could not be opened, read, written or renamed")       \
+    X(LPI_ERR_FORMAT, -12, "data is not a valid checkpoint of this library")
 
 typedef enum lpi_status {
 #define LPI_STATUS_ENUM_ENTRY(name, value, message) name = value,
@@ -255,6 +257,30 @@ LPI_API int lpi_fftw_wisdom_import_file(const char *path);
 LPI_API int lpi_fftw_wisdom_export_file(const char *path);
 LPI_API int lpi_fftw_wisdom_import_string(const char *wisdom);
 LPI_API int lpi_fftw_wisdom_export_string(char *buf, size_t size, size_t *length);
+
+/* ---- Checkpoints ---------------------------------------------------------- *
+ * A checkpoint holds everything that determines a system's future: its kind
+ * and parameters, split, method (a custom composition's weights included),
+ * implicit settings, time and full working state (with the compensated
+ * carry), so a loaded system continues the trajectory to the bit. It is a
+ * versioned binary format with magic bytes, a byte-order marker and a CRC-32;
+ * a truncated, corrupted, foreign, other-byte-order or newer-version checkpoint
+ * is refused with LPI_ERR_FORMAT and a message saying which. The thread count
+ * is not stored (results do not depend on it); a loaded system uses 1.
+ * Rigid body, pendulum and sine-Euler can be saved; generic and moment systems
+ * cannot (their pieces are user callbacks): LPI_ERR_UNSUPPORTED. See lpi_save(3). */
+
+/* Writes the checkpoint to path atomically (a temporary file in the same
+ * directory, fsync, rename): path holds either its old contents or the whole
+ * new checkpoint. LPI_ERR_IO with the reason when the file system refuses. */
+LPI_API int lpi_save(const lpi_system *sys, const char *path);
+/* Creates a new system from a checkpoint file (*out NULL on failure). */
+LPI_API int lpi_load(lpi_system **out, const char *path);
+/* The checkpoint in memory: *size is set to its length in bytes. With
+ * buf == NULL and capacity == 0 this only queries the size; otherwise
+ * capacity < *size gives LPI_ERR_SIZE with buf untouched. */
+LPI_API int lpi_save_buffer(const lpi_system *sys, void *buf, size_t capacity, size_t *size);
+LPI_API int lpi_load_buffer(lpi_system **out, const void *buf, size_t size);
 
 #ifdef __cplusplus
 }

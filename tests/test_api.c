@@ -26,7 +26,8 @@ static void test_version_and_status_names(void **state) {
     /* Every code has a distinct name and a non-empty message. */
     const int codes[] = {LPI_OK, LPI_ERR_NULL, LPI_ERR_INVALID, LPI_ERR_SIZE, LPI_ERR_NONFINITE,
                          LPI_ERR_NOT_ABELIAN, LPI_ERR_UNSUPPORTED, LPI_ERR_NO_MEMORY,
-                         LPI_ERR_INTERNAL, LPI_ERR_CALLBACK, LPI_ERR_NO_CONVERGENCE};
+                         LPI_ERR_INTERNAL, LPI_ERR_CALLBACK, LPI_ERR_NO_CONVERGENCE,
+                         LPI_ERR_IO, LPI_ERR_FORMAT};
     const size_t count = sizeof codes / sizeof codes[0];
     for (size_t i = 0; i < count; ++i) {
         assert_true(strlen(lpi_status_message(codes[i])) > 0);

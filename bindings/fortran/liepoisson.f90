@@ -24,7 +24,7 @@ module liepoisson
     integer(c_int), parameter, public :: LPI_OK = 0, LPI_ERR_NULL = -1, LPI_ERR_INVALID = -2, &
         LPI_ERR_SIZE = -3, LPI_ERR_NONFINITE = -4, LPI_ERR_NOT_ABELIAN = -5, &
         LPI_ERR_UNSUPPORTED = -6, LPI_ERR_NO_MEMORY = -7, LPI_ERR_INTERNAL = -8, &
-        LPI_ERR_CALLBACK = -9, LPI_ERR_NO_CONVERGENCE = -10
+        LPI_ERR_CALLBACK = -9, LPI_ERR_NO_CONVERGENCE = -10, LPI_ERR_IO = -11, LPI_ERR_FORMAT = -12
 
     ! ---- callback types ------------------------------------------------------
     abstract interface
@@ -313,6 +313,29 @@ module liepoisson
             integer(c_size_t), value :: size
             integer(c_size_t), intent(out) :: length
         end function
+        ! checkpoints
+        integer(c_int) function c_lpi_save(sys, path) bind(C, name="lpi_save")
+            import :: c_int, c_ptr, c_char
+            type(c_ptr), value :: sys
+            character(kind=c_char), intent(in) :: path(*)
+        end function
+        integer(c_int) function c_lpi_load(out, path) bind(C, name="lpi_load")
+            import :: c_int, c_ptr, c_char
+            type(c_ptr), intent(out) :: out
+            character(kind=c_char), intent(in) :: path(*)
+        end function
+        integer(c_int) function c_lpi_save_buffer(sys, buf, capacity, size) bind(C, name="lpi_save_buffer")
+            import :: c_int, c_ptr, c_size_t
+            type(c_ptr), value :: sys, buf
+            integer(c_size_t), value :: capacity
+            integer(c_size_t), intent(out) :: size
+        end function
+        integer(c_int) function c_lpi_load_buffer(out, buf, size) bind(C, name="lpi_load_buffer")
+            import :: c_int, c_ptr, c_size_t
+            type(c_ptr), intent(out) :: out
+            type(c_ptr), value :: buf
+            integer(c_size_t), value :: size
+        end function
         ! from the C library, to read C strings
         integer(c_size_t) function c_strlen(s) bind(C, name="strlen")
             import :: c_size_t, c_ptr
@@ -333,7 +356,7 @@ module liepoisson
         c_lpi_sine_euler_get_grid, c_lpi_sine_euler_enstrophy, c_lpi_sine_euler_casimir_traces, &
         c_lpi_sine_euler_fft_floor, c_lpi_set_threads, c_lpi_fftw_wisdom_import_file, &
         c_lpi_fftw_wisdom_export_file, c_lpi_fftw_wisdom_import_string, &
-        c_lpi_fftw_wisdom_export_string
+        c_lpi_fftw_wisdom_export_string, c_lpi_save, c_lpi_load, c_lpi_save_buffer, c_lpi_load_buffer
 
     ! lpi_step takes a default or 64-bit step count.
     interface lpi_step
@@ -351,7 +374,8 @@ module liepoisson
         lpi_sine_euler_set_modes, lpi_sine_euler_get_modes, lpi_sine_euler_set_grid, &
         lpi_sine_euler_get_grid, lpi_sine_euler_enstrophy, lpi_sine_euler_casimir_traces, &
         lpi_sine_euler_fft_floor, lpi_set_threads, lpi_fftw_wisdom_import_file, &
-        lpi_fftw_wisdom_export_file, lpi_fftw_wisdom_import_string, lpi_fftw_wisdom_export_string
+        lpi_fftw_wisdom_export_file, lpi_fftw_wisdom_import_string, lpi_fftw_wisdom_export_string, &
+        lpi_save, lpi_load, lpi_save_buffer, lpi_load_buffer
 
 contains
 
@@ -822,6 +846,46 @@ contains
             end if
         end if
         call finish(st, c_null_ptr, status)
+    end subroutine
+
+    ! ---- checkpoints ----------------------------------------------------------
+
+    subroutine lpi_save(sys, path, status)
+        type(c_ptr), intent(in) :: sys
+        character(len=*), intent(in) :: path
+        integer, intent(out), optional :: status
+        call finish(c_lpi_save(sys, c_string(path)), sys, status)
+    end subroutine
+
+    subroutine lpi_load(sys, path, status)
+        type(c_ptr), intent(out) :: sys
+        character(len=*), intent(in) :: path
+        integer, intent(out), optional :: status
+        call finish(c_lpi_load(sys, c_string(path)), c_null_ptr, status)
+    end subroutine
+
+    ! The checkpoint in memory, as an allocatable byte array.
+    subroutine lpi_save_buffer(sys, bytes, status)
+        type(c_ptr), intent(in) :: sys
+        integer(c_int8_t), allocatable, target, intent(out) :: bytes(:)
+        integer, intent(out), optional :: status
+        integer(c_size_t) :: size
+        integer(c_int) :: st
+        st = c_lpi_save_buffer(sys, c_null_ptr, 0_c_size_t, size)
+        if (st == LPI_OK) then
+            allocate (bytes(size))
+            st = c_lpi_save_buffer(sys, c_loc(bytes), size, size)
+        else
+            allocate (bytes(0))
+        end if
+        call finish(st, sys, status)
+    end subroutine
+
+    subroutine lpi_load_buffer(sys, bytes, status)
+        type(c_ptr), intent(out) :: sys
+        integer(c_int8_t), target, intent(in) :: bytes(:)
+        integer, intent(out), optional :: status
+        call finish(c_lpi_load_buffer(sys, c_loc(bytes), size(bytes, kind=c_size_t)), c_null_ptr, status)
     end subroutine
 
 end module liepoisson

@@ -116,7 +116,11 @@ LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *se
         require(transforms_per_step, "transforms_per_step");
         if (nsteps < 1) lpi::fail(LPI_ERR_INVALID, "nsteps must be >= 1, got " + std::to_string(nsteps));
         const lpi::Method &method = sys->system.method();
-        if (method.kind == lpi::MethodKind::RungeKutta4)
+        // Only splittings have a flow program; every other kind is refused.
+        const bool splitting = method.kind == lpi::MethodKind::Sequence ||
+                               method.kind == lpi::MethodKind::SequenceAdjoint ||
+                               method.kind == lpi::MethodKind::SymmetricComposition;
+        if (!splitting)
             lpi::fail(LPI_ERR_INVALID, "the FFT floor is defined for splitting methods, not '" +
                                            method.name + "'");
         // Flows per step in a long run, as the splitting integrator counts them.

@@ -25,6 +25,10 @@ void Model::set_threads(int n) {
         fail(LPI_ERR_UNSUPPORTED, std::string(kind()) + " integrates on one thread only");
 }
 
+std::vector<double> Model::checkpoint_parameters() const {
+    fail(LPI_ERR_UNSUPPORTED, std::string("a ") + kind() + " system cannot be checkpointed");
+}
+
 }  // namespace lpi
 
 namespace lpi {

@@ -47,6 +47,11 @@ public:
     // Threads used inside one flow. The default integrates on one thread:
     // n = 1 is accepted, n > 1 throws LPI_ERR_UNSUPPORTED.
     virtual void set_threads(int n);
+
+    // What a checkpoint stores to rebuild this model: its parameters, which
+    // make_model_for_checkpoint (checkpoint.cpp) turns back into the model of
+    // the same kind. The default refuses with LPI_ERR_UNSUPPORTED.
+    virtual std::vector<double> checkpoint_parameters() const;
 };
 
 }  // namespace lpi

@@ -69,6 +69,16 @@ void System::get_state(double *x, std::size_t n) const {
     model_->to_public(state_.data(), x);
 }
 
+void System::restore_working_state(std::vector<double> state, double time) {
+    require_length("working state", state.size(), model_->state_size());
+    for (std::size_t i = 0; i < state.size(); ++i)
+        if (!std::isfinite(state[i]))
+            fail(LPI_ERR_NONFINITE, "working state entry " + std::to_string(i) + " is not finite");
+    if (!std::isfinite(time)) fail(LPI_ERR_NONFINITE, "time is not finite");
+    state_.swap(state);
+    time_ = time;
+}
+
 void System::step(double dt, std::int64_t nsteps) {
     if (!std::isfinite(dt)) fail(LPI_ERR_NONFINITE, "dt is not finite");
     if (dt == 0.0) fail(LPI_ERR_INVALID, "dt must be nonzero");

@@ -26,6 +26,7 @@ public:
     // A user-supplied symmetric composition of leapfrog (see custom_composition).
     void set_composition(const double *gammas, std::size_t n);
     void set_implicit_settings(const ImplicitSettings &settings);
+    const ImplicitSettings &implicit_settings() const { return implicit_; }
     // Piece flows (RK4: vector-field evaluations) per step in a long run.
     std::size_t flows_per_step() const { return integrator_->evaluations_per_step(); }
     void set_split(const std::string &name);
@@ -35,6 +36,9 @@ public:
     void set_state(const double *x, std::size_t n);  // also resets time to 0
     void get_state(double *x, std::size_t n) const;
     const std::vector<double> &working_state() const { return state_; }
+    // Restores a working state and time exactly (checkpoints): the length
+    // must be the model's state_size() and every value finite.
+    void restore_working_state(std::vector<double> state, double time);
 
     void step(double dt, std::int64_t nsteps);
     double time() const { return time_; }

@@ -283,6 +283,15 @@ private:
 GenericModel::GenericModel(std::unique_ptr<StructureConstants> constants, const char *kind)
     : kind_(kind), constants_(std::move(constants)) {}
 
+std::vector<double> GenericModel::checkpoint_parameters() const {
+    // Callbacks are code plus a user pointer: nothing in a file can bring
+    // them back, and a system restored without them would not be the same.
+    fail(LPI_ERR_UNSUPPORTED, std::string("a ") + kind_ + " system cannot be checkpointed: "
+                              "its Hamiltonian pieces and Casimirs are user callbacks, which "
+                              "cannot be saved (save lpi_get_state and lpi_time instead, and "
+                              "rebuild the system)");
+}
+
 void GenericModel::flow(std::size_t piece, double t, double *state) {
     if (pieces_.empty())
         fail(LPI_ERR_INVALID, std::string("the ") + kind_ +

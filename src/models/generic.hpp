@@ -90,6 +90,8 @@ public:
     std::size_t casimir_count() const override { return casimirs_.size(); }
     void casimirs(const double *state, double *out) const override;
     void vector_field(const double *state, double *rate) const override;
+    // Refuses (LPI_ERR_UNSUPPORTED): the pieces and Casimirs are user callbacks.
+    std::vector<double> checkpoint_parameters() const override;
 
     const StructureConstants &constants() const { return *constants_; }
     std::size_t pieces() const { return pieces_.size(); }

@@ -16,6 +16,7 @@ public:
     void set_split(const std::string &name) override { split_.select(name, kind()); }
     std::string split() const override { return split_.current(); }
     std::size_t piece_count() const override { return 2; }
+    std::vector<double> checkpoint_parameters() const override { return {}; }
 
     void flow(std::size_t piece, double t, double *state) override {
         double *carry = state + 3;

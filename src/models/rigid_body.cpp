@@ -22,6 +22,9 @@ public:
     void set_split(const std::string &name) override { split_.select(name, kind()); }
     std::string split() const override { return split_.current(); }
     double inertia(int axis) const { return inertia_[axis]; }
+    std::vector<double> checkpoint_parameters() const override {
+        return {inertia_[0], inertia_[1], inertia_[2]};
+    }
     std::size_t piece_count() const override { return split_.index() == kCasimirShift ? 2 : 3; }
 
     void flow(std::size_t piece, double t, double *state) override {

@@ -107,6 +107,9 @@ public:
     void set_split(const std::string &name) override { split_.select(name, kind()); }
     std::string split() const override { return split_.current(); }
     std::size_t piece_count() const override { return dirs_.size(); }
+    // The thread count is a runtime setting (results are identical for every
+    // count), so N is all a checkpoint needs.
+    std::vector<double> checkpoint_parameters() const override { return {double(N_)}; }
 
     void set_threads(int n) override {
         if (n < 1) fail(LPI_ERR_INVALID, "thread count must be >= 1, got " + std::to_string(n));

@@ -92,9 +92,10 @@ contains
     end subroutine
 
     subroutine test_rigid_body()
-        type(c_ptr) :: sys
-        real(c_double) :: m(3), c0(1), c1(1), exact(3), h
-        integer :: flows
+        type(c_ptr) :: sys, copy, copy2
+        real(c_double) :: m(3), m_copy(3), c0(1), c1(1), exact(3), h
+        integer(c_int8_t), allocatable :: bytes(:)
+        integer :: flows, status
         call lpi_rigid_body_create(sys, 1.0_c_double, 2.0_c_double, 3.0_c_double)
         call check(lpi_dim(sys) == 3, "rigid body dim")
         call check(lpi_casimir_count(sys) == 1, "rigid body casimir count")
@@ -115,6 +116,17 @@ contains
         call lpi_set_composition(sys, [0.5_c_double, 0.5_c_double])
         call lpi_flows_per_step(sys, flows)
         call check(flows > 0, "flows per step")
+        ! A checkpoint in memory resumes the trajectory bit for bit.
+        call lpi_save_buffer(sys, bytes)
+        call lpi_load_buffer(copy, bytes)
+        call lpi_step(sys, 0.01_c_double, 100)
+        call lpi_step(copy, 0.01_c_double, 100)
+        call lpi_get_state(sys, m)
+        call lpi_get_state(copy, m_copy)
+        call check(all(m == m_copy), "checkpoint resumes bit for bit")
+        call lpi_load_buffer(copy2, bytes(1:size(bytes) - 1), status)
+        call check(status == LPI_ERR_FORMAT, "truncated checkpoint refused")
+        call lpi_destroy(copy)
         call lpi_destroy(sys)
         call check(.not. c_associated(sys), "destroy nulls the handle")
         call lpi_destroy(sys)  ! no-op

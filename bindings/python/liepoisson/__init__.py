@@ -33,7 +33,7 @@ HAVE_NUMPY = np is not None
 __all__ = [
     "version", "methods", "Method", "status_name", "status_message", "HAVE_NUMPY",
     "System", "RigidBody", "Pendulum", "Generic", "Moments", "SineEuler",
-    "fftw_wisdom_import_file", "fftw_wisdom_export_file",
+    "load", "load_bytes", "fftw_wisdom_import_file", "fftw_wisdom_export_file",
     "fftw_wisdom_import_string", "fftw_wisdom_export_string",
     "LiePoissonError",
 ]
@@ -342,6 +342,39 @@ class System:
         self._call("lpi_casimirs", ptr, n)
         return result()
 
+    # checkpoints
+    def save(self, path):
+        """Writes a checkpoint to path atomically (lpi_save)."""
+        self._call("lpi_save", os.fsencode(path))
+
+    def save_bytes(self):
+        """The checkpoint as bytes (lpi_save_buffer)."""
+        size = c_size_t()
+        del self._pending[:]
+        status = lib.lpi_save_buffer(self._h(), None, 0, byref(size))
+        if status != 0:
+            _raise(status, _text(lib.lpi_last_error(self._handle)))
+        buf = ctypes.create_string_buffer(size.value)
+        self._call("lpi_save_buffer", buf, size.value, byref(size))
+        return buf.raw[:size.value]
+
+    @classmethod
+    def _adopt(cls, handle, method=None):
+        """Wraps a handle made by lpi_load*, as the subclass of its kind."""
+        N = c_int32()
+        if lib.lpi_sine_euler_size(handle, byref(N)) == 0:
+            kind = SineEuler
+        elif lib.lpi_rigid_body_exact(handle, 0.0, (c_double * 3)()) == 0:
+            kind = RigidBody
+        else:
+            kind = Pendulum  # generic and moment systems cannot be saved
+        self = kind.__new__(kind)
+        self._handle = handle
+        self._keep, self._pending = [], []
+        self._method, self._split, self._threads = method, None, 1
+        self._finalizer = weakref.finalize(self, _destroy, handle, self._keep)
+        return self
+
     def __repr__(self):
         if self.closed:
             return "<%s (closed)>" % type(self).__name__
@@ -551,6 +584,25 @@ class SineEuler(System):
         sec, count = c_double(), c_double()
         self._call("lpi_sine_euler_fft_floor", int(nsteps), byref(sec), byref(count))
         return sec.value, count.value
+
+
+# ---- checkpoints ----------------------------------------------------------------
+
+def load(path):
+    """A system restored from a checkpoint file (lpi_load); it continues the
+    saved trajectory bit for bit. The method's name is not stored in the object
+    (its .method is None) but the library uses the saved one."""
+    handle = ctypes.c_void_p()
+    _check_free(lib.lpi_load(byref(handle), os.fsencode(path)))
+    return System._adopt(handle)
+
+
+def load_bytes(data):
+    """A system restored from checkpoint bytes (lpi_load_buffer)."""
+    data = bytes(data)
+    handle = ctypes.c_void_p()
+    _check_free(lib.lpi_load_buffer(byref(handle), data, len(data)))
+    return System._adopt(handle)
 
 
 # ---- FFTW wisdom (process-wide) -----------------------------------------------

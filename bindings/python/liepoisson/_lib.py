@@ -82,6 +82,10 @@ PROTOTYPES = {
     "lpi_fftw_wisdom_export_file": (c_int, [c_char_p]),
     "lpi_fftw_wisdom_import_string": (c_int, [c_char_p]),
     "lpi_fftw_wisdom_export_string": (c_int, [c_char_p, c_size_t, c_size_t_p]),
+    "lpi_save": (c_int, [c_handle, c_char_p]),
+    "lpi_load": (c_int, [c_handle_p, c_char_p]),
+    "lpi_save_buffer": (c_int, [c_handle, c_void_p, c_size_t, c_size_t_p]),
+    "lpi_load_buffer": (c_int, [c_handle_p, c_void_p, c_size_t]),
 }
 
 

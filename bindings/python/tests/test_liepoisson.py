@@ -65,6 +65,37 @@ class TestModule(unittest.TestCase):
                 self.assertIsInstance(s, list)
 
 
+class TestCheckpoints(unittest.TestCase):
+    def test_resume_bit_for_bit(self):
+        with lp.RigidBody(*INERTIA) as body, tempfile.TemporaryDirectory() as d:
+            body.method = "kahan-li-6"
+            body.state = [1.0, 0.5, -0.3]
+            body.step(0.01, 37)
+            path = os.path.join(d, "run.lpi")
+            body.save(path)
+            data = body.save_bytes()
+            body.step(0.01, 50)
+            for copy in (lp.load(path), lp.load_bytes(data)):
+                with copy:
+                    self.assertIsInstance(copy, lp.RigidBody)
+                    copy.step(0.01, 50)
+                    self.assertEqual(as_list(copy.state), as_list(body.state))
+                    self.assertEqual(copy.time, body.time)
+
+    def test_bad_checkpoints(self):
+        with self.assertRaises(lp.LiePoissonError) as caught:
+            lp.load_bytes(b"not a checkpoint")
+        self.assertEqual(caught.exception.status_name, "LPI_ERR_FORMAT")
+        with self.assertRaises(lp.LiePoissonError) as caught:
+            lp.load("/nonexistent/dir/run.lpi")
+        self.assertEqual(caught.exception.status_name, "LPI_ERR_IO")
+        g = generic_rigid_body()
+        with self.assertRaises(lp.LiePoissonError) as caught:
+            g.save_bytes()
+        self.assertEqual(caught.exception.status_name, "LPI_ERR_UNSUPPORTED")
+        g.close()
+
+
 class TestRigidBody(unittest.TestCase):
     def test_casimir_kept_by_splitting_not_by_rk4(self):
         drifts = {}

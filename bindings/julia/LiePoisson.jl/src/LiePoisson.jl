@@ -107,6 +107,12 @@ lpi_fftw_wisdom_import_string(w) = ccall(_sym(:lpi_fftw_wisdom_import_string), C
 lpi_fftw_wisdom_export_string(buf, size, length) =
     ccall(_sym(:lpi_fftw_wisdom_export_string), Cint, (Ptr{UInt8}, Csize_t, Ptr{Csize_t}),
           buf, size, length)
+lpi_save(sys, path) = ccall(_sym(:lpi_save), Cint, (Sys, Cstring), sys, path)
+lpi_load(out, path) = ccall(_sym(:lpi_load), Cint, (Ptr{Sys}, Cstring), out, path)
+lpi_save_buffer(sys, buf, capacity, size) =
+    ccall(_sym(:lpi_save_buffer), Cint, (Sys, Ptr{UInt8}, Csize_t, Ptr{Csize_t}), sys, buf, capacity, size)
+lpi_load_buffer(out, buf, size) =
+    ccall(_sym(:lpi_load_buffer), Cint, (Ptr{Sys}, Ptr{UInt8}, Csize_t), out, buf, size)
 end # module C
 
 # ---- errors --------------------------------------------------------------------
@@ -191,6 +197,18 @@ RigidBody(I1, I2, I3) = System(out -> C.lpi_rigid_body_create(out, I1, I2, I3))
 Pendulum() = System(out -> C.lpi_pendulum_create(out))
 Moments() = System(out -> C.lpi_moments_create(out))
 SineEuler(N::Integer) = System(out -> C.lpi_sine_euler_create(out, N))
+
+"""save(sys, path): writes a checkpoint atomically; `load(path)` resumes it bit for bit."""
+save(sys::System, path::AbstractString) = _call(h -> C.lpi_save(h, path), sys)
+load(path::AbstractString) = System(out -> C.lpi_load(out, path))
+function save_bytes(sys::System)
+    size = Ref{Csize_t}(0)
+    _call(h -> C.lpi_save_buffer(h, C_NULL, 0, size), sys)
+    buf = Vector{UInt8}(undef, size[])
+    _call(h -> C.lpi_save_buffer(h, buf, length(buf), size), sys)
+    buf
+end
+load_bytes(buf::Vector{UInt8}) = System(out -> C.lpi_load_buffer(out, buf, length(buf)))
 
 """Generic(dim, brackets): {x_i, x_j} = sum c x_k over (i, j, k, c), 0-based."""
 function Generic(dim::Integer, brackets = Tuple{Int,Int,Int,Float64}[])
@@ -378,7 +396,8 @@ function fftw_wisdom_export_string()
     String(buf[1:len[]])
 end
 
-export LiePoissonError, RigidBody, Pendulum, Generic, Moments, SineEuler, System,
+export LiePoissonError, RigidBody, Pendulum, Generic, Moments, SineEuler, System, save, load,
+    save_bytes, load_bytes,
     set_method!, set_split!, set_composition!, flows_per_step, set_implicit_options!,
     set_threads!, dim, state, set_state!, step!, energy, casimir_count, casimirs, last_error,
     exact, poisson_rank, add_piece!, add_casimir!, add_product_piece!, sine_euler_size, modes,

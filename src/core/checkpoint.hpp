@@ -1,0 +1,72 @@
+// Checkpoints: a System written to bytes (or a file) and read back so that
+// stepping continues the same trajectory to the bit.
+//
+// Format, version 1. Every number is in the writer's byte order, announced by
+// the marker; IEEE 754 doubles are stored as their 8 bytes.
+//   offset  0  magic        8 bytes  89 'L' 'P' 'I' 0D 0A 1A 0A (PNG-style:
+//                                    catches text-mode and 7-bit transfers)
+//           8  byte order   u32      0x01020304 as written
+//          12  version      u32      1
+//          16  total size   u64      bytes in the whole checkpoint
+//          24  payload:
+//              kind         string   "rigid-body", "pendulum", "sine-euler"
+//              parameters   u32 n, n x f64   (Model::checkpoint_parameters)
+//              split        string
+//              method       string   registry name, or "custom"
+//              gammas       u32 n, n x f64   (the composition's weights)
+//              tolerance    f64      implicit settings
+//              iterations   i32
+//              time         f64
+//              state        u64 n, n x f64   (the working layout, including
+//                                              the compensated carry)
+//   size-4     CRC-32       u32      of every byte before it (IEEE 802.3)
+// A string is u32 length + bytes (no NUL). Threads are a runtime setting
+// (results are identical for every count) and are not stored.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "system.hpp"
+
+namespace lpi {
+
+constexpr std::uint32_t kCheckpointVersion = 1;
+
+// CRC-32 (reflected polynomial 0xEDB88320, init and final xor 0xFFFFFFFF: the
+// checksum of zlib, PNG and IEEE 802.3; check value 0xCBF43926 for "123456789").
+std::uint32_t crc32(const unsigned char *data, std::size_t size);
+
+// The checkpoint of a system; LPI_ERR_UNSUPPORTED for models that cannot be
+// saved (generic systems: their pieces are user callbacks).
+std::vector<unsigned char> encode_checkpoint(const System &system);
+
+// A decoded, validated checkpoint: the model is built (split selected), the
+// rest is applied to a System around it by restore_checkpoint.
+struct Checkpoint {
+    std::unique_ptr<Model> model;
+    std::string method;
+    std::vector<double> gammas;
+    ImplicitSettings implicit;
+    double time = 0.0;
+    std::vector<double> state;
+};
+
+// Throws LPI_ERR_FORMAT for anything that is not an intact checkpoint this
+// library can read (truncated, corrupted, wrong magic, other byte order, newer
+// version, inconsistent contents), with a message saying which.
+Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size);
+// Sets method, implicit settings, state and time; LPI_ERR_FORMAT when this
+// build's method of that name has other coefficients than the checkpoint's.
+void restore_checkpoint(System &system, const Checkpoint &checkpoint);
+
+// Atomic write: a temporary file in the same directory, fsync, rename over
+// path, fsync of the directory. LPI_ERR_IO (with the reason) on failure, and
+// no temporary file is left behind.
+void write_file_atomically(const std::string &path, const std::vector<unsigned char> &bytes);
+std::vector<unsigned char> read_file(const std::string &path);
+
+}  // namespace lpi
