@@ -21,4 +21,18 @@ if "$lpi" run sine-euler --N 9 --dt 0.05 --steps 20 --every 2 --snapshots 5 --ou
         [ "$n" -eq 3 ] || { echo "expected 3 vorticity snapshots, got $n"; exit 1; }
     fi
 fi
-echo "lpi run: CSV rows, quiet off a terminal, bad options refused, snapshots drawn"
+
+# --checkpoint / --resume: 20 steps, then 30 more from the checkpoint, end
+# exactly (to the bit) where 50 steps in one run end.
+"$lpi" run pendulum --method suzuki-4 --dt 0.05 --steps 50 --every 10 --out "$out/whole" >/dev/null
+"$lpi" run pendulum --method suzuki-4 --dt 0.05 --steps 20 --every 10 --out "$out/parts" \
+    --checkpoint "$out/pendulum.lpi" >/dev/null
+"$lpi" run pendulum --dt 0.05 --steps 30 --every 10 --out "$out/parts" --resume "$out/pendulum.lpi" >/dev/null
+whole=$(tail -1 "$out/whole/pendulum.csv" | cut -d, -f1-3,5-)
+parts=$(tail -1 "$out/parts/pendulum.csv" | cut -d, -f1-3,5-)
+[ "$whole" = "$parts" ] || { echo "resumed run differs: '$whole' vs '$parts'"; exit 1; }
+[ "$(wc -l < "$out/parts/pendulum.csv")" -eq 7 ] || { echo "resumed rows not appended"; exit 1; }
+if "$lpi" run pendulum --resume "$out/no-such-file.lpi" --out "$out" 2>/dev/null; then
+    echo "a missing checkpoint was accepted"; exit 1
+fi
+echo "lpi run: --checkpoint then --resume continues to the bit"

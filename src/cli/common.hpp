@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace lpi_cli {
@@ -34,6 +35,10 @@ public:
     Handle(const Handle &) = delete;
     Handle &operator=(const Handle &) = delete;
     Handle(Handle &&other) noexcept : sys_(other.sys_) { other.sys_ = nullptr; }
+    Handle &operator=(Handle &&other) noexcept {
+        std::swap(sys_, other.sys_);
+        return *this;
+    }
     ~Handle() { lpi_destroy(sys_); }
     lpi_system *get() const { return sys_; }
     lpi_system **out() { return &sys_; }

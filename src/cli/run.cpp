@@ -27,6 +27,9 @@ struct RunOptions {
     int threads = 1;
     int snapshot_every = 10;  // sine-Euler: a PNG every this many output rows (0: none)
     std::string out_dir = "lpi-run";
+    std::string checkpoint;    // save here every checkpoint_every rows and at the end
+    int checkpoint_every = 10;
+    std::string resume;        // continue from this checkpoint
     SceneOptions scene_options;
 };
 
@@ -44,7 +47,13 @@ void run_usage(FILE *to) {
                  "  --inertia A,B,C   rigid-body inertias (default 1,2,3)\n"
                  "  --snapshots K     sine-Euler: a vorticity PNG every K rows (default 10; 0: none)\n"
                  "  --out DIR         output directory (default ./lpi-run)\n"
-                 "  writes DIR/SCENE.csv: step, time, energy, relative energy error, Casimirs;\n"
+                 "  --checkpoint FILE save a checkpoint (atomically) every 10 rows and at the end\n"
+                 "  --checkpoint-every K   ... every K rows instead\n"
+                 "  --resume FILE     continue from a checkpoint: the trajectory goes on bit for bit\n"
+                 "                    (--until is then an absolute time, --steps a count of more\n"
+                 "                    steps; rows are appended to DIR/SCENE.csv)\n"
+                 "  writes DIR/SCENE.csv: step, time, energy, relative energy error (to the energy\n"
+                 "  where this run starts), Casimirs;\n"
                  "  a progress bar with the time left is shown on a terminal only.\n");
 }
 
@@ -77,6 +86,9 @@ bool parse(int argc, char **argv, RunOptions &o) {
         else if (arg == "--N") o.scene_options.sine_euler_n = static_cast<int>(number("--N"));
         else if (arg == "--snapshots") o.snapshot_every = static_cast<int>(number("--snapshots"));
         else if (arg == "--out") o.out_dir = value("--out");
+        else if (arg == "--checkpoint") o.checkpoint = value("--checkpoint");
+        else if (arg == "--checkpoint-every") o.checkpoint_every = static_cast<int>(number("--checkpoint-every"));
+        else if (arg == "--resume") o.resume = value("--resume");
         else if (arg == "--inertia") {
             const char *text = value("--inertia");
             double *I = o.scene_options.inertia;
@@ -160,32 +172,45 @@ int run_command(int argc, char **argv) {
                      why_not.c_str());
         return 1;
     }
-    Handle h = it->create();
+    Handle h;
+    if (o.resume.empty()) {
+        h = it->create();
+    } else if (lpi_load(h.out(), o.resume.c_str()) != LPI_OK) {
+        std::fprintf(stderr, "lpi run: --resume: %s\n", lpi_last_error(nullptr));
+        return 1;
+    }
     lpi_system *sys = h.get();
     if (!o.method.empty()) check(lpi_set_method(sys, o.method.c_str()), sys, "--method");
     if (o.threads != 1) check(lpi_set_threads(sys, o.threads), sys, "--threads");
     const double until = o.until > 0 ? o.until : it->final_time;
-    const int64_t total = o.steps >= 0 ? o.steps : std::llround(until / o.dt);
+    const int64_t total =
+        o.steps >= 0 ? o.steps : std::max<int64_t>(0, std::llround((until - lpi_time(sys)) / o.dt));
     const int64_t every = o.every > 0 ? o.every : std::max<int64_t>(1, total / 100);
     int32_t N = 0;
     const bool vorticity = lpi_sine_euler_size(sys, &N) == LPI_OK;
 
     mkdir(o.out_dir.c_str(), 0777);
     const std::string csv = o.out_dir + "/" + o.scene + ".csv";
-    FILE *f = std::fopen(csv.c_str(), "w");
+    const bool append = !o.resume.empty() && access(csv.c_str(), F_OK) == 0;
+    FILE *f = std::fopen(csv.c_str(), append ? "a" : "w");
     if (!f) {
         std::fprintf(stderr, "lpi run: cannot write %s\n", csv.c_str());
         return 1;
     }
+    // On --resume the step column continues from the saved time; the energy
+    // error is relative to the energy where this run starts.
+    const int64_t first_step = std::llround(lpi_time(sys) / o.dt);
     const double H0 = energy_of(sys);
     std::vector<double> c = casimirs_of(sys);
-    std::fprintf(f, "step,time,energy,energy_error");
-    for (std::size_t i = 0; i < c.size(); ++i) std::fprintf(f, ",casimir_%zu", i);
-    std::fprintf(f, "\n");
+    if (!append) {
+        std::fprintf(f, "step,time,energy,energy_error");
+        for (std::size_t i = 0; i < c.size(); ++i) std::fprintf(f, ",casimir_%zu", i);
+        std::fprintf(f, "\n");
+    }
     auto row = [&](int64_t step) {
         const double H = energy_of(sys);
         c = casimirs_of(sys);
-        std::fprintf(f, "%lld,%.17g,%.17g,%.6e", static_cast<long long>(step), lpi_time(sys), H,
+        std::fprintf(f, "%lld,%.17g,%.17g,%.6e", static_cast<long long>(first_step + step), lpi_time(sys), H,
                      (H - H0) / std::fabs(H0));
         for (double v : c) std::fprintf(f, ",%.17g", v);
         std::fprintf(f, "\n");
@@ -205,11 +230,19 @@ int run_command(int argc, char **argv) {
     std::printf("lpi run %s: %lld steps of %g with %s, output every %lld steps\n", o.scene.c_str(),
                 static_cast<long long>(total), o.dt, o.method.empty() ? "leapfrog" : o.method.c_str(),
                 static_cast<long long>(every));
+    int64_t rows = 0;
+    auto save = [&](bool last) {
+        if (o.checkpoint.empty()) return;
+        if (!last && (o.checkpoint_every <= 0 || rows % o.checkpoint_every != 0)) return;
+        const int status = lpi_save(sys, o.checkpoint.c_str());
+        if (status != LPI_OK)
+            std::fprintf(stderr, "\nlpi run: checkpoint not written: %s\n", lpi_last_error(sys));
+    };
     Progress progress(total);
-    row(0);
+    if (!append) row(0);
     snapshot(0);
     const double t0 = cpu_seconds();
-    int64_t done = 0, rows = 0;
+    int64_t done = 0;
     while (done < total) {
         const int64_t n = std::min(every, total - done);
         const int status = lpi_step(sys, o.dt, n);
@@ -224,10 +257,13 @@ int run_command(int argc, char **argv) {
         done += n;
         row(done);
         snapshot(++rows);
+        save(false);
         progress.update(done, cpu_seconds() - t0);
     }
     progress.finish();
     std::fclose(f);
+    save(true);
+    if (!o.checkpoint.empty()) std::printf("checkpoint: %s\n", o.checkpoint.c_str());
     const double H = energy_of(sys);
     std::printf("done: t = %g, %.3f CPU seconds, relative energy error %.3e; wrote %s\n", lpi_time(sys),
                 cpu_seconds() - t0, (H - H0) / std::fabs(H0), csv.c_str());
