@@ -7,6 +7,7 @@
 
 #include "report.hpp"
 #include "scenes.hpp"
+#include "stress.hpp"
 
 using namespace lpi_cli;
 
@@ -18,6 +19,9 @@ void print_usage(FILE *to) {
                  "           error against CPU time for every applicable method over a sweep of\n"
                  "           step sizes; prints a table and writes CSV and PNG files to DIR\n"
                  "           (default ./lpi-report). Without SCENE: the default scenes.\n"
+                 "       lpi stress [--quick] [FILTER]\n"
+                 "           stiff and extreme cases against every applicable method: bounded,\n"
+                 "           energy error, Casimir drift and status per case, step and method\n"
                  "       lpi --version | --help\n"
                  "scenes:\n");
     for (const Scene &s : builtin_scenes())
@@ -78,6 +82,7 @@ int main(int argc, char **argv) {
         return 0;
     }
     if (command == "report") return report_command(argc - 2, argv + 2);
+    if (command == "stress") return stress_command(argc - 2, argv + 2);
     std::fprintf(stderr, "lpi: unknown command '%s'\n", command.c_str());
     print_usage(stderr);
     return 2;

@@ -222,7 +222,11 @@ public:
         gradient(x);
         for (SparseEntry &e : entries_) e.value = 0.0;
         for (const Contribution &k : contributions_) entries_[k.entry].value += k.c * g_[k.p];
-        workspace_.apply(constants_.dim(), entries_, t, x);
+        try {
+            workspace_.apply(constants_.dim(), entries_, t, x);
+        } catch (const Error &e) {
+            fail(e.status(), std::string(e.what()) + " in " + label());
+        }
     }
 
     double energy(const double *x) const override {
