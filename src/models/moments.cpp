@@ -41,7 +41,8 @@ constexpr Bracket kMomentBrackets[] = {
 // exponent range (1e4932) holds the products of entries up to 1e308, so a
 // finite state never gives a NaN from inf - inf, and a Casimir whose value
 // is representable is returned even when its terms are not (entries near
-// 1e150: K ~ 1e450 terms); one that is not representable becomes +-inf.
+// 1e150: K ~ 1e450 terms); one that is not representable becomes +-inf,
+// which lpi_casimirs reports as LPI_ERR_NONFINITE naming the Casimir.
 // Where long double is double, the same code is the plain double formula.
 template <class Real>
 Real invariant_I(const Real *x) {
@@ -186,8 +187,8 @@ std::unique_ptr<GenericModel> make_moments() {
     }
     auto model = std::make_unique<GenericModel>(
         std::make_unique<StructureConstants>(8, count, i, j, k, c), "moments");
-    model->add_casimir(casimir_I, nullptr);
-    model->add_casimir(casimir_K, nullptr);
+    model->add_builtin_casimir(casimir_I, "I = x4 x8 - 4 x5 x7 + 3 x6^2");
+    model->add_builtin_casimir(casimir_K, "K = det [[x4,x5,x6],[x5,x6,x7],[x6,x7,x8]]");
     return model;
 }
 
