@@ -3,6 +3,10 @@
 #   make            build            make check   build and run every test
 #   make run        the demonstration report      make bench   the benchmarks
 #   make install PREFIX=/usr/local [DESTDIR=...]  make clean
+#   make check-asan      every test under AddressSanitizer + UBSan (build-asan)
+#   make check-tsan      the threads test under ThreadSanitizer (build-tsan)
+#   make check-valgrind  the cmocka tests under valgrind, no leaks allowed
+#   make fuzz FUZZ_SECONDS=60  the libFuzzer harness from its corpus (clang)
 BUILD      ?= build
 BUILD_TYPE ?= Release
 PREFIX     ?= /usr/local
@@ -10,7 +14,8 @@ JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_ARGS ?=
 VERSION    := $(shell sed -n 's/^\#define LPI_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\).*/\2/p' include/liepoisson.h | paste -sd.)
 
-.PHONY: all build deps configure check run bench install clean version
+.PHONY: all build deps configure check run bench install clean version \
+        check-asan check-tsan check-valgrind fuzz
 
 all: build
 
@@ -38,6 +43,38 @@ install: build
 
 clean:
 	@rm -rf $(BUILD)
+
+# Sanitized builds live in their own directories. RelWithDebInfo keeps the
+# suite's run time reasonable while reports still carry lines.
+check-asan: deps
+	@cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLPI_SANITIZE=ON $(CMAKE_ARGS) >/dev/null
+	@cmake --build build-asan -j $(JOBS)
+	@cd build-asan && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	    ctest --output-on-failure -j $(JOBS)
+
+# OpenMP is left out: libgomp is not instrumented and would give false reports.
+check-tsan: deps
+	@cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLPI_TSAN=ON -DLPI_WITH_OPENMP=OFF $(CMAKE_ARGS) >/dev/null
+	@cmake --build build-tsan -j $(JOBS) --target test_threads test_sine_euler
+	@cd build-tsan && TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -R '^test_threads$$'
+
+# The cmocka tests of $(BUILD) under valgrind; VALGRIND_SKIP leaves out the
+# slowest (minutes each under valgrind; `make check-valgrind VALGRIND_SKIP=`
+# runs them all).
+VALGRIND_SKIP ?= test_compositions test_sine_euler
+check-valgrind: build
+	@set -e; for t in $(BUILD)/tests/test_* $(BUILD)/tests/example_user_system; do \
+	    name=$$(basename $$t); \
+	    [ -x "$$t" ] && [ -f "$$t" ] || continue; \
+	    case " $(VALGRIND_SKIP) " in *" $$name "*) echo "valgrind: $$name skipped"; continue;; esac; \
+	    echo "valgrind: $$name"; \
+	    (cd $(BUILD)/tests && CMOCKA_MESSAGE_OUTPUT=stdout valgrind -q --leak-check=full \
+	        --errors-for-leak-kinds=definite,indirect --error-exitcode=1 ./$$name >/dev/null); \
+	done; echo "valgrind: no errors, no leaks"
+
+FUZZ_SECONDS ?= 60
+fuzz:
+	@tests/fuzz/run.sh $(FUZZ_SECONDS)
 
 version:
 	@echo $(VERSION)
