@@ -10,7 +10,7 @@
 //    round-off: relative drift at most a floor plus kDriftPerFlow per exact
 //    piece flow (a linear bound, the worst case of accumulated round-off; for
 //    generic systems times ||t A|| / 5.4, the error growth of scaling and
-//    squaring);
+//    squaring), judged on runs that stayed bounded;
 //  - every failure (rk4 beyond its stability limit, implicit-midpoint not
 //    converging) is a documented status with the state rolled back bit for bit.
 //
@@ -64,11 +64,6 @@ struct Case {
     // stepping: LPI_ERR_NONFINITE where the exact flow of a piece overflows,
     // LPI_ERR_INVALID where a generic flow needs too many squarings.
     int allowed_failure = LPI_OK;
-    // Casimir drift is a must-hold check up to this dt/period. The moment
-    // algebra is not compact: its split flows are shears, and a composition
-    // with large substeps amplifies the round-off in I and K like the
-    // conditioning of its linear map (measured, not a defect of the flows).
-    double drift_checked_up_to = INFINITY;
 };
 
 constexpr double kDriftPerFlow = 1e-15;  // about 4.5 unit round-offs per flow
@@ -372,11 +367,15 @@ std::vector<Case> build_cases(bool quick) {
         k.factors = {1e-3, 0.1, 1.0, 1e3};
         k.steps = quick ? 100 : n;
         k.measure = moment_invariants;
-        // Beyond dt = 2 (a tenth of the substeps of the high-order methods)
-        // kick-drift splitting of the oscillator is linearly unstable: the
-        // composition itself grows and overflows, reported and rolled back.
+        // Round-off made while the ensemble is turned by 45 degrees (all
+        // entries ~ 1e150) stays in the state: checkpoints must see those
+        // phases, so their spacing is not commensurate with the period.
+        k.checkpoints = 97;
+        // Kick-drift splitting of the oscillator is linearly unstable for
+        // substeps beyond 2 (dt = 1 period, or less for compositions with
+        // large substeps): the numerical map itself grows until it
+        // overflows, which is reported and rolled back.
         k.allowed_failure = LPI_ERR_NONFINITE;
-        k.drift_checked_up_to = 1e-3;
         cases.push_back(k);
         k.name = "moments huge, entries near 1e150 (K ~ 1e450)";
         k.create = [] { return moments(1.0, 1e75, false); };
@@ -442,7 +441,7 @@ std::vector<Case> build_cases(bool quick) {
         if (!quick)
             add("sine-Euler N = 1021, a few steps", 1021, sine_field(1021, 17, any), {1e-2, 1e3}, 1,
                 {"leapfrog"});
-        add("sine-Euler N = 7, long run", 7, sine_field(7, 2024, any), {0.05},
+        add("sine-Euler N = 7, dt = 0.05 as in the paper, long run", 7, sine_field(7, 2024, any), {0.05},
             quick ? 10000 : 1000000, {"leapfrog"});
         cases.back().checkpoints = 10;
     }
@@ -504,7 +503,10 @@ int stress_command(int argc, char **argv) {
                     k.drift_floor + kDriftPerFlow * growth *
                                         static_cast<double>(o.flows_per_step) *
                                         static_cast<double>(o.steps_done);
-                if (poisson && factor <= k.drift_checked_up_to && !(o.casimir_drift <= tolerance))
+                // An unbounded run (an unstable composition of the moment
+                // algebra's shears) meets larger terms inside its steps than
+                // the checkpoints show: its drift is printed, not judged.
+                if (poisson && o.bounded && !(o.casimir_drift <= tolerance))
                     verdict += " !! Casimir drift";
                 if (!verdict.empty()) ++violations;
                 std::string status = lpi_status_name(o.status);
