@@ -225,7 +225,7 @@ public:
         try {
             workspace_.apply(constants_.dim(), entries_, t, x);
         } catch (const Error &e) {
-            fail(e.status(), std::string(e.what()) + " in " + label());
+            fail(e.status(), label() + ": " + e.what());
         }
     }
 
