@@ -4,6 +4,10 @@
 #   make run        the demonstration report      make bench   the benchmarks
 #   make install PREFIX=/usr/local [DESTDIR=...]  make clean
 #   make abi-baseline   rewrite abi/ from this build (an intended ABI change)
+#   make check-asan      every test under AddressSanitizer + UBSan (build-asan)
+#   make check-tsan      the threads test under ThreadSanitizer (build-tsan)
+#   make check-valgrind  the cmocka tests under valgrind, no leaks allowed
+#   make fuzz FUZZ_SECONDS=60  the libFuzzer harness from its corpus (clang)
 BUILD      ?= build
 BUILD_TYPE ?= Release
 PREFIX     ?= /usr/local
@@ -11,7 +15,8 @@ JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_ARGS ?=
 VERSION    := $(shell sed -n 's/^\#define LPI_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\).*/\2/p' include/liepoisson.h | paste -sd.)
 
-.PHONY: all build deps configure check run bench install clean version abi-baseline
+.PHONY: all build deps configure check run bench install clean version abi-baseline \
+        check-asan check-tsan check-valgrind fuzz
 
 all: build
 
@@ -42,6 +47,39 @@ abi-baseline: build
 
 clean:
 	@rm -rf $(BUILD)
+
+# Sanitized builds live in their own directories. RelWithDebInfo keeps the
+# suite's run time reasonable while reports still carry lines.
+check-asan: deps
+	@cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLPI_SANITIZE=ON $(CMAKE_ARGS) >/dev/null
+	@cmake --build build-asan -j $(JOBS)
+	@cd build-asan && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	    ctest --output-on-failure -j $(JOBS)
+
+# OpenMP is left out: libgomp is not instrumented and would give false reports.
+check-tsan: deps
+	@cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLPI_TSAN=ON -DLPI_WITH_OPENMP=OFF $(CMAKE_ARGS) >/dev/null
+	@cmake --build build-tsan -j $(JOBS) --target test_threads
+	@cd build-tsan && TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -R '^test_threads$$'
+
+# The cmocka tests of $(BUILD) under valgrind. VALGRIND_SKIP leaves out the
+# two slowest (minutes each under valgrind) and test_expm, whose long double
+# references need x87 80-bit arithmetic that valgrind performs in 64 bits
+# (its assertions then fail). `make check-valgrind VALGRIND_SKIP=` runs all.
+VALGRIND_SKIP ?= test_compositions test_sine_euler test_expm
+check-valgrind: build
+	@set -e; for t in $(BUILD)/tests/test_* $(BUILD)/tests/example_user_system; do \
+	    name=$$(basename $$t); \
+	    [ -x "$$t" ] && [ -f "$$t" ] || continue; \
+	    case " $(VALGRIND_SKIP) " in *" $$name "*) echo "valgrind: $$name skipped"; continue;; esac; \
+	    echo "valgrind: $$name"; \
+	    (cd $(BUILD)/tests && CMOCKA_MESSAGE_OUTPUT=stdout valgrind -q --leak-check=full \
+	        --errors-for-leak-kinds=definite,indirect --error-exitcode=1 ./$$name >/dev/null); \
+	done; echo "valgrind: no errors, no leaks"
+
+FUZZ_SECONDS ?= 60
+fuzz:
+	@tests/fuzz/run.sh $(FUZZ_SECONDS)
 
 version:
 	@echo $(VERSION)

@@ -9,6 +9,7 @@
 #include "report.hpp"
 #include "run.hpp"
 #include "scenes.hpp"
+#include "stress.hpp"
 
 using namespace lpi_cli;
 
@@ -22,6 +23,9 @@ void print_usage(FILE *to) {
                  "           (default ./lpi-report). Without SCENE: the default scenes.\n"
                  "           --N sets the sine-Euler scene's N (odd, default 31).\n"
                  "       lpi run SCENE [options]   integrate one scene; lpi run --help for the options\n"
+                 "       lpi stress [--quick] [FILTER]\n"
+                 "           stiff and extreme cases against every applicable method: bounded,\n"
+                 "           energy error, Casimir drift and status per case, step and method\n"
                  "       lpi --version | --help\n"
                  "scenes:\n");
     for (const Scene &s : builtin_scenes())
@@ -86,6 +90,7 @@ int main(int argc, char **argv) {
     }
     if (command == "report") return report_command(argc - 2, argv + 2);
     if (command == "run") return run_command(argc - 2, argv + 2);
+    if (command == "stress") return stress_command(argc - 2, argv + 2);
     std::fprintf(stderr, "lpi: unknown command '%s'\n", command.c_str());
     print_usage(stderr);
     return 2;

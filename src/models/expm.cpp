@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <limits>
 
 #include "../core/error.hpp"
@@ -199,6 +201,14 @@ void expm1_dense(std::size_t n, const double *A, double *W) {
     }
 }
 
+void ExpmWorkspace::check_finite(std::size_t m) const {
+    // x is left untouched when the exact flow is not representable.
+    for (std::size_t v = 0; v < m; ++v)
+        if (!std::isfinite(increment_[v]))
+            fail(LPI_ERR_NONFINITE, "the exact flow overflows (component " +
+                                        std::to_string(active_[v]) + ")");
+}
+
 long ExpmWorkspace::topological_depth() {
     // Kahn's algorithm on edges col -> row (x_col drives x_row). A cycle
     // (a self-loop included) means the pattern does not force nilpotency.
@@ -268,23 +278,43 @@ ExpmPath ExpmWorkspace::apply(std::size_t n, const std::vector<SparseEntry> &ent
             term_.swap(next_);
         }
         // One rounding on x: the increment is summed first.
+        check_finite(m);
         for (std::size_t v = 0; v < m; ++v) x[active_[v]] += increment_[v];
         return ExpmPath::Nilpotent;
     }
 
     dense_.assign(m * m, 0.0);
     for (const SparseEntry &e : local_) dense_[e.row * m + e.col] += e.value;
+    // Each squaring doubles the relative error of the computed exponential
+    // (for a rotation: its departure from orthogonality, which the Casimirs
+    // see), so beyond kMaxSquarings the flow is refused rather than returned
+    // with a Casimir error above about 2^kMaxSquarings unit round-offs.
+    const double norm = norm1(m, dense_.data());
+    if (!std::isfinite(norm))
+        fail(LPI_ERR_NONFINITE, "the matrix t A of the exact flow overflows (t = " +
+                                    std::to_string(t) + ")");
+    if (norm > std::ldexp(kDegrees[4].theta, kMaxSquarings)) {
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      "the step is too large for the exact flow: ||t A||_1 = %.3g needs more "
+                      "than 2^%d squarings in the matrix exponential; reduce dt",
+                      norm, kMaxSquarings);
+        fail(LPI_ERR_INVALID, text);
+    }
     exp_.resize(m * m);
     expm1_dense(m, dense_.data(), exp_.data());
     // x += (exp(tA) - I) x: the increment carries its own small rounding
     // errors, and x is rounded once (as in the nilpotent branch).
     term_.resize(m);
     for (std::size_t v = 0; v < m; ++v) term_[v] = x[active_[v]];
+    increment_.assign(m, 0.0);
     for (std::size_t r = 0; r < m; ++r) {
         double s = 0.0;
         for (std::size_t c = 0; c < m; ++c) s += exp_[r * m + c] * term_[c];
-        x[active_[r]] += s;
+        increment_[r] = s;
     }
+    check_finite(m);
+    for (std::size_t r = 0; r < m; ++r) x[active_[r]] += increment_[r];
     return ExpmPath::Pade;
 }
 

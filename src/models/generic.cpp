@@ -222,7 +222,11 @@ public:
         gradient(x);
         for (SparseEntry &e : entries_) e.value = 0.0;
         for (const Contribution &k : contributions_) entries_[k.entry].value += k.c * g_[k.p];
-        workspace_.apply(constants_.dim(), entries_, t, x);
+        try {
+            workspace_.apply(constants_.dim(), entries_, t, x);
+        } catch (const Error &e) {
+            fail(e.status(), label() + ": " + e.what());
+        }
     }
 
     double energy(const double *x) const override {
@@ -313,6 +317,10 @@ void GenericModel::casimirs(const double *state, double *out) const {
         if (rc != 0)
             fail(LPI_ERR_CALLBACK, "the callback of Casimir " + std::to_string(q) + " returned " +
                                        std::to_string(rc));
+        if (!std::isfinite(value) && !casimirs_[q].builtin.empty())
+            fail(LPI_ERR_NONFINITE, "Casimir " + std::to_string(q) + " (" + casimirs_[q].builtin +
+                                        ") is not representable at this state: it overflows a "
+                                        "double");
         if (!std::isfinite(value))
             fail(LPI_ERR_CALLBACK, "the callback of Casimir " + std::to_string(q) +
                                        " gave a non-finite value");
@@ -371,7 +379,11 @@ void GenericModel::add_piece(std::size_t n, const std::int32_t *indices, lpi_gra
 
 void GenericModel::add_casimir(lpi_casimir_fn fn, void *user) {
     if (!fn) fail(LPI_ERR_NULL, "the Casimir callback is NULL");
-    casimirs_.push_back({fn, user});
+    casimirs_.push_back({fn, user, std::string()});
+}
+
+void GenericModel::add_builtin_casimir(lpi_casimir_fn fn, const std::string &name) {
+    casimirs_.push_back({fn, nullptr, name});
 }
 
 std::vector<double> singular_values(std::size_t n, std::vector<double> M) {

@@ -68,6 +68,7 @@ private:
 struct CasimirCallback {
     lpi_casimir_fn fn;
     void *user;
+    std::string builtin;  // name of a built-in Casimir ("" for a user callback)
 };
 
 class GenericModel : public Model {
@@ -102,6 +103,9 @@ public:
     void add_piece(std::unique_ptr<Piece> piece) { pieces_.push_back(std::move(piece)); }
     void remove_last_piece() { pieces_.pop_back(); }
     void add_casimir(lpi_casimir_fn fn, void *user);
+    // A Casimir of the library's own: a non-finite value is an overflow of
+    // the state's scale (LPI_ERR_NONFINITE), not a failed callback.
+    void add_builtin_casimir(lpi_casimir_fn fn, const std::string &name);
 
     // "piece 3" for the next piece to be added.
     std::string next_piece_name() const { return "piece " + std::to_string(pieces_.size()); }

@@ -37,15 +37,35 @@ constexpr Bracket kMomentBrackets[] = {
     {1, 7, 7, 4},  {2, 3, 4, -8}, {2, 4, 5, -6}, {2, 5, 6, -4}, {2, 6, 7, -2},
 };
 
+// I and K are evaluated in long double: with x87 extended precision its
+// exponent range (1e4932) holds the products of entries up to 1e308, so a
+// finite state never gives a NaN from inf - inf, and a Casimir whose value
+// is representable is returned even when its terms are not (entries near
+// 1e150: K ~ 1e450 terms); one that is not representable becomes +-inf,
+// which lpi_casimirs reports as LPI_ERR_NONFINITE naming the Casimir.
+// Where long double is double, the same code is the plain double formula.
+template <class Real>
+Real invariant_I(const Real *x) {
+    return x[3] * x[7] - 4 * x[4] * x[6] + 3 * x[5] * x[5];
+}
+template <class Real>
+Real invariant_K(const Real *x) {
+    // det [[x4,x5,x6],[x5,x6,x7],[x6,x7,x8]] (paper numbering)
+    const Real a = x[3], b = x[4], c = x[5], d = x[6], e = x[7];
+    return a * (c * e - d * d) - b * (b * e - d * c) + c * (b * d - c * c);
+}
+
 int casimir_I(std::size_t, const double *x, double *out, void *) {
-    *out = x[3] * x[7] - 4.0 * x[4] * x[6] + 3.0 * x[5] * x[5];
+    long double wide[8];
+    std::copy(x, x + 8, wide);
+    *out = static_cast<double>(invariant_I(wide));
     return 0;
 }
 
 int casimir_K(std::size_t, const double *x, double *out, void *) {
-    // det [[x4,x5,x6],[x5,x6,x7],[x6,x7,x8]] (paper numbering)
-    const double a = x[3], b = x[4], c = x[5], d = x[6], e = x[7];
-    *out = a * (c * e - d * d) - b * (b * e - d * c) + c * (b * d - c * c);
+    long double wide[8];
+    std::copy(x, x + 8, wide);
+    *out = static_cast<double>(invariant_K(wide));
     return 0;
 }
 
@@ -57,6 +77,9 @@ public:
 
     void flow(double t, double *x) override {
         const double b = x[0], a = x[2];
+        if (!std::isfinite(a * b))
+            fail(LPI_ERR_NONFINITE, "x1 x3 = " + std::to_string(b) + " * " + std::to_string(a) +
+                                        " overflows in " + label());
         const double mu = derivative(a * b);
         const double lambda = 4.0 * x[1] * mu;
 
@@ -164,8 +187,8 @@ std::unique_ptr<GenericModel> make_moments() {
     }
     auto model = std::make_unique<GenericModel>(
         std::make_unique<StructureConstants>(8, count, i, j, k, c), "moments");
-    model->add_casimir(casimir_I, nullptr);
-    model->add_casimir(casimir_K, nullptr);
+    model->add_builtin_casimir(casimir_I, "I = x4 x8 - 4 x5 x7 + 3 x6^2");
+    model->add_builtin_casimir(casimir_K, "K = det [[x4,x5,x6],[x5,x6,x7],[x6,x7,x8]]");
     return model;
 }
 
