@@ -153,19 +153,22 @@ void apply_phase(int N, int count, const double *up, const double *down, double 
 // -(o + i) mod N of lane -s. Rows: lane s starts at s N and positions step by
 // 1; columns: lane s starts at s and positions step by N.
 
-template <bool Rows>
-inline void gather_runs(int N, int slope, int d0, int count, const double *w, double *x) {
+// Count > 0: the block size, known at compile time (full blocks); 0: count.
+template <bool Rows, int Count>
+inline void gather_runs(int N, int slope, int d0, int count, const double *__restrict w,
+                        double *__restrict x) {
     const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
+    const int n = Count > 0 ? Count : count;
     int o = d0;
     for (int s = 0; s < N; ++s) {
         const double *src = w + 2 * lane * s;
-        double *dst = x + 2 * s * count;
-        const int first = std::min(count, N - o);  // the run wraps at most once
+        double *dst = x + 2 * s * n;
+        const int first = o <= N - n ? n : N - o;  // the run wraps at most once
         for (int i = 0; i < first; ++i) {
             dst[2 * i] = src[2 * step * (o + i)];
             dst[2 * i + 1] = src[2 * step * (o + i) + 1];
         }
-        for (int i = first; i < count; ++i) {
+        for (int i = first; i < n; ++i) {
             dst[2 * i] = src[2 * step * (o + i - N)];
             dst[2 * i + 1] = src[2 * step * (o + i - N) + 1];
         }
@@ -176,34 +179,43 @@ inline void gather_runs(int N, int slope, int d0, int count, const double *w, do
 
 // Writes n values at positions p0 .. p0+n-1 (p0 + n <= N) of a lane and their
 // conjugates at positions -(p0 + r) mod N of the mirror lane.
-inline void put_run(int N, std::size_t step, int p0, int n, const double *src, double *lane, double *mirror) {
+inline void put_run(int N, std::size_t step, int p0, int n, const double *__restrict src,
+                    double *__restrict lane, double *__restrict mirror) {
+    if (n <= 0) return;
     for (int r = 0; r < n; ++r) {
         lane[2 * step * (p0 + r)] = src[2 * r];
         lane[2 * step * (p0 + r) + 1] = src[2 * r + 1];
     }
-    int r = 0;
-    if (p0 == 0 && n > 0) {  // position 0 is its own mirror position
+    int r0 = 0;
+    if (p0 == 0) {  // position 0 is its own mirror position
         mirror[0] = src[0];
         mirror[1] = -src[1];
-        r = 1;
+        r0 = 1;
     }
-    double *m = mirror + 2 * step * (N - p0);  // position N - p0 - r, r >= 1
-    for (; r < n; ++r) {
-        m[-2 * static_cast<std::ptrdiff_t>(step * r)] = src[2 * r];
-        m[-2 * static_cast<std::ptrdiff_t>(step * r) + 1] = -src[2 * r + 1];
+    // Upwards through the mirror lane: position N - p0 - r, r = n-1 .. r0.
+    double *m = mirror + 2 * step * (N - p0 - (n - 1));
+    const double *z = src + 2 * (n - 1);
+    for (int q = 0; q < n - r0; ++q) {
+        m[2 * step * q] = z[-2 * q];
+        m[2 * step * q + 1] = -z[-2 * q + 1];
     }
 }
 
-template <bool Rows>
-inline void scatter_runs(int N, int slope, int d0, int count, const double *x, double *w) {
+template <bool Rows, int Count>
+inline void scatter_runs(int N, int slope, int d0, int count, const double *__restrict x, double *w) {
     const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
+    const int n = Count > 0 ? Count : count;
     int o = d0;
     for (int s = 0; s < N; ++s) {
-        const double *src = x + 2 * s * count;
+        const double *src = x + 2 * s * n;
         double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
-        const int first = std::min(count, N - o);
-        put_run(N, step, o, first, src, dst, mirror);
-        put_run(N, step, 0, count - first, src + 2 * first, dst, mirror);
+        if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
+            put_run(N, step, o, n, src, dst, mirror);
+        } else {
+            const int first = std::min(n, N - o);
+            put_run(N, step, o, first, src, dst, mirror);
+            put_run(N, step, 0, n - first, src + 2 * first, dst, mirror);
+        }
         o += slope;
         if (o >= N) o -= N;
     }
@@ -260,8 +272,14 @@ inline void scatter_general(const Direction &D, int N, int d0, int count, const 
 LPI_SIMD_CLONES
 void gather_block(const Direction &D, int N, int d0, int count, const double *w, double *x) {
     switch (D.layout) {
-        case Direction::Row: gather_runs<true>(N, D.k2, d0, count, w, x); break;
-        case Direction::Column: gather_runs<false>(N, D.k1, d0, count, w, x); break;
+        case Direction::Row:
+            if (count == kBlock) gather_runs<true, kBlock>(N, D.k2, d0, count, w, x);
+            else gather_runs<true, 0>(N, D.k2, d0, count, w, x);
+            break;
+        case Direction::Column:
+            if (count == kBlock) gather_runs<false, kBlock>(N, D.k1, d0, count, w, x);
+            else gather_runs<false, 0>(N, D.k1, d0, count, w, x);
+            break;
         case Direction::General: gather_general(D, N, d0, count, w, x); break;
     }
 }
@@ -269,8 +287,14 @@ void gather_block(const Direction &D, int N, int d0, int count, const double *w,
 LPI_SIMD_CLONES
 void scatter_block(const Direction &D, int N, int d0, int count, const double *x, double *w) {
     switch (D.layout) {
-        case Direction::Row: scatter_runs<true>(N, D.k2, d0, count, x, w); break;
-        case Direction::Column: scatter_runs<false>(N, D.k1, d0, count, x, w); break;
+        case Direction::Row:
+            if (count == kBlock) scatter_runs<true, kBlock>(N, D.k2, d0, count, x, w);
+            else scatter_runs<true, 0>(N, D.k2, d0, count, x, w);
+            break;
+        case Direction::Column:
+            if (count == kBlock) scatter_runs<false, kBlock>(N, D.k1, d0, count, x, w);
+            else scatter_runs<false, 0>(N, D.k1, d0, count, x, w);
+            break;
         case Direction::General: scatter_general(D, N, d0, count, x, w); break;
     }
 }
