@@ -127,8 +127,6 @@ struct Plans {
 // t * fl(1/N) would scale every mode by the same N fl(1/N) != 1 in every flow,
 // a drift of the Casimirs linear in time (measured: 3e-15 per step at N = 31,
 // against 1.5e-15 with the division).
-// The AVX2 clone computes the same IEEE operations (no FMA contraction):
-// results do not depend on which clone runs.
 LPI_SIMD_CLONES
 void apply_phase(int N, int count, const double *up, const double *down, double sign, double *x) {
     const double n_real = N;
@@ -179,8 +177,8 @@ inline void gather_runs(int N, int slope, int d0, int count, const double *__res
 
 // Writes n values at positions p0 .. p0+n-1 (p0 + n <= N) of a lane and their
 // conjugates at positions -(p0 + r) mod N of the mirror lane.
-inline void put_run(int N, std::size_t step, int p0, int n, const double *__restrict src,
-                    double *__restrict lane, double *__restrict mirror) {
+inline void put_run(int N, std::size_t step, int p0, int n, const double *__restrict src, double *lane,
+                    double *mirror) {
     if (n <= 0) return;
     for (int r = 0; r < n; ++r) {
         lane[2 * step * (p0 + r)] = src[2 * r];
