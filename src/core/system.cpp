@@ -1,6 +1,7 @@
 #include "system.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "error.hpp"
 
@@ -98,8 +99,10 @@ void System::step(double dt, std::int64_t nsteps) {
     }
     if (!finite) {
         state_.swap(saved_);
+        char step[32];
+        std::snprintf(step, sizeof step, "%.6g", dt);
         fail(LPI_ERR_NONFINITE, "method '" + method_.name + "' produced a non-finite state "
-                                "with dt = " + std::to_string(dt) + "; state rolled back");
+                                "with dt = " + step + "; state rolled back");
     }
     time_ = end_time;
 }
