@@ -111,7 +111,8 @@ struct Plans {
 // The hot loops are compiled twice on x86-64 with GCC, for AVX2 and for the
 // baseline, and the loader picks one for the CPU (FFTW does the same for its
 // own codelets). AVX2 without FMA: the same IEEE operations, the same bits.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__) && \
+    !defined(LPI_NO_SIMD_CLONES)
 #define LPI_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define LPI_SIMD_CLONES
