@@ -154,12 +154,12 @@ void apply_phase(int N, int count, const double *up, const double *down, double 
 
 // Count > 0: the block size, known at compile time (full blocks); 0: count.
 template <bool Rows, int Count>
-inline void gather_runs(int N, int slope, int d0, int count, const double *__restrict w,
-                        double *__restrict x) {
+inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
+                        const double *__restrict w, double *__restrict x) {
     const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
     const int n = Count > 0 ? Count : count;
-    int o = d0;
-    for (int s = 0; s < N; ++s) {
+    int o = static_cast<int>((d0 + static_cast<long>(first_lane) * slope) % N);
+    for (int k = 0, s = first_lane; k < N; ++k, s = s + 1 < N ? s + 1 : 0) {
         const double *src = w + 2 * lane * s;
         double *dst = x + 2 * s * n;
         const int first = o <= N - n ? n : N - o;  // the run wraps at most once
@@ -201,11 +201,12 @@ inline void put_run(int N, std::size_t step, int p0, int n, const double *__rest
 }
 
 template <bool Rows, int Count>
-inline void scatter_runs(int N, int slope, int d0, int count, const double *__restrict x, double *w) {
+inline void scatter_runs(int N, int slope, int d0, int count, int first_lane,
+                         const double *__restrict x, double *w) {
     const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
     const int n = Count > 0 ? Count : count;
-    int o = d0;
-    for (int s = 0; s < N; ++s) {
+    int o = static_cast<int>((d0 + static_cast<long>(first_lane) * slope) % N);
+    for (int k = 0, s = first_lane; k < N; ++k, s = s + 1 < N ? s + 1 : 0) {
         const double *src = x + 2 * s * n;
         double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
         if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
@@ -269,30 +270,32 @@ inline void scatter_general(const Direction &D, int N, int d0, int count, const 
 
 // These only move numbers (and negate): every clone gives the same bits.
 LPI_SIMD_CLONES
-void gather_block(const Direction &D, int N, int d0, int count, const double *w, double *x) {
+void gather_block(const Direction &D, int N, int d0, int count, int first_lane, const double *w,
+                  double *x) {
     switch (D.layout) {
         case Direction::Row:
-            if (count == kBlock) gather_runs<true, kBlock>(N, D.k2, d0, count, w, x);
-            else gather_runs<true, 0>(N, D.k2, d0, count, w, x);
+            if (count == kBlock) gather_runs<true, kBlock>(N, D.k2, d0, count, first_lane, w, x);
+            else gather_runs<true, 0>(N, D.k2, d0, count, first_lane, w, x);
             break;
         case Direction::Column:
-            if (count == kBlock) gather_runs<false, kBlock>(N, D.k1, d0, count, w, x);
-            else gather_runs<false, 0>(N, D.k1, d0, count, w, x);
+            if (count == kBlock) gather_runs<false, kBlock>(N, D.k1, d0, count, first_lane, w, x);
+            else gather_runs<false, 0>(N, D.k1, d0, count, first_lane, w, x);
             break;
         case Direction::General: gather_general(D, N, d0, count, w, x); break;
     }
 }
 
 LPI_SIMD_CLONES
-void scatter_block(const Direction &D, int N, int d0, int count, const double *x, double *w) {
+void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
+                   double *w) {
     switch (D.layout) {
         case Direction::Row:
-            if (count == kBlock) scatter_runs<true, kBlock>(N, D.k2, d0, count, x, w);
-            else scatter_runs<true, 0>(N, D.k2, d0, count, x, w);
+            if (count == kBlock) scatter_runs<true, kBlock>(N, D.k2, d0, count, first_lane, x, w);
+            else scatter_runs<true, 0>(N, D.k2, d0, count, first_lane, x, w);
             break;
         case Direction::Column:
-            if (count == kBlock) scatter_runs<false, kBlock>(N, D.k1, d0, count, x, w);
-            else scatter_runs<false, 0>(N, D.k1, d0, count, x, w);
+            if (count == kBlock) scatter_runs<false, kBlock>(N, D.k1, d0, count, first_lane, x, w);
+            else scatter_runs<false, 0>(N, D.k1, d0, count, first_lane, x, w);
             break;
         case Direction::General: scatter_general(D, N, d0, count, x, w); break;
     }
@@ -383,7 +386,8 @@ private:
     int block_count() const { return (M_ + kBlock - 1) / kBlock; }
     void build_directions();
     void ensure_plans();
-    bool line_spectrum(const Direction &D, double t, const double *w);
+    bool line_spectrum(const Direction &D, const double *w);
+    void line_phase(int l, double factor);
     void move_block(const Direction &D, int block, fftw_complex *X, double *w) const;
 
     int N_, M_;
@@ -489,11 +493,9 @@ void SineEuler::ensure_plans() {
     }
 }
 
-// b_s = w_sk / |sk|^2 on the owned modes, B = FFT(b), u_l = exp(i t B_l / (2 eps)),
-// stored three times over, forwards and backwards, so that u_{l-c} and u_{l+c}
-// need no reduction mod N and run forwards along the lines of a block.
-// Returns false when every b_s is zero.
-bool SineEuler::line_spectrum(const Direction &D, double t, const double *w) {
+// b_s = w_sk / |sk|^2 on the owned modes, B = FFT(b) (real). Returns false
+// when every b_s is zero.
+bool SineEuler::line_spectrum(const Direction &D, const double *w) {
     const int N = N_;
     fftw_complex *b = plans_->b;
     int a = 0, c = 0;
@@ -514,20 +516,25 @@ bool SineEuler::line_spectrum(const Direction &D, double t, const double *w) {
     }
     if (!active) return false;
     fftw_execute_dft(plans_->b_forward, b, b);
-    const double factor = t / (2.0 * eps_);
-    double *up = plans_->up, *down = plans_->down;
-    for (int l = 0; l < N; ++l) {
-        const double angle = factor * b[l][0];
-        const double cs = std::cos(angle), sn = std::sin(angle);
-        const int minus = l == 0 ? 0 : N - l;
-        for (int copy = 0; copy < 3; ++copy) {
-            up[2 * (l + copy * N)] = cs;
-            up[2 * (l + copy * N) + 1] = sn;
-            down[2 * (minus + copy * N)] = cs;
-            down[2 * (minus + copy * N) + 1] = sn;
-        }
-    }
     return true;
+}
+
+// u_l = exp(i t B_l / (2 eps)) with factor = t / (2 eps), stored three times
+// over, forwards and backwards, so that u_{l-c} and u_{l+c} need no reduction
+// mod N and run forwards along the lines of a block. Each l writes its own
+// entries only, so threads may share the loop over l.
+void SineEuler::line_phase(int l, double factor) {
+    const int N = N_;
+    double *up = plans_->up, *down = plans_->down;
+    const double angle = factor * plans_->b[l][0];
+    const double cs = std::cos(angle), sn = std::sin(angle);
+    const int minus = l == 0 ? 0 : N - l;
+    for (int copy = 0; copy < 3; ++copy) {
+        up[2 * (l + copy * N)] = cs;
+        up[2 * (l + copy * N) + 1] = sn;
+        down[2 * (minus + copy * N)] = cs;
+        down[2 * (minus + copy * N) + 1] = sn;
+    }
 }
 
 // Lines d = d0 .. d0+count-1 of direction D: gather z_s = w_{d j + s k} into
@@ -539,11 +546,16 @@ void SineEuler::move_block(const Direction &D, int block, fftw_complex *X, doubl
     const int count = std::min(kBlock, M_ - block * kBlock);
     const int plan = count == kBlock ? 0 : 1;
     double *x = &X[0][0];
-    gather_block(D, N_, d0, count, w, x);
+    // Blocks start at different lanes, so that threads working on different
+    // blocks are not in the same lane of w at the same moment (the lanes meet
+    // at the blocks' edges, in shared cache lines). Every mode is written
+    // once per flow, so the order changes no bit.
+    const int first_lane = static_cast<int>(static_cast<long>(block) * N_ / block_count());
+    gather_block(D, N_, d0, count, first_lane, w, x);
     fftw_execute_dft(plans_->forward[plan], X, X);
     apply_phase(N_, count, plans_->up + 2 * (N_ + d0), plans_->down + 2 * (N_ + d0), -D.sigma, x);
     fftw_execute_dft(plans_->backward[plan], X, X);
-    scatter_block(D, N_, d0, count, x, w);
+    scatter_block(D, N_, d0, count, first_lane, x, w);
 }
 
 void SineEuler::flow(std::size_t piece, double t, double *state) {
@@ -551,18 +563,30 @@ void SineEuler::flow(std::size_t piece, double t, double *state) {
     const Direction &D = dirs_[piece];
     // A piece whose modes are all zero has H_k = 0: its flow is the identity
     // (taken exactly, not through a round trip of FFTs).
-    if (!line_spectrum(D, t, state)) return;
+    if (!line_spectrum(D, state)) return;
     const int blocks = block_count();
+    const double factor = t / (2.0 * eps_);
+    // One parallel region per flow: the phases, then the blocks of lines (the
+    // implicit barrier between the two loops orders them).
 #if LPI_HAVE_OPENMP
-#pragma omp parallel for num_threads(threads_) schedule(static) if (threads_ > 1 && blocks > 1)
+#pragma omp parallel num_threads(threads_) if (threads_ > 1 && blocks > 1)
 #endif
-    for (int blk = 0; blk < blocks; ++blk) {
+    {
 #if LPI_HAVE_OPENMP
-        fftw_complex *X = plans_->blocks[omp_get_thread_num()];
+#pragma omp for schedule(static)
+#endif
+        for (int l = 0; l < N_; ++l) line_phase(l, factor);
+#if LPI_HAVE_OPENMP
+#pragma omp for schedule(static)
+#endif
+        for (int blk = 0; blk < blocks; ++blk) {
+#if LPI_HAVE_OPENMP
+            fftw_complex *X = plans_->blocks[omp_get_thread_num()];
 #else
-        fftw_complex *X = plans_->blocks[0];
+            fftw_complex *X = plans_->blocks[0];
 #endif
-        move_block(D, blk, X, state);
+            move_block(D, blk, X, state);
+        }
     }
 }
 
