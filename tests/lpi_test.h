@@ -81,6 +81,44 @@ static inline void lpi_test_rigid_body_field(const double *m, double *dm, const 
     dm[2] = m[0] * w[1] - m[1] * w[0];
 }
 
+/* The piece m_k^2 / (2 I_k) of a rigid body written as a generic system;
+ * user points at I_k. */
+static inline int lpi_test_axis_gradient(size_t n, const double *x, double *g, void *user) {
+    (void)n;
+    g[0] = x[0] / *(const double *)user;
+    return 0;
+}
+static inline int lpi_test_axis_energy(size_t n, const double *x, double *h, void *user) {
+    (void)n;
+    *h = 0.5 * x[0] * x[0] / *(const double *)user;
+    return 0;
+}
+
+/* Sine-Euler mode indices: the representative of a mod N in -M..M, and a mod N. */
+static inline int lpi_test_centred(int a, int N) { return a > N / 2 ? a - N : a; }
+static inline int lpi_test_mod(int a, int N) { return ((a % N) + N) % N; }
+
+/* A reproducible Hermitian sine-Euler field (modes in FFT order, 2 N^2
+ * doubles) with w_0 = 0 and amplitude scale / (1 + |m|^2), drawn from a
+ * linear congruential generator started at `state`. */
+static inline void lpi_test_random_field(int N, uint64_t state, double scale, double *w) {
+    memset(w, 0, sizeof(double) * 2 * (size_t)N * (size_t)N);
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const int ra = lpi_test_centred(a, N), rb = lpi_test_centred(b, N);
+            if (ra < 0 || (ra == 0 && rb <= 0)) continue;
+            double v[2];
+            for (int i = 0; i < 2; ++i) {
+                state = state * 6364136223846793005ull + 1442695040888963407ull;
+                v[i] = (double)(state >> 11) / 9007199254740992.0 - 0.5;
+            }
+            const double decay = scale / (1.0 + ra * ra + rb * rb);
+            const int m = a * N + b, minus = lpi_test_mod(-a, N) * N + lpi_test_mod(-b, N);
+            w[2 * m] = v[0] * decay, w[2 * m + 1] = v[1] * decay;
+            w[2 * minus] = v[0] * decay, w[2 * minus + 1] = -v[1] * decay;
+        }
+}
+
 /* Least-squares slope of log(error) against log(step). */
 static inline double lpi_fit_order(const double *steps, const double *errors, int count) {
     double sx = 0, sy = 0, sxx = 0, sxy = 0;

@@ -13,17 +13,6 @@ static const double kE2C[] = {-1, 1};
 
 static const double kInertia[3] = {1.0, 2.0, 3.0};
 
-/* m_k^2 / (2 I_k): user points at I_k. */
-static int axis_grad(size_t n, const double *x, double *g, void *user) {
-    (void)n;
-    g[0] = x[0] / *(const double *)user;
-    return 0;
-}
-static int axis_energy(size_t n, const double *x, double *h, void *user) {
-    (void)n;
-    *h = 0.5 * x[0] * x[0] / *(const double *)user;
-    return 0;
-}
 static int linear_grad(size_t n, const double *x, double *g, void *user) {
     (void)n; (void)x; (void)user;
     g[0] = 1.0;
@@ -55,7 +44,7 @@ static lpi_system *generic_rigid_body(void) {
     lpi_system *sys = NULL;
     assert_int_equal(lpi_generic_create(&sys, 3, 3, kSoI, kSoJ, kSoK, kSoC), LPI_OK);
     for (int32_t k = 0; k < 3; ++k)
-        assert_int_equal(lpi_add_piece(sys, 1, &k, axis_grad, axis_energy, (void *)&kInertia[k]),
+        assert_int_equal(lpi_add_piece(sys, 1, &k, lpi_test_axis_gradient, lpi_test_axis_energy, (void *)&kInertia[k]),
                          LPI_OK);
     assert_int_equal(lpi_add_casimir(sys, norm2_casimir, NULL), LPI_OK);
     return sys;
@@ -171,7 +160,7 @@ static void test_either_order_and_agreeing_duplicates(void **state) {
     lpi_system *sys = NULL, *reference = generic_rigid_body();
     assert_int_equal(lpi_generic_create(&sys, 3, 4, i, j, k, c), LPI_OK);
     for (int32_t a = 0; a < 3; ++a)
-        assert_int_equal(lpi_add_piece(sys, 1, &a, axis_grad, axis_energy, (void *)&kInertia[a]),
+        assert_int_equal(lpi_add_piece(sys, 1, &a, lpi_test_axis_gradient, lpi_test_axis_energy, (void *)&kInertia[a]),
                          LPI_OK);
     const double m0[3] = {1.0, 0.5, -0.3};
     assert_true(max_difference(sys, reference, "leapfrog", m0, 0.1, 1, 50) == 0.0);
@@ -273,30 +262,30 @@ static void test_add_piece_errors(void **state) {
     const int32_t pair[] = {0, 1}, out_of_range[] = {3}, negative[] = {-2}, duplicate[] = {2, 2};
     const int32_t ok = 0, four[] = {0, 1, 2, 0};
 
-    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 2, pair, axis_grad, axis_energy, NULL),
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 2, pair, lpi_test_axis_gradient, lpi_test_axis_energy, NULL),
                      LPI_ERR_NOT_ABELIAN, "lpi_add_piece");
     assert_non_null(strstr(lpi_last_error(sys), "indices 0 and 1 do not commute, {x_0, x_1} = -1 x_2"));
-    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, out_of_range, axis_grad, axis_energy, NULL),
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, out_of_range, lpi_test_axis_gradient, lpi_test_axis_energy, NULL),
                      LPI_ERR_INVALID, "lpi_add_piece");
     assert_non_null(strstr(lpi_last_error(sys), "indices[0] = 3 is outside 0..2"));
-    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, negative, axis_grad, axis_energy, NULL),
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, negative, lpi_test_axis_gradient, lpi_test_axis_energy, NULL),
                      LPI_ERR_INVALID, "lpi_add_piece");
-    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 2, duplicate, axis_grad, axis_energy, NULL),
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 2, duplicate, lpi_test_axis_gradient, lpi_test_axis_energy, NULL),
                      LPI_ERR_INVALID, "lpi_add_piece");
     assert_non_null(strstr(lpi_last_error(sys), "indices[0] and indices[1] are both 2"));
-    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 0, &ok, axis_grad, axis_energy, NULL),
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 0, &ok, lpi_test_axis_gradient, lpi_test_axis_energy, NULL),
                      LPI_ERR_INVALID, "lpi_add_piece");
-    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 4, four, axis_grad, axis_energy, NULL),
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 4, four, lpi_test_axis_gradient, lpi_test_axis_energy, NULL),
                      LPI_ERR_INVALID, "lpi_add_piece");
-    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, &ok, NULL, axis_energy, NULL), LPI_ERR_NULL,
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, &ok, NULL, lpi_test_axis_energy, NULL), LPI_ERR_NULL,
                      "lpi_add_piece");
     assert_non_null(strstr(lpi_last_error(sys), "gradient callback is NULL"));
-    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, &ok, axis_grad, NULL, NULL), LPI_ERR_NULL,
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, &ok, lpi_test_axis_gradient, NULL, NULL), LPI_ERR_NULL,
                      "lpi_add_piece");
     assert_non_null(strstr(lpi_last_error(sys), "energy callback is NULL"));
-    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, NULL, axis_grad, axis_energy, NULL), LPI_ERR_NULL,
+    LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, NULL, lpi_test_axis_gradient, lpi_test_axis_energy, NULL), LPI_ERR_NULL,
                      "lpi_add_piece");
-    LPI_ASSERT_FAILS(NULL, lpi_add_piece(NULL, 1, &ok, axis_grad, axis_energy, NULL), LPI_ERR_NULL,
+    LPI_ASSERT_FAILS(NULL, lpi_add_piece(NULL, 1, &ok, lpi_test_axis_gradient, lpi_test_axis_energy, NULL), LPI_ERR_NULL,
                      "lpi_add_piece");
     LPI_ASSERT_FAILS(sys, lpi_add_casimir(sys, NULL, NULL), LPI_ERR_NULL, "lpi_add_casimir");
     assert_int_equal(lpi_casimir_count(sys), 1);
@@ -317,7 +306,7 @@ static void test_add_piece_errors(void **state) {
     /* Built-in models have no user pieces. */
     lpi_system *rb = NULL;
     assert_int_equal(lpi_rigid_body_create(&rb, 1, 2, 3), LPI_OK);
-    LPI_ASSERT_FAILS(rb, lpi_add_piece(rb, 1, &ok, axis_grad, axis_energy, NULL),
+    LPI_ASSERT_FAILS(rb, lpi_add_piece(rb, 1, &ok, lpi_test_axis_gradient, lpi_test_axis_energy, NULL),
                      LPI_ERR_UNSUPPORTED, "lpi_add_piece");
     LPI_ASSERT_FAILS(rb, lpi_add_casimir(rb, norm2_casimir, NULL), LPI_ERR_UNSUPPORTED,
                      "lpi_add_casimir");
@@ -335,7 +324,7 @@ static void test_callback_failures_roll_back(void **state) {
         int calls = 0;
         const int32_t x0 = 0, x1 = 1;
         assert_int_equal(lpi_generic_create(&sys, 3, 3, kSoI, kSoJ, kSoK, kSoC), LPI_OK);
-        assert_int_equal(lpi_add_piece(sys, 1, &x0, axis_grad, axis_energy, (void *)&kInertia[0]),
+        assert_int_equal(lpi_add_piece(sys, 1, &x0, lpi_test_axis_gradient, lpi_test_axis_energy, (void *)&kInertia[0]),
                          LPI_OK);
         assert_int_equal(lpi_add_piece(sys, 1, &x1, failing_grad, failing_energy, &calls), LPI_OK);
         assert_int_equal(lpi_set_method(sys, methods[q]), LPI_OK);
@@ -353,7 +342,7 @@ static void test_callback_failures_roll_back(void **state) {
     lpi_system *sys = NULL;
     const int32_t x2 = 2;
     assert_int_equal(lpi_generic_create(&sys, 3, 3, kSoI, kSoJ, kSoK, kSoC), LPI_OK);
-    assert_int_equal(lpi_add_piece(sys, 1, &x2, nan_grad, axis_energy, (void *)&kInertia[2]), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 1, &x2, nan_grad, lpi_test_axis_energy, (void *)&kInertia[2]), LPI_OK);
     assert_int_equal(lpi_set_state(sys, m0, 3), LPI_OK);
     LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.1, 2), LPI_ERR_CALLBACK, "lpi_step");
     assert_non_null(strstr(lpi_last_error(sys), "piece 0 (indices {2}) gave a non-finite component 0"));

@@ -9,27 +9,9 @@
 
 typedef double complex cplx;
 
-static int rep(int a, int N) { return a > N / 2 ? a - N : a; }
-static int mod(int a, int N) { return ((a % N) + N) % N; }
-
 /* A reproducible Hermitian field with w_0 = 0 and spectrum ~ 1/|m|^2 decay. */
 static void random_field(int N, unsigned seed, double *w) {
-    uint64_t state = 0x9E3779B97F4A7C15ull ^ seed;
-    memset(w, 0, sizeof(double) * 2 * N * N);
-    for (int a = 0; a < N; ++a)
-        for (int b = 0; b < N; ++b) {
-            const int ra = rep(a, N), rb = rep(b, N);
-            if (ra < 0 || (ra == 0 && rb <= 0)) continue;
-            double v[2];
-            for (int i = 0; i < 2; ++i) {
-                state = state * 6364136223846793005ull + 1442695040888963407ull;
-                v[i] = (double)(state >> 11) / 9007199254740992.0 - 0.5;
-            }
-            const double decay = 1.0 / (1.0 + ra * ra + rb * rb);
-            const int m = a * N + b, minus = mod(-a, N) * N + mod(-b, N);
-            w[2 * m] = v[0] * decay, w[2 * m + 1] = v[1] * decay;
-            w[2 * minus] = v[0] * decay, w[2 * minus + 1] = -v[1] * decay;
-        }
+    lpi_test_random_field(N, 0x9E3779B97F4A7C15ull ^ seed, 1.0, w);
 }
 
 static double max_abs_diff(const double *a, const double *b, size_t n) {
@@ -48,11 +30,11 @@ static void eq5_rate(int N, const cplx *w, cplx *rate) {
             cplx sum = 0;
             for (int n1 = 0; n1 < N; ++n1)
                 for (int n2 = 0; n2 < N; ++n2) {
-                    const int r1 = rep(n1, N), r2 = rep(n2, N);
+                    const int r1 = lpi_test_centred(n1, N), r2 = lpi_test_centred(n2, N);
                     if (r1 == 0 && r2 == 0) continue;
-                    const double cross = (double)rep(a, N) * r2 - (double)rep(b, N) * r1;
+                    const double cross = (double)lpi_test_centred(a, N) * r2 - (double)lpi_test_centred(b, N) * r1;
                     sum += sin(eps * cross) / (eps * (r1 * r1 + r2 * r2)) *
-                           w[mod(a + n1, N) * N + mod(b + n2, N)] * w[mod(-n1, N) * N + mod(-n2, N)];
+                           w[lpi_test_mod(a + n1, N) * N + lpi_test_mod(b + n2, N)] * w[lpi_test_mod(-n1, N) * N + lpi_test_mod(-n2, N)];
                 }
             rate[a * N + b] = sum;
         }
@@ -66,7 +48,7 @@ static void to_matrix(int N, const cplx *w, cplx *W) {
         for (int m2 = 0; m2 < N; ++m2) {
             const cplx phase = cexp(2 * M_PI * I * m1 * m2 / N);
             for (int b = 0; b < N; ++b) {
-                const int a = mod(b - m2, N); /* h^m2 e_b = e_{b-m2}, then g^m1 */
+                const int a = lpi_test_mod(b - m2, N); /* h^m2 e_b = e_{b-m2}, then g^m1 */
                 W[a * N + b] += w[m1 * N + m2] * phase * cexp(4 * M_PI * I * (double)m1 * a / N);
             }
         }
@@ -79,7 +61,7 @@ static void from_matrix(int N, const cplx *W, cplx *w) {
             const cplx phase = cexp(2 * M_PI * I * m1 * m2 / N);
             cplx sum = 0;
             for (int b = 0; b < N; ++b) {
-                const int a = mod(b - m2, N);
+                const int a = lpi_test_mod(b - m2, N);
                 sum += W[a * N + b] * conj(phase * cexp(4 * M_PI * I * (double)m1 * a / N));
             }
             w[m1 * N + m2] = sum / N;
@@ -92,7 +74,7 @@ static void matrix_rate(int N, const cplx *W, cplx *dW) {
     from_matrix(N, W, w);
     for (int a = 0; a < N; ++a)
         for (int b = 0; b < N; ++b) {
-            const int n2 = rep(a, N) * rep(a, N) + rep(b, N) * rep(b, N);
+            const int n2 = lpi_test_centred(a, N) * lpi_test_centred(a, N) + lpi_test_centred(b, N) * lpi_test_centred(b, N);
             w[a * N + b] = n2 ? w[a * N + b] / n2 : 0;
         }
     to_matrix(N, w, P);
@@ -289,10 +271,10 @@ static void test_single_line_is_steady(void **state) {
     memset(w, 0, sizeof w);
     const int k[2] = {2, 5};
     for (int s = 1; s <= N / 2; ++s) {
-        const int a = mod(s * k[0], N), b = mod(s * k[1], N);
+        const int a = lpi_test_mod(s * k[0], N), b = lpi_test_mod(s * k[1], N);
         const double re = cos(s), im = sin(3.0 * s) / s;
         w[2 * (a * N + b)] = re, w[2 * (a * N + b) + 1] = im;
-        w[2 * (mod(-a, N) * N + mod(-b, N))] = re, w[2 * (mod(-a, N) * N + mod(-b, N)) + 1] = -im;
+        w[2 * (lpi_test_mod(-a, N) * N + lpi_test_mod(-b, N))] = re, w[2 * (lpi_test_mod(-a, N) * N + lpi_test_mod(-b, N)) + 1] = -im;
     }
     w[0] = 0.25; /* the inert mean is kept as given */
     lpi_system *sys = sine_euler(N, w);
@@ -320,7 +302,7 @@ static void figure2_field(double *w) {
     double low_norm = 0, high_norm = 0, high_energy = 0; /* over the half plane */
     for (int a = 0; a < N; ++a)
         for (int b = 0; b < N; ++b) {
-            const int n2 = rep(a, N) * rep(a, N) + rep(b, N) * rep(b, N);
+            const int n2 = lpi_test_centred(a, N) * lpi_test_centred(a, N) + lpi_test_centred(b, N) * lpi_test_centred(b, N);
             const int i = a * N + b;
             const double p = w[2 * i] * w[2 * i] + w[2 * i + 1] * w[2 * i + 1];
             if (n2 == 1) {

@@ -7,27 +7,9 @@
  * systems refuse these methods. */
 #include "lpi_test.h"
 
-static int rep(int a, int N) { return a > N / 2 ? a - N : a; }
-static int mod(int a, int N) { return ((a % N) + N) % N; }
-
-/* A reproducible Hermitian field, w_0 = 0.3, amplitude ~ 1/(1 + |m|^2). */
+/* A reproducible Hermitian field, w_0 = 0.3, amplitude ~ 2/(1 + |m|^2). */
 static void random_field(int N, unsigned seed, double *w) {
-    uint64_t state = 0xD1B54A32D192ED03ull ^ seed;
-    memset(w, 0, sizeof(double) * 2 * N * N);
-    for (int a = 0; a < N; ++a)
-        for (int b = 0; b < N; ++b) {
-            const int ra = rep(a, N), rb = rep(b, N);
-            if (ra < 0 || (ra == 0 && rb <= 0)) continue;
-            double v[2];
-            for (int i = 0; i < 2; ++i) {
-                state = state * 6364136223846793005ull + 1442695040888963407ull;
-                v[i] = (double)(state >> 11) / 9007199254740992.0 - 0.5;
-            }
-            const double decay = 2.0 / (1.0 + ra * ra + rb * rb);
-            const int m = a * N + b, minus = mod(-a, N) * N + mod(-b, N);
-            w[2 * m] = v[0] * decay, w[2 * m + 1] = v[1] * decay;
-            w[2 * minus] = v[0] * decay, w[2 * minus + 1] = -v[1] * decay;
-        }
+    lpi_test_random_field(N, 0xD1B54A32D192ED03ull ^ seed, 2.0, w);
     w[0] = 0.3;
 }
 

@@ -170,16 +170,6 @@ static void test_baselines_fail_cleanly(void **state) {
 
 /* so(3) with every structure constant times `scale`. */
 static const double kInertia[3] = {1.0, 2.0, 3.0};
-static int axis_grad(size_t n, const double *x, double *g, void *user) {
-    (void)n;
-    g[0] = x[0] / *(const double *)user;
-    return 0;
-}
-static int axis_energy(size_t n, const double *x, double *h, void *user) {
-    (void)n;
-    *h = 0.5 * x[0] * x[0] / *(const double *)user;
-    return 0;
-}
 static int norm2_casimir(size_t dim, const double *x, double *out, void *user) {
     (void)user;
     *out = 0;
@@ -192,7 +182,7 @@ static lpi_system *generic_so3(double scale) {
     lpi_system *sys = NULL;
     assert_int_equal(lpi_generic_create(&sys, 3, 3, i, j, k, c), LPI_OK);
     for (int32_t a = 0; a < 3; ++a)
-        assert_int_equal(lpi_add_piece(sys, 1, &a, axis_grad, axis_energy, (void *)&kInertia[a]),
+        assert_int_equal(lpi_add_piece(sys, 1, &a, lpi_test_axis_gradient, lpi_test_axis_energy, (void *)&kInertia[a]),
                          LPI_OK);
     assert_int_equal(lpi_add_casimir(sys, norm2_casimir, NULL), LPI_OK);
     const double m[3] = {1.0, 0.5, -0.3};

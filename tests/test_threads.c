@@ -9,16 +9,6 @@
 
 enum { kKinds = 6, kCopies = 2, kMaxDim = 2 * 15 * 15 };
 
-static int axis_grad(size_t n, const double *x, double *g, void *user) {
-    (void)n;
-    g[0] = x[0] / *(const double *)user;
-    return 0;
-}
-static int axis_energy(size_t n, const double *x, double *h, void *user) {
-    (void)n;
-    *h = 0.5 * x[0] * x[0] / *(const double *)user;
-    return 0;
-}
 static int v_grad(size_t n, const double *x, double *g, void *user) {
     (void)n; (void)x; (void)user;
     g[0] = 0.5;
@@ -53,7 +43,7 @@ static int run_kind(int kind, double *out, size_t *n) {
         static const double c[] = {-1, 1, -1};
         status = lpi_generic_create(&sys, 3, 3, i, j, k, c);
         for (int32_t a = 0; a < 3 && status == LPI_OK; ++a)
-            status = lpi_add_piece(sys, 1, &a, axis_grad, axis_energy, (void *)&kInertia[a]);
+            status = lpi_add_piece(sys, 1, &a, lpi_test_axis_gradient, lpi_test_axis_energy, (void *)&kInertia[a]);
         x[0] = 1.0, x[1] = 0.5, x[2] = -0.3;
         break;
     }
