@@ -152,6 +152,12 @@ void write_history(const std::string &path, const std::map<std::string, std::vec
     std::fclose(f);
 }
 
+bool is_poisson(const std::string &method) {
+    for (int i = 0; i < lpi_method_count(); ++i)
+        if (method == lpi_method_name(i)) return lpi_method_is_poisson(i) == 1;
+    return false;
+}
+
 bool have_gnuplot() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
 
 // Draws the work-precision and energy plots with gnuplot from the CSV files.
@@ -167,18 +173,28 @@ bool plot(const std::string &dir, const Scene &scene, const std::vector<std::str
                  "set title '%s: error at T = %g against CPU time'\n"
                  "set xlabel 'CPU seconds'\nset ylabel 'error |x(T) - x_ref(T)|'\nplot ",
                  base.c_str(), scene.name.c_str(), scene.final_time);
+    // Each method its own colour and point shape; the baselines (not Poisson
+    // maps) dashed, so the two families read apart at a glance.
+    auto style = [&](std::size_t i) {
+        char text[96];
+        std::snprintf(text, sizeof text, "lc %zu pt %zu dt %d", i % 8 + 1, i % 13 + 1,
+                      is_poisson(methods[i]) ? 1 : 2);
+        return std::string(text);
+    };
     for (std::size_t i = 0; i < methods.size(); ++i)
         std::fprintf(f, "%s'%s.csv' using (strcol(2) eq '%s' && strcol(10) eq 'LPI_OK' ? $6 : 1/0):7 "
-                        "with linespoints title '%s'",
-                     i ? ", " : "", base.c_str(), methods[i].c_str(), methods[i].c_str());
+                        "with linespoints %s title '%s'",
+                     i ? ", " : "", base.c_str(), methods[i].c_str(), style(i).c_str(),
+                     methods[i].c_str());
     std::fprintf(f,
                  "\nset output '%s_energy.png'\nset title '%s: relative energy error against time'\n"
                  "unset logscale x\nset xlabel 'time'\nset ylabel '|H(t) - H(0)| / |H(0)|'\nplot ",
                  base.c_str(), scene.name.c_str());
     for (std::size_t i = 0; i < methods.size(); ++i)
         std::fprintf(f, "%s'%s_energy.csv' using (strcol(1) eq '%s' ? $3 : 1/0):($4 > 0 ? $4 : 1/0) "
-                        "with lines title '%s'",
-                     i ? ", " : "", base.c_str(), methods[i].c_str(), methods[i].c_str());
+                        "with lines lc %zu dt %d title '%s'",
+                     i ? ", " : "", base.c_str(), methods[i].c_str(), i % 8 + 1,
+                     is_poisson(methods[i]) ? 1 : 2, methods[i].c_str());
     std::fprintf(f, "\n");
     std::fclose(f);
     return std::system(("gnuplot '" + script + "' 2>/dev/null").c_str()) == 0;
