@@ -32,6 +32,19 @@ Method composition(std::string name, int order, std::vector<double> gammas,
     return m;
 }
 
+// A method that integrates the full vector field (or the matrix form): not a
+// Poisson map, one "stage" per step.
+Method baseline(const char *name, int order, MethodKind kind, const char *reference) {
+    Method m;
+    m.name = name;
+    m.order = order;
+    m.stages = 1;
+    m.reference = reference;
+    m.poisson = false;
+    m.kind = kind;
+    return m;
+}
+
 // The full weights of a symmetric composition from its independent half,
 // listed from the outermost stage to the centre stage (included, last):
 // {g1, ..., gm, c} -> {g1, ..., gm, c, gm, ..., g1}.
@@ -149,63 +162,31 @@ std::vector<Method> make_table() {
         "M. Sofroniou and G. Spaletta, Optim. Methods Softw. 20 (2005) 597; Hairer, "
         "Lubich & Wanner (2006) sect. V.3.2"));
 
-    Method rk4;
-    rk4.name = "rk4";
-    rk4.order = 4;
-    rk4.stages = 1;
-    rk4.reference = "classical Runge-Kutta (Kutta 1901); not a Poisson map";
-    rk4.poisson = false;
-    rk4.kind = MethodKind::RungeKutta4;
-    table.push_back(rk4);
-
-    Method midpoint;
-    midpoint.name = "implicit-midpoint";
-    midpoint.order = 2;
-    midpoint.stages = 1;
-    midpoint.reference = "implicit midpoint rule, fixed-point iteration (Hairer, Lubich & Wanner, "
-                         "Geometric Numerical Integration (2006) sect. IV.4.2, VI.3); symplectic "
-                         "for canonical systems, not a Lie-Poisson map";
-    midpoint.poisson = false;
-    midpoint.kind = MethodKind::ImplicitMidpoint;
-    table.push_back(midpoint);
+    table.push_back(baseline("rk4", 4, MethodKind::RungeKutta4,
+                             "classical Runge-Kutta (Kutta 1901); not a Poisson map"));
+    table.push_back(baseline(
+        "implicit-midpoint", 2, MethodKind::ImplicitMidpoint,
+        "implicit midpoint rule, fixed-point iteration (Hairer, Lubich & Wanner, Geometric "
+        "Numerical Integration (2006) sect. IV.4.2, VI.3); symplectic for canonical systems, not "
+        "a Lie-Poisson map"));
 
     // The sine-Euler matrix-form baselines (other systems refuse them).
     // isomp is a Lie-Poisson integrator in exact arithmetic, but solved by
     // fixed-point iteration it keeps the Casimirs only to the iteration's
     // tolerance, not to round-off: a baseline here.
-    Method isomp;
-    isomp.name = "isomp";
-    isomp.order = 2;
-    isomp.stages = 1;
-    isomp.reference = "isospectral midpoint method on the matrix form of sine-Euler, fixed-point "
-                      "iteration, BLAS-3 (K. Modin and M. Viviani, Found. Comput. Math. 20 (2020) "
-                      "889; M. Viviani, BIT Numer. Math. 60 (2020) 741); Casimirs kept to the "
-                      "iteration tolerance; sine-Euler only";
-    isomp.poisson = false;
-    isomp.kind = MethodKind::IsospectralMidpoint;
-    table.push_back(isomp);
-
-    Method rk4_matrix;
-    rk4_matrix.name = "rk4-matrix";
-    rk4_matrix.order = 4;
-    rk4_matrix.stages = 1;
-    rk4_matrix.reference = "classical Runge-Kutta on the matrix form dW/dt = (i/(2 eps)) [P, W] "
-                           "of sine-Euler (V. Zeitlin, Physica D 49 (1991) 353), BLAS-3; not a "
-                           "Poisson map; sine-Euler only";
-    rk4_matrix.poisson = false;
-    rk4_matrix.kind = MethodKind::RungeKutta4Matrix;
-    table.push_back(rk4_matrix);
-
-    Method direct;
-    direct.name = "direct-eq5";
-    direct.order = 4;
-    direct.stages = 1;
-    direct.reference = "classical Runge-Kutta on McLachlan 1993 eq. (5) summed term by term, "
-                       "O(N^4) per evaluation: a correctness reference; sine-Euler with N <= 31 "
-                       "only";
-    direct.poisson = false;
-    direct.kind = MethodKind::DirectEq5;
-    table.push_back(direct);
+    table.push_back(baseline(
+        "isomp", 2, MethodKind::IsospectralMidpoint,
+        "isospectral midpoint method on the matrix form of sine-Euler, fixed-point iteration, "
+        "BLAS-3 (K. Modin and M. Viviani, Found. Comput. Math. 20 (2020) 889; M. Viviani, BIT "
+        "Numer. Math. 60 (2020) 741); Casimirs kept to the iteration tolerance; sine-Euler only"));
+    table.push_back(baseline(
+        "rk4-matrix", 4, MethodKind::RungeKutta4Matrix,
+        "classical Runge-Kutta on the matrix form dW/dt = (i/(2 eps)) [P, W] of sine-Euler "
+        "(V. Zeitlin, Physica D 49 (1991) 353), BLAS-3; not a Poisson map; sine-Euler only"));
+    table.push_back(baseline(
+        "direct-eq5", 4, MethodKind::DirectEq5,
+        "classical Runge-Kutta on McLachlan 1993 eq. (5) summed term by term, O(N^4) per "
+        "evaluation: a correctness reference; sine-Euler with N <= 31 only"));
     return table;
 }
 
