@@ -307,6 +307,7 @@ Method custom_composition(const double *gammas, std::size_t n) {
 
 std::vector<Flow> build_flow_program(const Method &method, std::size_t pieces) {
     std::vector<Flow> raw;
+    if (pieces == 0) return raw;  // nothing to compose; System::step refuses to step
     switch (method.kind) {
     case MethodKind::Sequence:
         for (std::size_t k = 0; k < pieces; ++k) raw.push_back({k, 1.0});

@@ -85,6 +85,12 @@ void System::step(double dt, std::int64_t nsteps) {
     if (dt == 0.0) fail(LPI_ERR_INVALID, "dt must be nonzero");
     if (nsteps < 0) fail(LPI_ERR_INVALID, "nsteps must be >= 0, got " + std::to_string(nsteps));
     if (nsteps == 0) return;
+    // A model whose pieces are added by the user (generic, moments) may have
+    // none yet: there is no Hamiltonian to integrate.
+    if (model_->piece_count() == 0)
+        fail(LPI_ERR_INVALID, std::string("the ") + model_->kind() +
+                                  " system has no Hamiltonian pieces yet (add them with "
+                                  "lpi_add_piece)");
     const double end_time = time_ + dt * static_cast<double>(nsteps);
     if (!std::isfinite(end_time))
         fail(LPI_ERR_INVALID, "dt * nsteps overflows the time variable");

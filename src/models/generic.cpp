@@ -297,10 +297,6 @@ std::vector<double> GenericModel::checkpoint_parameters() const {
 }
 
 void GenericModel::flow(std::size_t piece, double t, double *state) {
-    if (pieces_.empty())
-        fail(LPI_ERR_INVALID, std::string("the ") + kind_ +
-                                  " system has no Hamiltonian pieces yet (add them with "
-                                  "lpi_add_piece)");
     pieces_[piece]->flow(t, state);
 }
 
@@ -329,10 +325,6 @@ void GenericModel::casimirs(const double *state, double *out) const {
 }
 
 void GenericModel::vector_field(const double *state, double *rate) const {
-    if (pieces_.empty())
-        fail(LPI_ERR_INVALID, std::string("the ") + kind_ +
-                                  " system has no Hamiltonian pieces yet (add them with "
-                                  "lpi_add_piece)");
     std::fill(rate, rate + dim(), 0.0);
     for (const auto &p : pieces_) p->add_vector_field(state, rate);
 }

@@ -84,7 +84,7 @@ public:
     std::string split() const override { return split_.current(); }
     // A system without pieces reports one, whose flow refuses to run: every
     // method then fails with a clear message instead of doing nothing.
-    std::size_t piece_count() const override { return pieces_.empty() ? 1 : pieces_.size(); }
+    std::size_t piece_count() const override { return pieces_.size(); }
 
     void flow(std::size_t piece, double t, double *state) override;
     double energy(const double *state) const override;
