@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -46,6 +47,16 @@ public:
 private:
     lpi_system *sys_ = nullptr;
 };
+
+// The registered methods a system accepts (the matrix-form baselines, for
+// instance, apply to sine-Euler only), probed once on one system from `create`.
+inline std::vector<bool> accepted_methods(const std::function<Handle()> &create) {
+    Handle probe = create();
+    std::vector<bool> accepted(static_cast<std::size_t>(lpi_method_count()));
+    for (int i = 0; i < lpi_method_count(); ++i)
+        accepted[static_cast<std::size_t>(i)] = lpi_set_method(probe.get(), lpi_method_name(i)) == LPI_OK;
+    return accepted;
+}
 
 inline std::vector<double> state_of(const lpi_system *sys) {
     std::vector<double> x(lpi_dim(sys));

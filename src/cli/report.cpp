@@ -229,15 +229,13 @@ void run_report(const Scene &scene, const ReportOptions &options) {
     std::vector<std::string> methods;
     std::map<std::string, std::vector<Sample>> histories;
     const double history_dt = scene.steps[scene.steps.size() / 2];
+    const std::vector<bool> accepted = accepted_methods(scene.create);
     for (int i = 0; i < lpi_method_count(); ++i) {
         const char *method = lpi_method_name(i);
+        if (!accepted[static_cast<std::size_t>(i)]) continue;  // not applicable here
         if (std::find(scene.excluded_methods.begin(), scene.excluded_methods.end(), method) !=
             scene.excluded_methods.end())
             continue;
-        {
-            Handle probe = scene.create();
-            if (lpi_set_method(probe.get(), method) != LPI_OK) continue;  // not applicable here
-        }
         methods.push_back(method);
         // A composition of s leapfrog stages sweeps steps s times larger, so
         // every method spans about the same range of cost.
