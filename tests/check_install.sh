@@ -1,16 +1,21 @@
 #!/bin/sh
-# Installs the build into a staging directory (DESTDIR) and builds and runs an
-# outside C program against it: via pkg-config (shared and static) and via
-# CMake's find_package (shared and static); a Fortran program too when the
-# Fortran binding is built.
+# Installs the build into a staging directory (DESTDIR) and checks that what is
+# installed works from there, with no LD_LIBRARY_PATH: the installed lpi and the
+# Fortran library find libliepoisson through their $ORIGIN-relative RUNPATH (the
+# staging directory is a moved prefix); outside C programs build and run via
+# pkg-config (shared; static from the archive with `pkg-config --static` flags
+# alone) and via CMake's find_package (shared and static); a Fortran program
+# via liepoisson-fortran.pc when the Fortran binding is built.
 # Usage: check_install.sh BUILD PREFIX LIBDIR INCLUDEDIR CC CMAKE HAVE_FORTRAN [FC]
 set -eu
 build=$1 prefix=$2 libdir=$3 includedir=$4 cc=$5 cmake=$6 have_fortran=$7 fc=${8:-}
+source_dir=$(cd "$(dirname "$0")/.." && pwd)
 work=$(mktemp -d "${TMPDIR:-/tmp}/lpi-install.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 stage=$work/stage
 root=$stage$prefix
 fail() { echo "check_install: $*"; exit 1; }
+unset LD_LIBRARY_PATH
 
 DESTDIR=$stage "$cmake" --install "$build" >"$work/install.log" 2>&1 || { cat "$work/install.log"; fail "install failed"; }
 
@@ -20,21 +25,43 @@ for f in "$includedir/liepoisson.h" "$libdir/libliepoisson.a" "$libdir/pkgconfig
          "bin/lpi" "share/man/man3/lpi_step.3" "share/man/man7/liepoisson.7"; do
     [ -e "$root/$f" ] || fail "missing $prefix/$f"
 done
-major=$(sed -n 's/^#define LPI_VERSION_MAJOR \([0-9]*\).*/\1/p' "$root/$includedir/liepoisson.h")
+version=$(sed -n 's/^#define LPI_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\).*/\2/p' "$root/$includedir/liepoisson.h" | paste -sd.)
+major=${version%%.*}
 [ -L "$root/$libdir/libliepoisson.so" ] || fail "libliepoisson.so is not a link"
 [ "$(readlink "$root/$libdir/libliepoisson.so")" = "libliepoisson.so.$major" ] || fail "libliepoisson.so does not point at the SONAME"
 soname=$(readelf -d "$root/$libdir/libliepoisson.so.$major" | sed -n 's/.*(SONAME).*\[\(.*\)\]/\1/p')
 [ "$soname" = "libliepoisson.so.$major" ] || fail "SONAME is '$soname'"
 if [ "$have_fortran" = 1 ]; then
-    [ -e "$root/$includedir/liepoisson.mod" ] || fail "missing the Fortran module"
-    [ -e "$root/$libdir/libliepoisson_fortran.so.$major" ] || fail "missing libliepoisson_fortran"
+    for f in "$includedir/liepoisson.mod" "$libdir/libliepoisson_fortran.so.$major" "$libdir/pkgconfig/liepoisson-fortran.pc"; do
+        [ -e "$root/$f" ] || fail "missing $prefix/$f"
+    done
 fi
-LD_LIBRARY_PATH=$root/$libdir "$root/bin/lpi" --help >/dev/null || fail "the installed lpi does not run"
+
+# RUNPATHs: relative to the file itself, never the build tree.
+runpath() { readelf -d "$1" | sed -n 's/.*(R\(UN\)\{0,1\}PATH).*\[\(.*\)\]/\2/p'; }
+# where the loader finds libliepoisson for FILE, with no LD_LIBRARY_PATH
+resolved() {
+    found=$(ldd "$1" | sed -n "s/^[[:space:]]*libliepoisson.so.$major => \([^ ]*\).*/\1/p")
+    [ -n "$found" ] && readlink -f "$found"
+}
+staged_lib=$(readlink -f "$root/$libdir/libliepoisson.so.$major")
+[ "$(runpath "$root/bin/lpi")" = "\$ORIGIN/../$libdir" ] || fail "installed lpi has RUNPATH '$(runpath "$root/bin/lpi")'"
+[ -z "$(runpath "$root/$libdir/libliepoisson.so.$major")" ] || fail "libliepoisson has a RUNPATH"
+[ "$(resolved "$root/bin/lpi")" = "$staged_lib" ] ||
+    fail "installed lpi loads libliepoisson from '$(resolved "$root/bin/lpi")'"
+[ "$("$root/bin/lpi" --version)" = "lpi (liepoisson) $version" ] || fail "the installed lpi does not run"
+if [ "$have_fortran" = 1 ]; then
+    [ "$(runpath "$root/$libdir/libliepoisson_fortran.so.$major")" = "\$ORIGIN" ] ||
+        fail "libliepoisson_fortran has RUNPATH '$(runpath "$root/$libdir/libliepoisson_fortran.so.$major")'"
+fi
+# No installed description names this machine's build or source tree.
+if grep -rlF -e "$build" -e "$source_dir" "$root/$libdir/pkgconfig" "$root/$libdir/cmake"; then
+    fail "the files above name the build or source tree"
+fi
 
 # The outside program: needs the rigid body, the methods and (when built) FFTW.
 cat >"$work/prog.c" <<'PROG'
 #include <liepoisson.h>
-#include <math.h>
 #include <stdio.h>
 int main(void) {
     lpi_system *sys = NULL, *se = NULL;
@@ -49,11 +76,12 @@ int main(void) {
     int s = lpi_sine_euler_create(&se, 5);
     if (s == LPI_OK) s = lpi_step(se, 0.01, 2);
     if (s != LPI_OK && s != LPI_ERR_UNSUPPORTED) return 1;
-    printf("liepoisson %s: Casimir drift %.1e, sine-Euler %s\n", lpi_version_string(),
-           fabs(c1 - c0), lpi_status_name(s));
+    const double drift = c1 > c0 ? c1 - c0 : c0 - c1;
+    printf("liepoisson %s: Casimir drift %.1e, sine-Euler %s\n", lpi_version_string(), drift,
+           lpi_status_name(s));
     lpi_destroy(se);
     lpi_destroy(sys);
-    return fabs(c1 - c0) < 1e-13 ? 0 : 1;
+    return drift < 1e-13 ? 0 : 1;
 }
 PROG
 
@@ -62,18 +90,48 @@ needed() { readelf -d "$1" | grep -c "NEEDED.*libliepoisson" || true; }
 # pkg-config: the staged tree is found through the sysroot.
 export PKG_CONFIG_PATH="$root/$libdir/pkgconfig" PKG_CONFIG_SYSROOT_DIR="$stage"
 # shellcheck disable=SC2046
-"$cc" -o "$work/prog_pc" "$work/prog.c" $(pkg-config --cflags --libs liepoisson) -lm \
+"$cc" -o "$work/prog_pc" "$work/prog.c" $(pkg-config --cflags --libs liepoisson) \
     -Wl,-rpath,"$root/$libdir" || fail "pkg-config shared build failed"
 [ "$(needed "$work/prog_pc")" = 1 ] || fail "shared build does not use libliepoisson.so"
 "$work/prog_pc" || fail "pkg-config shared program failed"
-# static: the archive, and everything it needs from Libs.private / Requires.private
-libs=$(pkg-config --static --libs liepoisson | sed 's/-lliepoisson\b//')
-# shellcheck disable=SC2086
-"$cc" -o "$work/prog_static" "$work/prog.c" $(pkg-config --cflags liepoisson) \
-    "$root/$libdir/libliepoisson.a" $libs || fail "pkg-config static build failed: pkg-config gave: $libs"
+# Static, as the README says: beside the shared library, name the archive and
+# let --as-needed drop the -lliepoisson that follows.
+# shellcheck disable=SC2046
+"$cc" -o "$work/prog_archive" "$work/prog.c" $(pkg-config --cflags liepoisson) "$root/$libdir/libliepoisson.a" \
+    -Wl,--as-needed $(pkg-config --static --libs liepoisson) >"$work/static.log" 2>&1 ||
+    { cat "$work/static.log"; fail "static build beside the shared library failed"; }
+[ "$(needed "$work/prog_archive")" = 0 ] || fail "static build beside the shared library needs libliepoisson.so"
+"$work/prog_archive" >/dev/null || fail "static program (built beside the shared library) failed"
+# Static where only the archive is installed: `pkg-config --static` alone must
+# name every private dependency; without --static the link must fail, or the
+# check above proves nothing about Libs.private and Requires.private.
+cp -R "$stage" "$work/stage-static"
+rm -f "$work/stage-static$prefix/$libdir"/libliepoisson.so*
+export PKG_CONFIG_PATH="$work/stage-static$prefix/$libdir/pkgconfig" PKG_CONFIG_SYSROOT_DIR="$work/stage-static"
+# shellcheck disable=SC2046
+"$cc" -o "$work/prog_static" "$work/prog.c" $(pkg-config --static --cflags --libs liepoisson) >"$work/static.log" 2>&1 ||
+    { cat "$work/static.log"; fail "pkg-config static build failed: pkg-config gave: $(pkg-config --static --libs liepoisson)"; }
 [ "$(needed "$work/prog_static")" = 0 ] || fail "static build still needs libliepoisson.so"
-"$work/prog_static" || fail "pkg-config static program failed"
+"$work/prog_static" >/dev/null || fail "pkg-config static program failed"
+# shellcheck disable=SC2046
+if "$cc" -o "$work/prog_no_private" "$work/prog.c" $(pkg-config --cflags --libs liepoisson) >/dev/null 2>&1; then
+    fail "the archive links without its private dependencies: the static check is void"
+fi
 unset PKG_CONFIG_PATH PKG_CONFIG_SYSROOT_DIR
+
+# CMake: the installed static target's link needs are plain flags, with no -L
+# into a directory the compiler searches anyway.
+default_dirs=$("$cc" -print-search-dirs | sed -n 's/^libraries: =//p' | tr : '\n' |
+               while read -r d; do [ -d "$d" ] && (cd "$d" && pwd -P); done)
+static_links=$(sed -n '/liepoisson::liepoisson_static PROPERTIES/,/^)/s/.*INTERFACE_LINK_LIBRARIES "\(.*\)"/\1/p' \
+               "$root/$libdir/cmake/liepoisson/liepoissonTargets.cmake")
+case "$static_links" in *'$<'*) fail "the static target's link libraries keep a generator expression: $static_links";; esac
+for flag in $(echo "$static_links" | tr ';' ' '); do
+    case "$flag" in
+        -L*) d=$(cd "${flag#-L}" 2>/dev/null && pwd -P) || fail "the static target links from a missing ${flag#-L}"
+             if echo "$default_dirs" | grep -qxF "$d"; then fail "the static target carries a needless $flag"; fi;;
+    esac
+done
 
 # CMake: find_package(liepoisson) with the shared and the static target.
 mkdir -p "$work/cmake"
@@ -82,19 +140,21 @@ cmake_minimum_required(VERSION 3.18)
 project(outside C)
 find_package(liepoisson 0.1 REQUIRED)
 add_executable(prog_shared prog.c)
-target_link_libraries(prog_shared PRIVATE liepoisson::liepoisson m)
+target_link_libraries(prog_shared PRIVATE liepoisson::liepoisson)
 add_executable(prog_static prog.c)
-target_link_libraries(prog_static PRIVATE liepoisson::liepoisson_static m)
+target_link_libraries(prog_static PRIVATE liepoisson::liepoisson_static)
 CM
 cp "$work/prog.c" "$work/cmake/"
 "$cmake" -S "$work/cmake" -B "$work/cmake/build" -DCMAKE_C_COMPILER="$cc" \
     -DCMAKE_PREFIX_PATH="$root" >"$work/cmake.log" 2>&1 || { cat "$work/cmake.log"; fail "find_package failed"; }
 "$cmake" --build "$work/cmake/build" >>"$work/cmake.log" 2>&1 || { cat "$work/cmake.log"; fail "CMake build failed"; }
-"$work/cmake/build/prog_shared" || fail "CMake shared program failed"
+"$work/cmake/build/prog_shared" >/dev/null || fail "CMake shared program failed"
 [ "$(needed "$work/cmake/build/prog_static")" = 0 ] || fail "CMake static build needs libliepoisson.so"
-"$work/cmake/build/prog_static" || fail "CMake static program failed"
+"$work/cmake/build/prog_static" >/dev/null || fail "CMake static program failed"
 
-# Fortran: use liepoisson from the installed module.
+# Fortran: the installed module through liepoisson-fortran.pc. The program's
+# RUNPATH reaches libliepoisson_fortran only; libliepoisson is found through
+# the Fortran library's own.
 if [ "$have_fortran" = 1 ] && [ -n "$fc" ]; then
     cat >"$work/prog.f90" <<'F90'
 program outside
@@ -110,9 +170,14 @@ program outside
     call lpi_destroy(sys)
 end program
 F90
-    "$fc" -o "$work/prog_f" -I"$root/$includedir" "$work/prog.f90" -L"$root/$libdir" \
-        -lliepoisson_fortran -lliepoisson -Wl,-rpath,"$root/$libdir" || fail "Fortran build failed"
-    # libliepoisson_fortran finds libliepoisson through the loader path (RUNPATH is not inherited)
-    LD_LIBRARY_PATH="$root/$libdir" "$work/prog_f" || fail "Fortran program failed"
+    export PKG_CONFIG_PATH="$root/$libdir/pkgconfig" PKG_CONFIG_SYSROOT_DIR="$stage"
+    # shellcheck disable=SC2046
+    "$fc" -o "$work/prog_f" "$work/prog.f90" $(pkg-config --cflags --libs liepoisson-fortran) \
+        -Wl,-rpath,"$root/$libdir" || fail "Fortran build through liepoisson-fortran.pc failed"
+    unset PKG_CONFIG_PATH PKG_CONFIG_SYSROOT_DIR
+    [ "$(resolved "$work/prog_f")" = "$staged_lib" ] ||
+        fail "the Fortran program loads libliepoisson from '$(resolved "$work/prog_f")'"
+    "$work/prog_f" || fail "Fortran program failed"
 fi
-echo "install: staged under DESTDIR; pkg-config (shared, static), CMake (shared, static)$( [ "$have_fortran" = 1 ] && echo ', Fortran module') all build and run"
+echo "install: staged under DESTDIR, run without LD_LIBRARY_PATH: lpi, pkg-config (shared, static)," \
+     "CMake (shared, static)$( [ "$have_fortran" = 1 ] && echo ', Fortran via liepoisson-fortran.pc') all build and run"
