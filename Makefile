@@ -8,12 +8,26 @@
 #   make check-tsan      the threads test under ThreadSanitizer (build-tsan)
 #   make check-valgrind  the cmocka tests under valgrind, no leaks allowed
 #   make fuzz FUZZ_SECONDS=60  the libFuzzer harness from its corpus (clang)
+# Quiet by default: only the compilers' warnings and errors (and CMake's). V=1
+# shows CMake's status lines, the progress lines and every command.
 BUILD      ?= build
 BUILD_TYPE ?= Release
 PREFIX     ?= /usr/local
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_ARGS ?=
+V          ?= 0
 VERSION    := $(shell sed -n 's/^\#define LPI_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\).*/\2/p' include/liepoisson.h | paste -sd.)
+
+ifeq ($(V),0)
+  STATUS_OUT    := >/dev/null
+  OUTPUT_ARGS   := -DCMAKE_RULE_MESSAGES=OFF -DCMAKE_TARGET_MESSAGES=OFF
+  BUILD_ARGS    :=
+  MAKEFLAGS     += --no-print-directory
+else
+  STATUS_OUT    :=
+  OUTPUT_ARGS   := -DCMAKE_RULE_MESSAGES=ON -DCMAKE_TARGET_MESSAGES=ON
+  BUILD_ARGS    := --verbose
+endif
 
 .PHONY: all build deps configure check run bench install clean version abi-baseline \
         check-asan check-tsan check-valgrind fuzz
@@ -24,10 +38,10 @@ deps:
 	@scripts/install-deps
 
 configure: deps
-	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DCMAKE_INSTALL_PREFIX=$(PREFIX) $(CMAKE_ARGS) >/dev/null
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DCMAKE_INSTALL_PREFIX=$(PREFIX) $(OUTPUT_ARGS) $(CMAKE_ARGS) $(STATUS_OUT)
 
 build: configure
-	@cmake --build $(BUILD) -j $(JOBS)
+	@cmake --build $(BUILD) -j $(JOBS) $(BUILD_ARGS)
 
 check: build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
@@ -36,11 +50,12 @@ run: build
 	@$(BUILD)/lpi report --out $(BUILD)/report
 
 bench: build
-	@cmake --build $(BUILD) -j $(JOBS) --target benchmarks
+	@cmake --build $(BUILD) -j $(JOBS) $(BUILD_ARGS) --target benchmarks
 	@for b in $(BUILD)/tests/bench/bench_*; do [ -x "$$b" ] && "$$b"; done
 
 install: build
-	@DESTDIR="$(DESTDIR)" cmake --install $(BUILD) --prefix $(PREFIX)
+	@DESTDIR="$(DESTDIR)" cmake --install $(BUILD) --prefix $(PREFIX) $(STATUS_OUT)
+	@echo "liepoisson $(VERSION) installed in $(DESTDIR)$(PREFIX)"
 
 abi-baseline: build
 	@tests/check_abi.sh --update . $(BUILD)/libliepoisson.so
@@ -55,15 +70,15 @@ clean:
 # with the ASan runtime and are left out here; they run in `make check`.
 ASAN_EXCLUDE = ^test_python_|^test_fortran$$|^test_install$$
 check-asan: deps
-	@cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLPI_SANITIZE=ON $(CMAKE_ARGS) >/dev/null
-	@cmake --build build-asan -j $(JOBS)
+	@cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLPI_SANITIZE=ON $(OUTPUT_ARGS) $(CMAKE_ARGS) $(STATUS_OUT)
+	@cmake --build build-asan -j $(JOBS) $(BUILD_ARGS)
 	@cd build-asan && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	    ctest --output-on-failure -j $(JOBS) -E '$(ASAN_EXCLUDE)'
 
 # OpenMP is left out: libgomp is not instrumented and would give false reports.
 check-tsan: deps
-	@cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLPI_TSAN=ON -DLPI_WITH_OPENMP=OFF $(CMAKE_ARGS) >/dev/null
-	@cmake --build build-tsan -j $(JOBS) --target test_threads
+	@cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLPI_TSAN=ON -DLPI_WITH_OPENMP=OFF $(OUTPUT_ARGS) $(CMAKE_ARGS) $(STATUS_OUT)
+	@cmake --build build-tsan -j $(JOBS) $(BUILD_ARGS) --target test_threads
 	@cd build-tsan && TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -R '^test_threads$$'
 
 # The cmocka tests of $(BUILD) under valgrind. VALGRIND_SKIP leaves out the
