@@ -85,6 +85,21 @@ int main(void) {
 }
 PROG
 
+cat >"$work/prog.f90" <<'F90'
+program outside
+    use liepoisson
+    use, intrinsic :: iso_c_binding
+    type(c_ptr) :: sys
+    real(c_double) :: c(1)
+    call lpi_rigid_body_create(sys, 1.0_c_double, 2.0_c_double, 3.0_c_double)
+    call lpi_set_state(sys, [1.0_c_double, 0.5_c_double, -0.3_c_double])
+    call lpi_step(sys, 0.01_c_double, 100)
+    call lpi_casimirs(sys, c)
+    if (abs(c(1) - 1.34_c_double) > 1e-13_c_double) stop 1
+    call lpi_destroy(sys)
+end program
+F90
+
 needed() { readelf -d "$1" | grep -c "NEEDED.*libliepoisson" || true; }
 
 # pkg-config: the staged tree is found through the sysroot.
@@ -133,7 +148,7 @@ for flag in $(echo "$static_links" | tr ';' ' '); do
     esac
 done
 
-# CMake: find_package(liepoisson) with the shared and the static target.
+# CMake: find_package(liepoisson) with the shared, the static and the Fortran target.
 mkdir -p "$work/cmake"
 cat >"$work/cmake/CMakeLists.txt" <<'CM'
 cmake_minimum_required(VERSION 3.18)
@@ -143,33 +158,28 @@ add_executable(prog_shared prog.c)
 target_link_libraries(prog_shared PRIVATE liepoisson::liepoisson)
 add_executable(prog_static prog.c)
 target_link_libraries(prog_static PRIVATE liepoisson::liepoisson_static)
+if(WITH_FORTRAN)
+  enable_language(Fortran)
+  add_executable(prog_f prog.f90)
+  target_link_libraries(prog_f PRIVATE liepoisson::liepoisson_fortran)
+endif()
 CM
-cp "$work/prog.c" "$work/cmake/"
-"$cmake" -S "$work/cmake" -B "$work/cmake/build" -DCMAKE_C_COMPILER="$cc" \
-    -DCMAKE_PREFIX_PATH="$root" >"$work/cmake.log" 2>&1 || { cat "$work/cmake.log"; fail "find_package failed"; }
+cp "$work/prog.c" "$work/prog.f90" "$work/cmake/"
+with_fortran=OFF
+[ "$have_fortran" = 1 ] && [ -n "$fc" ] && with_fortran=ON
+"$cmake" -S "$work/cmake" -B "$work/cmake/build" -DCMAKE_C_COMPILER="$cc" -DCMAKE_Fortran_COMPILER="$fc" \
+    -DWITH_FORTRAN=$with_fortran -DCMAKE_PREFIX_PATH="$root" >"$work/cmake.log" 2>&1 ||
+    { cat "$work/cmake.log"; fail "find_package failed"; }
 "$cmake" --build "$work/cmake/build" >>"$work/cmake.log" 2>&1 || { cat "$work/cmake.log"; fail "CMake build failed"; }
 "$work/cmake/build/prog_shared" >/dev/null || fail "CMake shared program failed"
 [ "$(needed "$work/cmake/build/prog_static")" = 0 ] || fail "CMake static build needs libliepoisson.so"
 "$work/cmake/build/prog_static" >/dev/null || fail "CMake static program failed"
+if [ $with_fortran = ON ]; then "$work/cmake/build/prog_f" || fail "CMake Fortran program failed"; fi
 
 # Fortran: the installed module through liepoisson-fortran.pc. The program's
 # RUNPATH reaches libliepoisson_fortran only; libliepoisson is found through
 # the Fortran library's own.
 if [ "$have_fortran" = 1 ] && [ -n "$fc" ]; then
-    cat >"$work/prog.f90" <<'F90'
-program outside
-    use liepoisson
-    use, intrinsic :: iso_c_binding
-    type(c_ptr) :: sys
-    real(c_double) :: c(1)
-    call lpi_rigid_body_create(sys, 1.0_c_double, 2.0_c_double, 3.0_c_double)
-    call lpi_set_state(sys, [1.0_c_double, 0.5_c_double, -0.3_c_double])
-    call lpi_step(sys, 0.01_c_double, 100)
-    call lpi_casimirs(sys, c)
-    if (abs(c(1) - 1.34_c_double) > 1e-13_c_double) stop 1
-    call lpi_destroy(sys)
-end program
-F90
     export PKG_CONFIG_PATH="$root/$libdir/pkgconfig" PKG_CONFIG_SYSROOT_DIR="$stage"
     # shellcheck disable=SC2046
     "$fc" -o "$work/prog_f" "$work/prog.f90" $(pkg-config --cflags --libs liepoisson-fortran) \
@@ -180,4 +190,4 @@ F90
     "$work/prog_f" || fail "Fortran program failed"
 fi
 echo "install: staged under DESTDIR, run without LD_LIBRARY_PATH: lpi, pkg-config (shared, static)," \
-     "CMake (shared, static)$( [ "$have_fortran" = 1 ] && echo ', Fortran via liepoisson-fortran.pc') all build and run"
+     "CMake (shared, static)$( [ "$have_fortran" = 1 ] && echo ', Fortran via liepoisson-fortran.pc and CMake') all build and run"
