@@ -1,11 +1,11 @@
 #!/bin/sh
 # Installs the build into a staging directory (DESTDIR) and checks that what is
-# installed works from there, with no LD_LIBRARY_PATH: the installed lpi and the
+# installed works from there with no LD_LIBRARY_PATH: the installed lpi and the
 # Fortran library find libliepoisson through their $ORIGIN-relative RUNPATH (the
-# staging directory is a moved prefix); outside C programs build and run via
-# pkg-config (shared; static from the archive with `pkg-config --static` flags
-# alone) and via CMake's find_package (shared and static); a Fortran program
-# via liepoisson-fortran.pc when the Fortran binding is built.
+# staging directory is a moved prefix; a build with CMAKE_SKIP_INSTALL_RPATH has
+# none); outside C programs build and run via pkg-config (shared; static from
+# the archive with `pkg-config --static` flags alone) and via find_package
+# (shared, static); a Fortran program via liepoisson-fortran.pc and CMake.
 # Usage: check_install.sh BUILD PREFIX LIBDIR INCLUDEDIR CC CMAKE HAVE_FORTRAN [FC]
 set -eu
 build=$1 prefix=$2 libdir=$3 includedir=$4 cc=$5 cmake=$6 have_fortran=$7 fc=${8:-}
@@ -37,7 +37,14 @@ if [ "$have_fortran" = 1 ]; then
     done
 fi
 
-# RUNPATHs: relative to the file itself, never the build tree.
+# RUNPATHs: relative to the file itself, never the build tree; none where the
+# build was told to skip them (a system prefix), and the loader is told instead.
+if grep -qE '^CMAKE_SKIP_INSTALL_RPATH:BOOL=(ON|TRUE|YES|1)$' "$build/CMakeCache.txt"; then
+    lpi_runpath='' fortran_runpath=''
+    export LD_LIBRARY_PATH="$root/$libdir"
+else
+    lpi_runpath="\$ORIGIN/../$libdir" fortran_runpath="\$ORIGIN"
+fi
 runpath() { readelf -d "$1" | sed -n 's/.*(R\(UN\)\{0,1\}PATH).*\[\(.*\)\]/\2/p'; }
 # where the loader finds libliepoisson for FILE, with no LD_LIBRARY_PATH
 resolved() {
@@ -45,13 +52,13 @@ resolved() {
     [ -n "$found" ] && readlink -f "$found"
 }
 staged_lib=$(readlink -f "$root/$libdir/libliepoisson.so.$major")
-[ "$(runpath "$root/bin/lpi")" = "\$ORIGIN/../$libdir" ] || fail "installed lpi has RUNPATH '$(runpath "$root/bin/lpi")'"
+[ "$(runpath "$root/bin/lpi")" = "$lpi_runpath" ] || fail "installed lpi has RUNPATH '$(runpath "$root/bin/lpi")'"
 [ -z "$(runpath "$root/$libdir/libliepoisson.so.$major")" ] || fail "libliepoisson has a RUNPATH"
 [ "$(resolved "$root/bin/lpi")" = "$staged_lib" ] ||
     fail "installed lpi loads libliepoisson from '$(resolved "$root/bin/lpi")'"
 [ "$("$root/bin/lpi" --version)" = "lpi (liepoisson) $version" ] || fail "the installed lpi does not run"
 if [ "$have_fortran" = 1 ]; then
-    [ "$(runpath "$root/$libdir/libliepoisson_fortran.so.$major")" = "\$ORIGIN" ] ||
+    [ "$(runpath "$root/$libdir/libliepoisson_fortran.so.$major")" = "$fortran_runpath" ] ||
         fail "libliepoisson_fortran has RUNPATH '$(runpath "$root/$libdir/libliepoisson_fortran.so.$major")'"
 fi
 # No installed description names this machine's build or source tree.
