@@ -117,6 +117,37 @@ std::string format_double(double x) {
     return text;
 }
 
+// Checks the header (the first head_size <= 24 bytes of a checkpoint of
+// `size` bytes): magic, byte order, version, and the announced total size
+// against the actual one.
+void check_header(const unsigned char *head, std::size_t head_size, std::uint64_t size) {
+    // In the order that gives the most useful message.
+    const std::size_t magic_seen = head_size < sizeof kMagic ? head_size : sizeof kMagic;
+    if (magic_seen > 0 && std::memcmp(head, kMagic, magic_seen) != 0)
+        fail(LPI_ERR_FORMAT, "not a liepoisson checkpoint (wrong magic bytes)");
+    if (head_size < kHeaderSize || size < kHeaderSize + kChecksumSize)
+        fail(LPI_ERR_FORMAT, "truncated: " + std::to_string(size) +
+                                 " bytes, shorter than a checkpoint header");
+    const std::uint32_t order = load_u32(head + 8);
+    if (order == kByteOrderSwapped)
+        fail(LPI_ERR_FORMAT, "written on a machine of the other byte order (this build reads "
+                             "checkpoints of its own byte order only)");
+    if (order != kByteOrder) fail(LPI_ERR_FORMAT, "corrupted header (byte-order marker)");
+    const std::uint32_t version = load_u32(head + 12);
+    if (version > kCheckpointVersion)
+        fail(LPI_ERR_FORMAT, "format version " + std::to_string(version) +
+                                 " is newer than this library reads (up to " +
+                                 std::to_string(kCheckpointVersion) + "); upgrade liepoisson");
+    if (version == 0) fail(LPI_ERR_FORMAT, "corrupted header (format version 0)");
+    const std::uint64_t total = load_u64(head + 16);
+    if (total > size)
+        fail(LPI_ERR_FORMAT, "truncated: " + std::to_string(size) + " of " +
+                                 std::to_string(total) + " bytes");
+    if (total < size)
+        fail(LPI_ERR_FORMAT, std::to_string(size - total) + " unexpected bytes after the " +
+                                 std::to_string(total) + "-byte checkpoint");
+}
+
 // The models a checkpoint can name, rebuilt from their parameters. The
 // state length is checked first: a crafted file must not make the library
 // allocate a model far larger than the file.
@@ -253,41 +284,6 @@ std::vector<unsigned char> encode_checkpoint(const System &system) {
     w.put(crc32(bytes.data(), bytes.size()));
     return std::move(bytes);
 }
-
-namespace {
-
-// Checks the header (the first head_size <= 24 bytes of a checkpoint of
-// `size` bytes): magic, byte order, version, and the announced total size
-// against the actual one.
-void check_header(const unsigned char *head, std::size_t head_size, std::uint64_t size) {
-    // In the order that gives the most useful message.
-    const std::size_t magic_seen = head_size < sizeof kMagic ? head_size : sizeof kMagic;
-    if (magic_seen > 0 && std::memcmp(head, kMagic, magic_seen) != 0)
-        fail(LPI_ERR_FORMAT, "not a liepoisson checkpoint (wrong magic bytes)");
-    if (head_size < kHeaderSize || size < kHeaderSize + kChecksumSize)
-        fail(LPI_ERR_FORMAT, "truncated: " + std::to_string(size) +
-                                 " bytes, shorter than a checkpoint header");
-    const std::uint32_t order = load_u32(head + 8);
-    if (order == kByteOrderSwapped)
-        fail(LPI_ERR_FORMAT, "written on a machine of the other byte order (this build reads "
-                             "checkpoints of its own byte order only)");
-    if (order != kByteOrder) fail(LPI_ERR_FORMAT, "corrupted header (byte-order marker)");
-    const std::uint32_t version = load_u32(head + 12);
-    if (version > kCheckpointVersion)
-        fail(LPI_ERR_FORMAT, "format version " + std::to_string(version) +
-                                 " is newer than this library reads (up to " +
-                                 std::to_string(kCheckpointVersion) + "); upgrade liepoisson");
-    if (version == 0) fail(LPI_ERR_FORMAT, "corrupted header (format version 0)");
-    const std::uint64_t total = load_u64(head + 16);
-    if (total > size)
-        fail(LPI_ERR_FORMAT, "truncated: " + std::to_string(size) + " of " +
-                                 std::to_string(total) + " bytes");
-    if (total < size)
-        fail(LPI_ERR_FORMAT, std::to_string(size - total) + " unexpected bytes after the " +
-                                 std::to_string(total) + "-byte checkpoint");
-}
-
-}  // namespace
 
 Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size) {
     check_header(data, size, size);
