@@ -7,7 +7,7 @@
 #   make check-asan      every test under AddressSanitizer + UBSan (build-asan)
 #   make check-tsan      the threads test under ThreadSanitizer (build-tsan)
 #   make check-valgrind  the cmocka tests under valgrind, no leaks allowed
-#   make fuzz FUZZ_SECONDS=60  the libFuzzer harness from its corpus (clang)
+#   make fuzz FUZZ_SECONDS=60  the libFuzzer harnesses from their corpora (clang)
 # Quiet by default: only the compilers' warnings and errors (and CMake's). V=1
 # shows CMake's status lines, the progress lines and every command.
 BUILD      ?= build

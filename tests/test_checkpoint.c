@@ -2,8 +2,14 @@
  * saveable kind, every registered method, custom compositions, implicit
  * settings, the compensated carry); every truncation, every flipped byte, a
  * foreign, other-byte-order, newer-version or inconsistent checkpoint is
- * refused; files are written atomically and leave no temporary files. */
+ * refused, and so is every payload no setter would accept (checkpoints
+ * crafted here by an encoder of the documented layout, written
+ * independently); files are read bounded, written atomically under any
+ * legal name, and leave no temporary files. */
 #include <dirent.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -23,6 +29,90 @@ static uint32_t crc32_bitwise(const unsigned char *p, size_t n) {
 static void reseal(unsigned char *buf, size_t size) {
     const uint32_t c = crc32_bitwise(buf, size - 4);
     memcpy(buf + size - 4, &c, 4);
+}
+
+/* A checkpoint written from the documented layout, field by field. */
+typedef struct {
+    const char *kind;
+    size_t n_params;
+    const double *params;
+    const char *split, *method;
+    size_t n_gammas;
+    const double *gammas;
+    double tolerance;
+    int32_t iterations;
+    double time;
+    uint64_t n_state;     /* the stored count */
+    size_t state_values;  /* the values that follow it */
+    const double *state;
+} crafted;
+
+typedef struct {
+    unsigned char *p;
+    size_t n;
+} sink;
+
+static void put(sink *b, const void *v, size_t n) {
+    b->p = realloc(b->p, b->n + n);
+    assert_non_null(b->p);
+    memcpy(b->p + b->n, v, n);
+    b->n += n;
+}
+static void put_u32(sink *b, uint32_t v) { put(b, &v, 4); }
+static void put_string(sink *b, const char *s, size_t n) {
+    put_u32(b, (uint32_t)n);
+    put(b, s, n);
+}
+
+static unsigned char *craft(const crafted *c, size_t *size) {
+    sink b = {NULL, 0};
+    const unsigned char magic[8] = {0x89, 'L', 'P', 'I', 0x0D, 0x0A, 0x1A, 0x0A};
+    put(&b, magic, 8);
+    put_u32(&b, 0x01020304u);
+    put_u32(&b, 1);
+    const uint64_t total_placeholder = 0;
+    put(&b, &total_placeholder, 8);
+    put_string(&b, c->kind, strlen(c->kind));
+    put_u32(&b, (uint32_t)c->n_params);
+    put(&b, c->params, 8 * c->n_params);
+    put_string(&b, c->split, strlen(c->split));
+    put_string(&b, c->method, strlen(c->method));
+    put_u32(&b, (uint32_t)c->n_gammas);
+    put(&b, c->gammas, 8 * c->n_gammas);
+    put(&b, &c->tolerance, 8);
+    put(&b, &c->iterations, 4);
+    put(&b, &c->time, 8);
+    put(&b, &c->n_state, 8);
+    put(&b, c->state, 8 * c->state_values);
+    put_u32(&b, 0); /* the checksum, sealed below */
+    const uint64_t total = b.n;
+    memcpy(b.p + 16, &total, 8);
+    reseal(b.p, b.n);
+    *size = b.n;
+    return b.p;
+}
+
+/* A rigid body (1, 2, 3.5), leapfrog, default implicit settings, at t = 0.25,
+ * m = (0.3, 1.1, -0.7) with a carry of a quarter ulp on m_1. */
+static const double kInertia[3] = {1.0, 2.0, 3.5};
+static double rigid_state[6];
+static crafted rigid_crafted(void) {
+    const double m[6] = {0.3, 1.1, -0.7, 0.0, 0x1p-54, 0.0};
+    memcpy(rigid_state, m, sizeof m);
+    const crafted c = {"rigid-body", 3, kInertia, "casimir-shift", "leapfrog", 0, NULL,
+                       1e-13, 100, 0.25, 6, 6, rigid_state};
+    return c;
+}
+
+static void assert_crafted_refused(const crafted *c, int status, const char *needle) {
+    size_t size;
+    unsigned char *buf = craft(c, &size);
+    lpi_system *sys = (lpi_system *)0x1;
+    LPI_ASSERT_FAILS(NULL, lpi_load_buffer(&sys, buf, size), status, "lpi_load_buffer");
+    assert_null(sys);
+    if (needle && !strstr(lpi_last_error(NULL), needle))
+        fail_msg("message '%s' does not say '%s'", lpi_last_error(NULL), needle);
+    free(buf);
 }
 
 static unsigned char *save(const lpi_system *sys, size_t *size) {
@@ -333,6 +423,226 @@ static void test_foreign_newer_other_order(void **state) {
     lpi_destroy(sys);
 }
 
+/* The crafted encoder writes what lpi_save_buffer writes; a crafted
+ * checkpoint with a carry and a time loads with both, and re-saves to the
+ * same bytes. */
+static void test_layout_and_round_trip(void **state) {
+    (void)state;
+    lpi_system *sys = rigid_body();
+    assert_int_equal(lpi_set_method(sys, "leapfrog"), LPI_OK);
+    size_t size, crafted_size;
+    unsigned char *real = save(sys, &size);
+    crafted c = rigid_crafted();
+    const double gammas[1] = {1.0};
+    c.n_gammas = 1, c.gammas = gammas, c.time = 0.0, rigid_state[4] = 0.0;
+    unsigned char *mine = craft(&c, &crafted_size);
+    assert_int_equal(crafted_size, size);
+    assert_memory_equal(mine, real, size);
+    free(mine), free(real);
+
+    c = rigid_crafted();
+    c.n_gammas = 1, c.gammas = gammas;
+    mine = craft(&c, &crafted_size);
+    lpi_system *copy = load(mine, crafted_size);
+    assert_true(lpi_time(copy) == 0.25);
+    double m[3];
+    assert_int_equal(lpi_get_state(copy, m, 3), LPI_OK);
+    assert_true(m[0] == 0.3 && m[1] == 1.1 + 0x1p-54 && m[2] == -0.7);
+    real = save(copy, &size);
+    assert_int_equal(size, crafted_size);
+    assert_memory_equal(real, mine, size);
+    free(mine), free(real);
+    lpi_destroy(copy);
+    lpi_destroy(sys);
+}
+
+/* Everything a setter refuses, a checkpoint may not carry either: the
+ * checksum only says the bytes are those that were written. */
+static void test_impossible_payloads(void **state) {
+    (void)state;
+    const double gammas[1] = {1.0};
+    crafted c = rigid_crafted();
+    c.n_gammas = 1, c.gammas = gammas;
+    size_t size;
+    unsigned char *fine = craft(&c, &size);
+    lpi_destroy(load(fine, size)); /* the unaltered base of every case */
+    free(fine);
+
+    /* Compensation carries: a remainder of rounding, not a second value. */
+    c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas;
+    rigid_state[3] = 1e-3;
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "carry");
+    c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas;
+    rigid_state[0] = 0.0, rigid_state[1] = 0.0, rigid_state[2] = 0.0, rigid_state[4] = 0x1p-1074;
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "carry");
+    c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas;
+    rigid_state[0] = 1.5e308, rigid_state[3] = 1.5e308;
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "overflows");
+    c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas;
+    rigid_state[5] = NAN;
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "not finite");
+
+    /* Implicit settings, as lpi_set_implicit_options checks them. */
+    const double tolerances[] = {0.0, -1e-10, NAN, INFINITY};
+    for (int i = 0; i < 4; ++i) {
+        c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas;
+        c.tolerance = tolerances[i];
+        assert_crafted_refused(&c, LPI_ERR_FORMAT, "tolerance");
+    }
+    const int32_t iterations[] = {0, -5, INT32_MIN};
+    for (int i = 0; i < 3; ++i) {
+        c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas;
+        c.iterations = iterations[i];
+        assert_crafted_refused(&c, LPI_ERR_FORMAT, "max_iterations");
+    }
+    c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas;
+    c.time = INFINITY;
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "time");
+
+    /* Methods: the registry's name with the registry's weights, or a custom
+     * composition that passes lpi_set_composition. */
+    c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas, c.method = "strang";
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "alias");
+    c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas, c.method = "no-such-method";
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "unknown method");
+    c = rigid_crafted(), c.n_gammas = 0, c.gammas = NULL;
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "other weights");
+    const double lopsided[3] = {0.5, 0.25, 0.25};
+    c = rigid_crafted(), c.method = "custom", c.n_gammas = 3, c.gammas = lopsided;
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "symmetric");
+
+    /* Names: printable ASCII, no NUL inside, bounded lengths. */
+    static const char kind_with_nul[] = "rigid-body\0x";
+    c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas, c.split = "casimir\tshift";
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "printable");
+    {
+        /* "rigid-body\0x": the name is compared whole, NUL and all. */
+        size_t n;
+        c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas;
+        unsigned char *buf = craft(&c, &n);
+        unsigned char *longer = malloc(n + 2);
+        memcpy(longer, buf, 24);
+        const uint32_t len = 12;
+        memcpy(longer + 24, &len, 4);
+        memcpy(longer + 28, kind_with_nul, 12);
+        memcpy(longer + 40, buf + 38, n - 38);
+        const uint64_t total = n + 2;
+        memcpy(longer + 16, &total, 8);
+        reseal(longer, n + 2);
+        assert_refused(longer, n + 2, "printable");
+        free(buf), free(longer);
+    }
+    char *absurd = calloc(1, 258);
+    memset(absurd, 'a', 257);
+    c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas, c.method = absurd;
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "at most 256");
+    free(absurd);
+
+    /* Counts whose byte size overflows 64 bits, or far beyond the payload. */
+    c = rigid_crafted(), c.n_gammas = 1, c.gammas = gammas;
+    c.n_state = UINT64_C(1) << 61; /* times 8 is 2^64 = 0 */
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "state");
+    c.n_state = UINT64_MAX;
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "state");
+    {
+        /* A parameter count of 2^29 (times 8 is 2^32), three inertias after it. */
+        size_t n;
+        crafted honest = rigid_crafted();
+        honest.n_gammas = 1, honest.gammas = gammas;
+        unsigned char *buf = craft(&honest, &n);
+        const uint32_t huge = 0x20000000u;
+        memcpy(buf + 38, &huge, 4);
+        reseal(buf, n);
+        assert_refused(buf, n, "parameters");
+        free(buf);
+    }
+}
+
+/* Sine-Euler: the working state must pass lpi_sine_euler_set_modes
+ * (Hermitian, w_0 real); a kind this build cannot make is UNSUPPORTED. */
+static void test_sine_euler_payloads(void **state) {
+    (void)state;
+    /* N = 3, from public coordinates: w_0 = 0.5, w_(0,1) = 0.25 - 0.5 i,
+     * w_(1,-1) = 1, w_(1,0) = -0.75 i, w_(1,1) = 0.125; the rest their
+     * conjugates. Layout [a*N+b] = (re, im). */
+    double modes[18] = {0};
+    const struct {
+        int a, b;
+        double re, im;
+    } half[] = {{0, 1, 0.25, -0.5}, {1, 2, 1.0, 0.0}, {1, 0, 0.0, -0.75}, {1, 1, 0.125, 0.0}};
+    modes[0] = 0.5;
+    for (int i = 0; i < 4; ++i) {
+        const int m = half[i].a * 3 + half[i].b;
+        const int minus = ((3 - half[i].a) % 3) * 3 + (3 - half[i].b) % 3;
+        modes[2 * m] = half[i].re, modes[2 * m + 1] = half[i].im;
+        modes[2 * minus] = half[i].re, modes[2 * minus + 1] = -half[i].im;
+    }
+    const double N = 3.0, gammas[1] = {1.0};
+    crafted c = {"sine-euler", 1, &N, "directions", "leapfrog", 1, gammas, 1e-13, 100, 0.0,
+                 18, 18, modes};
+    size_t size;
+    unsigned char *buf = craft(&c, &size);
+    lpi_system *probe = NULL;
+    const int available = lpi_sine_euler_create(&probe, 3);
+    if (available == LPI_ERR_UNSUPPORTED) {
+        /* The file is intact: this build lacks what the kind needs. */
+        lpi_system *sys = (lpi_system *)0x1;
+        LPI_ASSERT_FAILS(NULL, lpi_load_buffer(&sys, buf, size), LPI_ERR_UNSUPPORTED,
+                         "lpi_load_buffer");
+        assert_non_null(strstr(lpi_last_error(NULL), "FFTW"));
+        assert_null(sys);
+        free(buf);
+        return;
+    }
+    assert_int_equal(available, LPI_OK);
+    lpi_destroy(probe);
+    lpi_system *sys = load(buf, size);
+    double back[18];
+    assert_int_equal(lpi_sine_euler_get_modes(sys, back, 18), LPI_OK);
+    assert_memory_equal(back, modes, sizeof modes);
+    size_t again_size;
+    unsigned char *again = save(sys, &again_size);
+    assert_int_equal(again_size, size);
+    assert_memory_equal(again, buf, size);
+    free(again), free(buf);
+    lpi_destroy(sys);
+
+    modes[2 * 1 + 1] += 1e-3; /* w_(0,1) no longer the conjugate of w_(0,2) */
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "Hermitian");
+    modes[2 * 1 + 1] -= 1e-3;
+    modes[1] = 0.25; /* w_0 not real */
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "real");
+    modes[1] = 0.0;
+    const double even = 4.0, fractional = 3.5;
+    c.params = &even;
+    c.n_state = c.state_values = 32;
+    double zeros[32] = {0};
+    c.state = zeros;
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "invalid sine-euler parameters");
+    c.params = &fractional;
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "not an integer");
+}
+
+/* A legitimate run is never refused: the carry frozen by a non-splitting
+ * baseline after a splitting run, and sine-Euler modes after rk4 (which does
+ * not keep them Hermitian to the bit), load and continue to the bit. */
+static void test_baselines_after_splitting(void **state) {
+    (void)state;
+    const char *baselines[] = {"rk4", "implicit-midpoint"};
+    for (int b = 0; b < 2; ++b) {
+        lpi_system *sys = pendulum();
+        assert_int_equal(lpi_step(sys, 0.05, 2000), LPI_OK);
+        assert_int_equal(lpi_set_method(sys, baselines[b]), LPI_OK);
+        assert_resumes(sys, 0.05, 2000, 100);
+        lpi_destroy(sys);
+    }
+    lpi_system *sys = sine_euler(9);
+    if (!sys) return;
+    assert_int_equal(lpi_set_method(sys, "rk4"), LPI_OK);
+    assert_resumes(sys, 0.02, 100, 20);
+    lpi_destroy(sys);
+}
+
 /* Generic and moment systems carry user callbacks: refused, saying why. */
 static int grad_x0(size_t n, const double *x, double *g, void *u) {
     (void)n, (void)x, (void)u;
@@ -447,6 +757,133 @@ static void test_files(void **state) {
     lpi_destroy(sys);
 }
 
+/* Peak resident memory, in KiB. */
+static long peak_rss_kib(void) {
+    struct rusage usage;
+    assert_int_equal(getrusage(RUSAGE_SELF, &usage), 0);
+    return usage.ru_maxrss;
+}
+
+/* A sparse file of `size` bytes that starts with `head`; 0 when the file
+ * system cannot hold it. */
+static int sparse_file(const char *path, const void *head, size_t head_size, off_t size) {
+    const int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    assert_true(fd >= 0);
+    assert_int_equal(write(fd, head, head_size), (ssize_t)head_size);
+    const int ok = ftruncate(fd, size) == 0;
+    close(fd);
+    return ok;
+}
+
+/* A file is judged by its header and size before it is read: a foreign
+ * file or a lying header of gigabytes costs neither its size in memory nor
+ * the time to read it, and gives FORMAT, never NO_MEMORY. */
+static void test_files_read_bounded(void **state) {
+    (void)state;
+    char dir[] = "checkpoint_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[64];
+    snprintf(path, sizeof path, "%s/big", dir);
+    lpi_system *sys = rigid_body(), *out = (lpi_system *)0x1;
+    size_t size;
+    unsigned char *buf = save(sys, &size);
+    const long before = peak_rss_kib();
+    const off_t sizes[] = {(off_t)1 << 30, (off_t)8 << 30};
+    for (int i = 0; i < 2; ++i) {
+        /* Foreign: text where the magic should be. */
+        if (!sparse_file(path, "Just some text, no checkpoint at all", 36, sizes[i])) break;
+        LPI_ASSERT_FAILS(NULL, lpi_load(&out, path), LPI_ERR_FORMAT, "lpi_load");
+        assert_true(peak_rss_kib() - before < 64 * 1024);
+        assert_non_null(strstr(lpi_last_error(NULL), "magic"));
+        assert_null(out);
+        /* A real header, announcing its own size: not the file's. */
+        assert_true(sparse_file(path, buf, size, sizes[i]));
+        LPI_ASSERT_FAILS(NULL, lpi_load(&out, path), LPI_ERR_FORMAT, "lpi_load");
+        assert_true(peak_rss_kib() - before < 64 * 1024);
+        assert_non_null(strstr(lpi_last_error(NULL), "unexpected bytes"));
+    }
+    /* A header announcing 2^62 bytes, in a small file and in a buffer. */
+    unsigned char *liar = malloc(size);
+    memcpy(liar, buf, size);
+    const uint64_t huge = UINT64_C(1) << 62;
+    memcpy(liar + 16, &huge, 8);
+    assert_true(sparse_file(path, liar, size, (off_t)size));
+    LPI_ASSERT_FAILS(NULL, lpi_load(&out, path), LPI_ERR_FORMAT, "lpi_load");
+    assert_non_null(strstr(lpi_last_error(NULL), "truncated"));
+    assert_non_null(strstr(lpi_last_error(NULL), path)); /* which file */
+    assert_refused(liar, size, "truncated");
+    const long grown = peak_rss_kib() - before;
+    printf("peak memory grew by %ld KiB over the foreign and lying files\n", grown);
+    assert_true(grown < 64 * 1024);
+    unlink(path);
+    assert_int_equal(rmdir(dir), 0);
+    free(liar), free(buf);
+    lpi_destroy(sys);
+}
+
+/* Any name the file system accepts can be saved to: the temporary file has
+ * a short name of its own, not the target's name with a suffix. Failures
+ * name the path and keep the old file. */
+static void test_save_names_and_failures(void **state) {
+    (void)state;
+    char dir[] = "checkpoint_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char longest[512], missing[512];
+    const long name_max = pathconf(dir, _PC_NAME_MAX);
+    assert_true(name_max >= 14 && name_max < 400);
+    int n = snprintf(longest, sizeof longest, "%s/", dir);
+    memset(longest + n, 'c', (size_t)name_max);
+    longest[n + name_max] = '\0';
+    snprintf(missing, sizeof missing, "%s/no-such-dir/run.lpi", dir);
+
+    lpi_system *sys = rigid_body(), *copy = NULL;
+    assert_int_equal(lpi_step(sys, 0.01, 10), LPI_OK);
+    assert_int_equal(lpi_save(sys, longest), LPI_OK);
+    assert_int_equal(count_entries(dir), 1);
+    assert_int_equal(lpi_load(&copy, longest), LPI_OK);
+    assert_true(lpi_time(copy) == lpi_time(sys));
+    lpi_destroy(copy);
+
+    /* A missing directory: IO, naming the path. */
+    LPI_ASSERT_FAILS(sys, lpi_save(sys, missing), LPI_ERR_IO, "lpi_save");
+    assert_non_null(strstr(lpi_last_error(sys), missing));
+    /* The target is a directory: refused, the directory intact. */
+    LPI_ASSERT_FAILS(sys, lpi_save(sys, dir), LPI_ERR_IO, "lpi_save");
+    assert_int_equal(count_entries(dir), 1);
+    copy = (lpi_system *)0x1;
+    LPI_ASSERT_FAILS(NULL, lpi_load(&copy, dir), LPI_ERR_IO, "lpi_load");
+    assert_non_null(strstr(lpi_last_error(NULL), "is a directory"));
+    assert_null(copy);
+
+    /* A write that fails half-way (the file-size limit stands in for a full
+     * disk): IO, the old checkpoint intact, no temporary file left. */
+    size_t size;
+    unsigned char *old = save(sys, &size);
+    assert_int_equal(lpi_step(sys, 0.01, 10), LPI_OK);
+    struct rlimit limit;
+    assert_int_equal(getrlimit(RLIMIT_FSIZE, &limit), 0);
+    const struct rlimit small = {size / 2, limit.rlim_max};
+    void (*previous)(int) = signal(SIGXFSZ, SIG_IGN);
+    assert_int_equal(setrlimit(RLIMIT_FSIZE, &small), 0);
+    const int status = lpi_save(sys, longest);
+    assert_int_equal(setrlimit(RLIMIT_FSIZE, &limit), 0);
+    signal(SIGXFSZ, previous);
+    assert_int_equal(status, LPI_ERR_IO);
+    assert_non_null(strstr(lpi_last_error(sys), longest));
+    assert_int_equal(count_entries(dir), 1);
+    FILE *f = fopen(longest, "rb");
+    assert_non_null(f);
+    unsigned char *file = malloc(size + 1);
+    assert_int_equal(fread(file, 1, size + 1, f), size);
+    fclose(f);
+    assert_memory_equal(file, old, size);
+
+    unlink(longest);
+    assert_int_equal(rmdir(dir), 0);
+    free(file), free(old);
+    lpi_destroy(sys);
+}
+
 static void test_null_and_sizes(void **state) {
     (void)state;
     lpi_system *sys = rigid_body(), *out = (lpi_system *)0x1;
@@ -480,8 +917,14 @@ int main(void) {
         cmocka_unit_test(test_resume_every_method),
         cmocka_unit_test(test_truncated_and_flipped),
         cmocka_unit_test(test_foreign_newer_other_order),
+        cmocka_unit_test(test_layout_and_round_trip),
+        cmocka_unit_test(test_impossible_payloads),
+        cmocka_unit_test(test_sine_euler_payloads),
+        cmocka_unit_test(test_baselines_after_splitting),
         cmocka_unit_test(test_callbacks_refused),
         cmocka_unit_test(test_files),
+        cmocka_unit_test(test_files_read_bounded),
+        cmocka_unit_test(test_save_names_and_failures),
         cmocka_unit_test(test_null_and_sizes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -20,17 +20,23 @@ struct Bytes {
 };
 
 // A new handle from the bytes that read() gives; *out stays NULL on failure.
+// A refused file's path leads the message (I/O errors name it already).
 template <class Read>
-int load(lpi_system **out, const char *function, Read &&read) {
+int load(lpi_system **out, const char *function, const char *path, Read &&read) {
     if (out) *out = nullptr;
     return guarded(nullptr, function, [&] {
         require(out, "out");
-        Bytes bytes;
-        read(bytes);
-        lpi::Checkpoint cp = lpi::decode_checkpoint(bytes.data, bytes.size);
-        auto handle = std::make_unique<lpi_system>(std::move(cp.model));
-        lpi::restore_checkpoint(handle->system, cp);
-        *out = handle.release();
+        try {
+            Bytes bytes;
+            read(bytes);
+            lpi::Checkpoint cp = lpi::decode_checkpoint(bytes.data, bytes.size);
+            auto handle = std::make_unique<lpi_system>(std::move(cp.model));
+            lpi::restore_checkpoint(handle->system, cp);
+            *out = handle.release();
+        } catch (const lpi::Error &e) {
+            if (!path || (e.status() != LPI_ERR_FORMAT && e.status() != LPI_ERR_UNSUPPORTED)) throw;
+            lpi::fail(e.status(), std::string("'") + path + "': " + e.what());
+        }
     });
 }
 
@@ -48,9 +54,9 @@ LPI_API int lpi_save(const lpi_system *sys, const char *path) {
 }
 
 LPI_API int lpi_load(lpi_system **out, const char *path) {
-    return load(out, "lpi_load", [&](Bytes &bytes) {
+    return load(out, "lpi_load", path, [&](Bytes &bytes) {
         require(path, "path");
-        bytes.owned = lpi::read_file(path);
+        bytes.owned = lpi::read_checkpoint_file(path);
         bytes.data = bytes.owned.data();
         bytes.size = bytes.owned.size();
     });
@@ -74,7 +80,7 @@ LPI_API int lpi_save_buffer(const lpi_system *sys, void *buf, size_t capacity, s
 }
 
 LPI_API int lpi_load_buffer(lpi_system **out, const void *buf, size_t size) {
-    return load(out, "lpi_load_buffer", [&](Bytes &bytes) {
+    return load(out, "lpi_load_buffer", nullptr, [&](Bytes &bytes) {
         require(buf, "buf");
         bytes.data = static_cast<const unsigned char *>(buf);
         bytes.size = size;

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <system_error>
@@ -71,6 +72,12 @@ public:
         need(n, what);
         std::string s(reinterpret_cast<const char *>(p_), n);
         p_ += n;
+        // Every name this library writes is printable ASCII: a NUL or a
+        // control byte would also end up inside error messages.
+        for (unsigned char c : s)
+            if (c < 0x20 || c > 0x7E)
+                fail(LPI_ERR_FORMAT, std::string(what) + " holds the byte " + std::to_string(c) +
+                                         " (names are printable ASCII)");
         return s;
     }
     std::vector<double> get_doubles(std::uint64_t n, const char *what) {
@@ -103,6 +110,43 @@ std::uint64_t load_u64(const unsigned char *p) {
 }
 
 std::string io_reason(int error) { return std::generic_category().message(error); }
+
+std::string format_double(double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.17g", x);
+    return text;
+}
+
+// Checks the header (the first head_size <= 24 bytes of a checkpoint of
+// `size` bytes): magic, byte order, version, and the announced total size
+// against the actual one.
+void check_header(const unsigned char *head, std::size_t head_size, std::uint64_t size) {
+    // In the order that gives the most useful message.
+    const std::size_t magic_seen = head_size < sizeof kMagic ? head_size : sizeof kMagic;
+    if (magic_seen > 0 && std::memcmp(head, kMagic, magic_seen) != 0)
+        fail(LPI_ERR_FORMAT, "not a liepoisson checkpoint (wrong magic bytes)");
+    if (head_size < kHeaderSize || size < kHeaderSize + kChecksumSize)
+        fail(LPI_ERR_FORMAT, "truncated: " + std::to_string(size) +
+                                 " bytes, shorter than a checkpoint header");
+    const std::uint32_t order = load_u32(head + 8);
+    if (order == kByteOrderSwapped)
+        fail(LPI_ERR_FORMAT, "written on a machine of the other byte order (this build reads "
+                             "checkpoints of its own byte order only)");
+    if (order != kByteOrder) fail(LPI_ERR_FORMAT, "corrupted header (byte-order marker)");
+    const std::uint32_t version = load_u32(head + 12);
+    if (version > kCheckpointVersion)
+        fail(LPI_ERR_FORMAT, "format version " + std::to_string(version) +
+                                 " is newer than this library reads (up to " +
+                                 std::to_string(kCheckpointVersion) + "); upgrade liepoisson");
+    if (version == 0) fail(LPI_ERR_FORMAT, "corrupted header (format version 0)");
+    const std::uint64_t total = load_u64(head + 16);
+    if (total > size)
+        fail(LPI_ERR_FORMAT, "truncated: " + std::to_string(size) + " of " +
+                                 std::to_string(total) + " bytes");
+    if (total < size)
+        fail(LPI_ERR_FORMAT, std::to_string(size - total) + " unexpected bytes after the " +
+                                 std::to_string(total) + "-byte checkpoint");
+}
 
 // The models a checkpoint can name, rebuilt from their parameters. The
 // state length is checked first: a crafted file must not make the library
@@ -146,6 +190,55 @@ std::unique_ptr<Model> make_model_for_checkpoint(const std::string &kind,
         fail(LPI_ERR_FORMAT, std::string("invalid ") + kind + " parameters: " + e.what());
     }
     fail(LPI_ERR_FORMAT, "unknown system kind '" + kind + "'");
+}
+
+// The carry of a compensated model ([x, carry]) is the rounding remainder
+// of x: at most half an ulp of its component when a flow writes it
+// (compensated_add). The non-splitting baselines (rk4, implicit-midpoint)
+// leave it as it is while x moves, so it is bounded against the largest
+// component, with a margin of 2^21 over what the flows leave: 2^-32 of it.
+constexpr double kMaxRelativeCarry = 0x1p-32;
+
+void check_carry(const CompensatedModel &model, const std::vector<double> &state) {
+    const std::size_t n = model.dim();
+    double largest = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double value = state[i] + state[n + i];
+        if (!std::isfinite(value))
+            fail(LPI_ERR_FORMAT, "state entry " + std::to_string(i) +
+                                     " overflows when its compensation carry is added");
+        largest = std::fmax(largest, std::fabs(value));
+    }
+    for (std::size_t i = 0; i < n; ++i)
+        if (std::fabs(state[n + i]) > kMaxRelativeCarry * largest)
+            fail(LPI_ERR_FORMAT, "the compensation carry of state entry " + std::to_string(i) +
+                                     " is " + format_double(state[n + i]) +
+                                     ", no rounding remainder of a state whose largest entry is " +
+                                     format_double(largest));
+}
+
+// The working state must be one the model's own operations produce, checked
+// as strictly as the setters check what users give: the checksum proves
+// that the bytes are those written, not that this library wrote them.
+void check_working_state(const Model &model, const std::vector<double> &state) {
+    for (std::size_t i = 0; i < state.size(); ++i)
+        if (!std::isfinite(state[i]))
+            fail(LPI_ERR_FORMAT, "working state entry " + std::to_string(i) + " is not finite");
+    if (const auto *compensated = dynamic_cast<const CompensatedModel *>(&model)) {
+        check_carry(*compensated, state);
+    } else if (const auto *sine_euler = dynamic_cast<const SineEulerModel *>(&model)) {
+        // The modes must pass lpi_sine_euler_set_modes: Hermitian and w_0
+        // real, to its tolerance. The splitting flows keep them so to the
+        // bit (each mirror mode is written as the exact conjugate), but the
+        // rk4, implicit-midpoint and direct-eq5 baselines do not, so a
+        // checkpoint they leave cannot be held to bit-exact symmetry.
+        std::vector<double> x(model.dim());
+        try {
+            sine_euler->public_from_modes(state.data(), x.data());
+        } catch (const Error &e) {
+            fail(LPI_ERR_FORMAT, std::string("the stored state: ") + e.what());
+        }
+    }
 }
 
 }  // namespace
@@ -193,31 +286,7 @@ std::vector<unsigned char> encode_checkpoint(const System &system) {
 }
 
 Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size) {
-    // The header, in the order that gives the most useful message.
-    const std::size_t magic_seen = size < sizeof kMagic ? size : sizeof kMagic;
-    if (magic_seen > 0 && std::memcmp(data, kMagic, magic_seen) != 0)
-        fail(LPI_ERR_FORMAT, "not a liepoisson checkpoint (wrong magic bytes)");
-    if (size < kHeaderSize + kChecksumSize)
-        fail(LPI_ERR_FORMAT, "truncated: " + std::to_string(size) +
-                                 " bytes, shorter than a checkpoint header");
-    const std::uint32_t order = load_u32(data + 8);
-    if (order == kByteOrderSwapped)
-        fail(LPI_ERR_FORMAT, "written on a machine of the other byte order (this build reads "
-                             "checkpoints of its own byte order only)");
-    if (order != kByteOrder) fail(LPI_ERR_FORMAT, "corrupted header (byte-order marker)");
-    const std::uint32_t version = load_u32(data + 12);
-    if (version > kCheckpointVersion)
-        fail(LPI_ERR_FORMAT, "format version " + std::to_string(version) +
-                                 " is newer than this library reads (up to " +
-                                 std::to_string(kCheckpointVersion) + "); upgrade liepoisson");
-    if (version == 0) fail(LPI_ERR_FORMAT, "corrupted header (format version 0)");
-    const std::uint64_t total = load_u64(data + 16);
-    if (total > size)
-        fail(LPI_ERR_FORMAT, "truncated: " + std::to_string(size) + " of " +
-                                 std::to_string(total) + " bytes");
-    if (total < size)
-        fail(LPI_ERR_FORMAT, std::to_string(size - total) + " unexpected bytes after the " +
-                                 std::to_string(total) + "-byte checkpoint");
+    check_header(data, size, size);
     const std::size_t body = size - kChecksumSize;
     if (crc32(data, body) != load_u32(data + body))
         fail(LPI_ERR_FORMAT, "checksum mismatch: the checkpoint is corrupted");
@@ -247,6 +316,8 @@ Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size) {
         fail(LPI_ERR_FORMAT, "the state has " + std::to_string(cp.state.size()) + " values, a " +
                                  kind + " system of these parameters has " +
                                  std::to_string(cp.model->state_size()));
+    if (!std::isfinite(cp.time)) fail(LPI_ERR_FORMAT, "the time is not finite");
+    check_working_state(*cp.model, cp.state);
     return cp;
 }
 
@@ -263,6 +334,10 @@ void restore_checkpoint(System &system, const Checkpoint &cp) {
         if (e.status() == LPI_ERR_NO_MEMORY) throw;
         fail(LPI_ERR_FORMAT, e.what());
     }
+    // An alias ("strang") is resolved on load but never written.
+    if (system.method().name != cp.method)
+        fail(LPI_ERR_FORMAT, "method '" + cp.method + "' is stored under its name '" +
+                                 system.method().name + "', not an alias");
     // Bit-for-bit continuation needs the very same weights.
     const std::vector<double> &gammas = system.method().gammas;
     if (gammas.size() != cp.gammas.size() ||
@@ -272,42 +347,61 @@ void restore_checkpoint(System &system, const Checkpoint &cp) {
                              "in the checkpoint; resuming would not continue the same trajectory");
 }
 
-void write_file_atomically(const std::string &path, const std::vector<unsigned char> &bytes) {
+namespace {
+
+// The directory part of path, for the temporary file and the final fsync.
+std::string directory_of(const std::string &path) {
+    const std::size_t slash = path.find_last_of('/');
+    return slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+}
+
+// A new, empty file in `dir` under a short name of its own (".lpi-" and 12
+// characters): legal wherever the target's name is, even a name of NAME_MAX
+// bytes to which no suffix could be added. O_EXCL with mode 0666 (not
+// mkstemp's 0600), so the umask gives the file the usual permissions.
+int create_temporary(const std::string &dir, std::string &temp) {
     static std::atomic<unsigned> counter{0};
-    const std::string temp = path + ".tmp." + std::to_string(::getpid()) + "." +
-                             std::to_string(counter.fetch_add(1));
-    const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    for (int attempt = 0;; ++attempt) {
+        char name[32];
+        std::snprintf(name, sizeof name, ".lpi-%06x%06x",
+                      static_cast<unsigned>(::getpid()) & 0xFFFFFFu,
+                      counter.fetch_add(1) & 0xFFFFFFu);
+        temp = dir + "/" + name;
+        const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd >= 0 || errno != EEXIST || attempt == 100) return fd;
+    }
+}
+
+}  // namespace
+
+void write_file_atomically(const std::string &path, const std::vector<unsigned char> &bytes) {
+    const std::string dir = directory_of(path);
+    std::string temp;
+    const int fd = create_temporary(dir, temp);
     if (fd < 0)
-        fail(LPI_ERR_IO, "cannot create '" + temp + "': " + io_reason(errno));
-    auto abandon = [&](const std::string &what, int error) {
-        ::close(fd);
+        fail(LPI_ERR_IO, "cannot save '" + path + "': cannot create a file in '" + dir +
+                             "': " + io_reason(errno));
+    // Until the rename, `path` is untouched: a failure leaves the old file.
+    auto abandon = [&](const std::string &what, int error, bool open) {
+        if (open) ::close(fd);
         ::unlink(temp.c_str());
-        fail(LPI_ERR_IO, what + " '" + temp + "': " + io_reason(error));
+        fail(LPI_ERR_IO, "cannot save '" + path + "': " + what + ": " + io_reason(error));
     };
     std::size_t done = 0;
     while (done < bytes.size()) {
         const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
         if (n < 0) {
             if (errno == EINTR) continue;
-            abandon("cannot write", errno);
+            abandon("cannot write '" + temp + "'", errno, true);
         }
         done += static_cast<std::size_t>(n);
     }
-    if (::fsync(fd) != 0) abandon("cannot flush", errno);
-    if (::close(fd) != 0) {
-        const int error = errno;
-        ::unlink(temp.c_str());
-        fail(LPI_ERR_IO, "cannot close '" + temp + "': " + io_reason(error));
-    }
-    if (::rename(temp.c_str(), path.c_str()) != 0) {
-        const int error = errno;
-        ::unlink(temp.c_str());
-        fail(LPI_ERR_IO, "cannot rename '" + temp + "' to '" + path + "': " + io_reason(error));
-    }
+    if (::fsync(fd) != 0) abandon("cannot flush '" + temp + "'", errno, true);
+    if (::close(fd) != 0) abandon("cannot close '" + temp + "'", errno, false);
+    if (::rename(temp.c_str(), path.c_str()) != 0)
+        abandon("cannot rename '" + temp + "' to it", errno, false);
     // Make the rename itself durable. Best effort: the file is complete and in
     // place either way, and some file systems cannot sync a directory.
-    const std::size_t slash = path.find_last_of('/');
-    const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
     const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (dfd >= 0) {
         ::fsync(dfd);
@@ -315,35 +409,49 @@ void write_file_atomically(const std::string &path, const std::vector<unsigned c
     }
 }
 
-std::vector<unsigned char> read_file(const std::string &path) {
+namespace {
+
+// Reads up to n bytes; fewer only at the end of the file.
+std::size_t read_fully(int fd, unsigned char *data, std::size_t n, const std::string &path) {
+    std::size_t done = 0;
+    while (done < n) {
+        const ssize_t got = ::read(fd, data + done, n - done);
+        if (got < 0) {
+            if (errno == EINTR) continue;
+            fail(LPI_ERR_IO, "cannot read '" + path + "': " + io_reason(errno));
+        }
+        if (got == 0) break;
+        done += static_cast<std::size_t>(got);
+    }
+    return done;
+}
+
+}  // namespace
+
+std::vector<unsigned char> read_checkpoint_file(const std::string &path) {
     // O_NONBLOCK: a FIFO given by mistake must not hang the call.
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) fail(LPI_ERR_IO, "cannot open '" + path + "': " + io_reason(errno));
+    struct Closer {
+        int fd;
+        ~Closer() { ::close(fd); }
+    } closer{fd};
     struct stat st;
-    if (::fstat(fd, &st) != 0) {
-        const int error = errno;
-        ::close(fd);
-        fail(LPI_ERR_IO, "cannot stat '" + path + "': " + io_reason(error));
-    }
-    if (!S_ISREG(st.st_mode)) {
-        ::close(fd);
-        fail(LPI_ERR_IO, "'" + path + "' is not a regular file");
-    }
-    std::vector<unsigned char> bytes;
-    bytes.reserve(static_cast<std::size_t>(st.st_size));
-    unsigned char chunk[65536];
-    for (;;) {
-        const ssize_t n = ::read(fd, chunk, sizeof chunk);
-        if (n < 0) {
-            if (errno == EINTR) continue;
-            const int error = errno;
-            ::close(fd);
-            fail(LPI_ERR_IO, "cannot read '" + path + "': " + io_reason(error));
-        }
-        if (n == 0) break;
-        bytes.insert(bytes.end(), chunk, chunk + n);
-    }
-    ::close(fd);
+    if (::fstat(fd, &st) != 0) fail(LPI_ERR_IO, "cannot stat '" + path + "': " + io_reason(errno));
+    if (S_ISDIR(st.st_mode)) fail(LPI_ERR_IO, "'" + path + "' is a directory");
+    if (!S_ISREG(st.st_mode)) fail(LPI_ERR_IO, "'" + path + "' is not a regular file");
+    // The header first, checked against the file's size: a foreign or lying
+    // file costs 24 bytes of reading, never an allocation of its size.
+    const auto file_size = static_cast<std::uint64_t>(st.st_size);
+    unsigned char head[kHeaderSize];
+    const std::size_t head_size = read_fully(fd, head, sizeof head, path);
+    check_header(head, head_size, file_size);
+    if (file_size > std::numeric_limits<std::size_t>::max()) throw std::bad_alloc();
+    std::vector<unsigned char> bytes(static_cast<std::size_t>(file_size));
+    std::memcpy(bytes.data(), head, kHeaderSize);
+    const std::size_t rest = bytes.size() - kHeaderSize;
+    if (read_fully(fd, bytes.data() + kHeaderSize, rest, path) != rest)
+        fail(LPI_ERR_FORMAT, "truncated while it was read (the file shrank)");
     return bytes;
 }
 

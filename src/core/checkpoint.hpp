@@ -20,7 +20,7 @@
 //              state        u64 n, n x f64   (the working layout, including
 //                                              the compensated carry)
 //   size-4     CRC-32       u32      of every byte before it (IEEE 802.3)
-// A string is u32 length + bytes (no NUL). Threads are a runtime setting
+// A string is u32 length + bytes (printable ASCII, at most 256). Threads are a runtime setting
 // (results are identical for every count) and are not stored.
 #pragma once
 
@@ -57,16 +57,25 @@ struct Checkpoint {
 
 // Throws LPI_ERR_FORMAT for anything that is not an intact checkpoint this
 // library can read (truncated, corrupted, wrong magic, other byte order, newer
-// version, inconsistent contents), with a message saying which.
+// version, inconsistent contents, or contents no setter would accept: every
+// parameter and the working state are validated as strictly as user input),
+// with a message saying which; LPI_ERR_UNSUPPORTED for a kind this build
+// cannot make (sine-Euler without FFTW). Memory in proportion to `size`,
+// whatever the contents claim.
 Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size);
 // Sets method, implicit settings, state and time; LPI_ERR_FORMAT when this
-// build's method of that name has other coefficients than the checkpoint's.
+// build's method of that name has other coefficients than the checkpoint's,
+// or the name is an alias (a checkpoint stores the name itself).
 void restore_checkpoint(System &system, const Checkpoint &checkpoint);
 
-// Atomic write: a temporary file in the same directory, fsync, rename over
-// path, fsync of the directory. LPI_ERR_IO (with the reason) on failure, and
-// no temporary file is left behind.
+// Atomic write: a temporary file under a short name of its own in the same
+// directory, fsync, rename over path, fsync of the directory. LPI_ERR_IO
+// (naming path, with the reason) on failure; path then keeps its old
+// contents and no temporary file is left behind.
 void write_file_atomically(const std::string &path, const std::vector<unsigned char> &bytes);
-std::vector<unsigned char> read_file(const std::string &path);
+// The bytes of the checkpoint file at path, read bounded: the header is
+// checked against the file's size (LPI_ERR_FORMAT) before anything of that
+// size is allocated. LPI_ERR_IO when it cannot be read or is no regular file.
+std::vector<unsigned char> read_checkpoint_file(const std::string &path);
 
 }  // namespace lpi

@@ -1,8 +1,10 @@
 #!/bin/sh
-# Builds the libFuzzer harness with clang (ASan + UBSan, the library
-# instrumented too) in build-fuzz/ and runs it for SECONDS (default 60) from
-# the committed corpus. New inputs go to build-fuzz/corpus, never into the
-# repository; a crash leaves its reproducer in build-fuzz/ and fails.
+# Builds the libFuzzer harnesses with clang (ASan + UBSan, the library
+# instrumented too) in build-fuzz/ and runs them from their committed corpora
+# for SECONDS in all (default 60): two thirds to fuzz_api (the API surface),
+# one third to fuzz_checkpoint (the checkpoint decoder). New inputs go to
+# build-fuzz/corpus*, never into the repository; a crash leaves its
+# reproducer in build-fuzz/ and fails.
 #   tests/fuzz/run.sh [SECONDS]
 set -eu
 seconds="${1:-60}"
@@ -14,10 +16,16 @@ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release \
     -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
     -DCMAKE_C_FLAGS="$flags" -DCMAKE_CXX_FLAGS="$flags" \
     -DLPI_FUZZ=ON -DLPI_WITH_OPENMP=OFF -DBUILD_TESTING=OFF >/dev/null
-cmake --build "$build" -j "$jobs" --target fuzz_api
-mkdir -p "$build/corpus"
+cmake --build "$build" -j "$jobs" --target fuzz_api fuzz_checkpoint
+api_seconds=$((seconds * 2 / 3))
+checkpoint_seconds=$((seconds - api_seconds))
+mkdir -p "$build/corpus" "$build/corpus_checkpoint"
 cd "$build"
 # -timeout: one input taking seconds is a hang worth reporting.
-ASAN_OPTIONS=detect_leaks=1 "$build/tests/fuzz/fuzz_api" -max_total_time="$seconds" \
+ASAN_OPTIONS=detect_leaks=1 "$build/tests/fuzz/fuzz_api" -max_total_time="$api_seconds" \
     -timeout=10 -rss_limit_mb=2048 -max_len=512 -print_final_stats=1 \
     "$build/corpus" "$root/tests/fuzz/corpus"
+# -max_len: a little over the largest seed (a sine-Euler N = 5 checkpoint).
+ASAN_OPTIONS=detect_leaks=1 "$build/tests/fuzz/fuzz_checkpoint" \
+    -max_total_time="$checkpoint_seconds" -timeout=10 -rss_limit_mb=2048 -max_len=1024 \
+    -print_final_stats=1 "$build/corpus_checkpoint" "$root/tests/fuzz/corpus_checkpoint"
