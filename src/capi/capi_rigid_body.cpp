@@ -25,7 +25,7 @@ LPI_API int lpi_rigid_body_exact(const lpi_system *sys, double t, double *out) {
         lpi::rigid_body_exact(inertia, m0, t, m);
         // The state and t are finite: a value that is not has overflowed.
         lpi::require_no_overflow(m, 3, [](std::size_t i) {
-            return "component " + std::to_string(i) + " of the exact solution";
+            return "component " + std::to_string(i) + " of the exact solution at this t";
         });
         out[0] = m[0], out[1] = m[1], out[2] = m[2];
     });

@@ -107,7 +107,7 @@ LPI_API int lpi_sine_euler_get_grid(const lpi_system *sys, double *w, size_t n) 
         std::vector<double> grid(n);
         model.grid(sys->system.working_state().data(), grid.data());
         lpi::require_no_overflow(grid.data(), n, [&](std::size_t i) {
-            return entry_name("grid value", i, model.order());
+            return entry_name("grid value", i, model.order()) + " of this state";
         });
         std::memcpy(w, grid.data(), sizeof(double) * n);
     });
@@ -118,7 +118,7 @@ LPI_API int lpi_sine_euler_enstrophy(const lpi_system *sys, double *out) {
         const auto &model = sine_euler(sys);
         require(out, "out");
         const double enstrophy = model.enstrophy(sys->system.working_state().data());
-        lpi::require_no_overflow(&enstrophy, 1, [](std::size_t) { return std::string("the enstrophy"); });
+        lpi::require_no_overflow(&enstrophy, 1, [](std::size_t) { return std::string("the enstrophy of this state"); });
         *out = enstrophy;
     });
 }
@@ -131,7 +131,7 @@ LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, d
         std::vector<double> traces(static_cast<std::size_t>(kmax));
         model.casimir_traces(sys->system.working_state().data(), kmax, traces.data());
         lpi::require_no_overflow(traces.data(), traces.size(), [](std::size_t i) {
-            return "(1/N) tr W^" + std::to_string(i + 1);
+            return "(1/N) tr W^" + std::to_string(i + 1) + " of this state";
         });
         std::copy(traces.begin(), traces.end(), out);
     });

@@ -35,7 +35,7 @@ void require_no_overflow(const double *values, std::size_t n,
                          const std::function<std::string(std::size_t)> &what) {
     for (std::size_t i = 0; i < n; ++i)
         if (!std::isfinite(values[i]))
-            fail(LPI_ERR_OVERFLOW, what(i) + " overflows a double at this state");
+            fail(LPI_ERR_OVERFLOW, what(i) + " overflows a double");
 }
 
 void require_length(const char *what, std::size_t given, std::size_t expected) {
@@ -195,7 +195,7 @@ bool System::step(double dt, std::int64_t nsteps) {
 
 double System::energy() const {
     const double h = model_->energy(state_.data());
-    require_no_overflow(&h, 1, [](std::size_t) { return std::string("the energy"); });
+    require_no_overflow(&h, 1, [](std::size_t) { return std::string("the energy of this state"); });
     return h;
 }
 
@@ -204,7 +204,7 @@ void System::casimirs(double *out, std::size_t n) const {
     std::vector<double> values(n);
     model_->casimirs(state_.data(), values.data());
     require_no_overflow(values.data(), n,
-                        [](std::size_t i) { return "Casimir " + std::to_string(i); });
+                        [](std::size_t i) { return "Casimir " + std::to_string(i) + " of this state"; });
     std::copy(values.begin(), values.end(), out);
 }
 
