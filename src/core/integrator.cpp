@@ -61,12 +61,17 @@ public:
         const std::size_t size = model.state_size();
         const std::size_t last = program_.size() - 1;
         const std::size_t inner_end = merge_seam_ ? last : program_.size();
+        // The next observed step, counted rather than found by a division
+        // per step (one division costs as much as a small model's flow).
+        std::int64_t next_observed = observer.every > 0 ? observer.every : INT64_MAX;
         if (merge_seam_) model.flow(program_[0].piece, program_[0].weight * dt, state);
         for (std::int64_t step = 1; step <= n; ++step) {
             progress = {step, step};
             for (std::size_t i = merge_seam_ ? 1 : 0; i < inner_end; ++i)
                 model.flow(program_[i].piece, program_[i].weight * dt, state);
-            const bool observed = observer.every > 0 && step % observer.every == 0;
+            const bool observed = step == next_observed;
+            if (observed)
+                next_observed = observer.every <= INT64_MAX - step ? step + observer.every : INT64_MAX;
             const bool final = step == n;
             if (merge_seam_) {
                 if (observed && !final) pending_.assign(state, state + size);
