@@ -2,13 +2,24 @@
  * liepoisson — explicit, Casimir-preserving integration of Lie-Poisson systems.
  *
  * The one public header. Every function is prefixed lpi_, every handle is the
- * opaque lpi_system. Fallible functions return an int status: LPI_OK (0) or a
- * negative LPI_ERR_* code; lpi_last_error() then gives the detail. A failed call
- * leaves the handle's state exactly as it was. The library never prints,
- * aborts or exits, and no C++ exception crosses this interface.
+ * opaque lpi_system. Fallible functions return an int status: LPI_OK (0), a
+ * negative LPI_ERR_* code (lpi_last_error() then gives the detail), or - from
+ * lpi_step only - the positive LPI_STOPPED. A failed call leaves the handle's
+ * state exactly as it was. The library never prints, aborts or exits, and no
+ * C++ exception crosses this interface.
  *
  * Threading: one handle is used by one thread at a time; different handles
  * are independent and may be used concurrently.
+ *
+ * Re-entrancy: a user callback (piece gradient or energy, Casimir, moment
+ * product piece, observer) runs while the library is inside a call on its
+ * handle. A call on that same handle from such a callback is refused with
+ * LPI_ERR_BUSY and changes nothing, with two exceptions: inside an observer
+ * (lpi_set_observer) the read-only functions - those taking a const
+ * lpi_system * (lpi_get_state, lpi_energy, lpi_casimirs, the sine-Euler
+ * getters, lpi_save, ...) - are allowed; and lpi_dim, lpi_time,
+ * lpi_casimir_count and lpi_last_error, which return no status, always
+ * answer. Calls on other handles are not affected.
  */
 #ifndef LIEPOISSON_H
 #define LIEPOISSON_H
@@ -49,7 +60,10 @@ extern "C" {
     X(LPI_ERR_CALLBACK, -9, "a user callback reported failure")                     \
     X(LPI_ERR_NO_CONVERGENCE, -10, "an implicit method's iteration did not converge") \
     X(LPI_ERR_IO, -11, "a file could not be opened, read, written or renamed")       \
-    X(LPI_ERR_FORMAT, -12, "data is not a valid checkpoint of this library")
+    X(LPI_ERR_FORMAT, -12, "data is not a valid checkpoint of this library")           \
+    X(LPI_ERR_BUSY, -13, "the handle is inside one of its own callbacks")            \
+    X(LPI_ERR_OVERFLOW, -14, "a result of finite inputs overflows a double")          \
+    X(LPI_STOPPED, 1, "the observer stopped the step loop (not an error)")
 
 typedef enum lpi_status {
 #define LPI_STATUS_ENUM_ENTRY(name, value, message) name = value,
@@ -92,8 +106,9 @@ LPI_API int lpi_rigid_body_exact(const lpi_system *sys, double t, double *out);
  * Split: "standard-map" (the only one). */
 LPI_API int lpi_pendulum_create(lpi_system **out);
 
-/* Releases the handle. NULL is a no-op. */
-LPI_API void lpi_destroy(lpi_system *sys);
+/* Releases the handle; NULL is a no-op (LPI_OK). Called from one of the
+ * handle's own callbacks it frees nothing and returns LPI_ERR_BUSY. */
+LPI_API int lpi_destroy(lpi_system *sys);
 
 LPI_API int lpi_set_method(lpi_system *sys, const char *name);
 LPI_API int lpi_set_split(lpi_system *sys, const char *name);
@@ -106,16 +121,35 @@ LPI_API int lpi_set_state(lpi_system *sys, const double *x, size_t n);
 LPI_API int lpi_get_state(const lpi_system *sys, double *x, size_t n);
 
 /* Advances nsteps steps of size dt (dt finite and nonzero; negative dt
- * integrates backwards; nsteps >= 0). A step whose result is not finite is
- * rolled back to the state before the call and LPI_ERR_NONFINITE returned. */
+ * integrates backwards; nsteps >= 0). The time becomes lpi_time + dt * nsteps
+ * (LPI_ERR_OVERFLOW when that, or dt times a flow weight of the method,
+ * overflows). A step whose result is not finite, or whose callback fails, is
+ * rolled back to the state before the call: LPI_ERR_NONFINITE or
+ * LPI_ERR_CALLBACK with a message naming the step and the time. With an
+ * observer whose callback returns non-zero, LPI_STOPPED (positive): the
+ * state and time are those of a call of that many steps. */
 LPI_API int lpi_step(lpi_system *sys, double dt, int64_t nsteps);
+
+/* An observer of lpi_step: called with the steps completed in the current
+ * call (every, 2 every, ...) and the time reached; the handle then holds
+ * exactly the state a call of that many steps would leave, and observing does
+ * not change the trajectory to the bit. It may read the handle (the functions
+ * taking const lpi_system *); mutating calls on it return LPI_ERR_BUSY. A
+ * non-zero return stops lpi_step after that step (LPI_STOPPED). */
+typedef int (*lpi_observer_fn)(const lpi_system *sys, int64_t step, double t, void *user);
+
+/* Sets the observer of lpi_step (every >= 1), or removes it when fn is NULL
+ * (every is then ignored). Not stored in checkpoints. */
+LPI_API int lpi_set_observer(lpi_system *sys, int64_t every, lpi_observer_fn fn, void *user);
 
 /* Current time; NaN for NULL. Reset to 0 by lpi_set_state. */
 LPI_API double lpi_time(const lpi_system *sys);
 
+/* Energy of the current state; LPI_ERR_OVERFLOW when it overflows a double. */
 LPI_API int lpi_energy(const lpi_system *sys, double *out);
 
-/* Number of Casimirs lpi_casimirs reports; n must equal it. */
+/* Number of Casimirs lpi_casimirs reports; n must equal it. A Casimir that
+ * overflows a double gives LPI_ERR_OVERFLOW naming it, out untouched. */
 LPI_API size_t lpi_casimir_count(const lpi_system *sys);
 LPI_API int lpi_casimirs(const lpi_system *sys, double *out, size_t n);
 
@@ -138,8 +172,10 @@ LPI_API const char *lpi_method_reference(int i);
  * gammas (step i takes gammas[i] * dt), named "custom". The weights must be
  * finite (else LPI_ERR_NONFINITE), sum to 1 within 1e-14 times the sum of
  * their absolute values and be symmetric, gammas[i] = gammas[n-1-i] within a
- * relative 1e-14 (else LPI_ERR_INVALID). Mirrored pairs are replaced by their
- * mean, so the composition is exactly symmetric. The array is copied. */
+ * relative 1e-14 (else LPI_ERR_INVALID); weights whose sum of absolute values
+ * overflows a double are refused with LPI_ERR_OVERFLOW. Mirrored pairs are
+ * replaced by their mean, so the composition is exactly symmetric. The array
+ * is copied. */
 LPI_API int lpi_set_composition(lpi_system *sys, size_t n, const double *gammas);
 
 /* Exact piece flows per step in a long run of the current method, after the
@@ -227,11 +263,14 @@ LPI_API int lpi_sine_euler_size(const lpi_system *sys, int32_t *N);
 LPI_API int lpi_sine_euler_set_modes(lpi_system *sys, const double *re_im, size_t n);
 LPI_API int lpi_sine_euler_get_modes(const lpi_system *sys, double *re_im, size_t n);
 /* Real vorticity on the grid, n = N*N: entry [a*N + b] is
- * w(2 pi a / N, 2 pi b / N) = sum_m w_m exp(i (m1 x + m2 y)). */
+ * w(2 pi a / N, 2 pi b / N) = sum_m w_m exp(i (m1 x + m2 y)). Setting modes
+ * or a grid whose conversion overflows a double gives LPI_ERR_OVERFLOW. */
 LPI_API int lpi_sine_euler_set_grid(lpi_system *sys, const double *w, size_t n);
 LPI_API int lpi_sine_euler_get_grid(const lpi_system *sys, double *w, size_t n);
 
-/* Enstrophy 1/2 sum_m |w_m|^2 (w_0 included) = tr(W^2) / (2N). */
+/* Enstrophy 1/2 sum_m |w_m|^2 (w_0 included) = tr(W^2) / (2N). Here and in
+ * the getters below, a value that overflows a double gives LPI_ERR_OVERFLOW
+ * naming it (the output is then untouched). */
 LPI_API int lpi_sine_euler_enstrophy(const lpi_system *sys, double *out);
 /* out[k-1] = (1/N) tr W^k for k = 1 .. kmax (kmax >= 1; O(kmax N^3)). */
 LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, double *out);
@@ -239,14 +278,21 @@ LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, d
 /* Measures the FFT floor: FFTW executing, with this system's plans, buffers
  * and thread count, the transforms that nsteps steps of the current method
  * execute (and nothing else). Gives seconds per step and transforms per step.
- * A benchmark diagnostic; the state is not touched. */
+ * A benchmark diagnostic; the state is not touched. LPI_ERR_OVERFLOW when the
+ * flow count nsteps x flows per step overflows. */
 LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *seconds_per_step,
                                      double *transforms_per_step);
 
-/* Threads used inside one step (OpenMP over the lines of a direction); n >= 1.
- * Results are identical to the bit for every n. Models that integrate on one
- * thread accept only n = 1 (LPI_ERR_UNSUPPORTED otherwise), as does a build
- * without OpenMP. */
+/* Threads used inside one step (OpenMP over the lines of a direction);
+ * 1 <= n <= 4 x the processors available (omp_get_num_procs), else
+ * LPI_ERR_INVALID. Results are identical to the bit for every n. Models that
+ * integrate on one thread accept only n = 1 (LPI_ERR_UNSUPPORTED otherwise), as
+ * does a build without OpenMP. Before a parallel region could need new
+ * threads on the calling thread (here, and in lpi_step when the thread or the
+ * count changed), the library first starts and joins n - 1 threads of its own:
+ * when the system refuses one (process or memory limits), the call fails with
+ * LPI_ERR_NO_MEMORY and the count is unchanged, instead of the OpenMP runtime
+ * ending the process. See lpi_set_threads(3) for what this cannot cover. */
 LPI_API int lpi_set_threads(lpi_system *sys, int32_t n);
 
 /* FFTW wisdom (shared by the whole process; planning is serialised inside the

@@ -28,11 +28,14 @@ enum target {
     SE,       /* sine-Euler N = 9, stepped */
     SE_RK4,   /* sine-Euler N = 5 with rk4 */
     SE_IMP,   /* sine-Euler N = 5 with implicit-midpoint */
+    RB_HUGE,  /* rigid body at |m| ~ 1e200: energy and Casimir overflow */
+    SE_HUGE,  /* sine-Euler N = 5 with modes 1e308: every derived value overflows */
     TARGETS
 };
 static const char *const kTargetName[TARGETS] = {"NULL", "rigid body", "pendulum", "rigid body/rk4",
     "rigid body/implicit", "generic", "generic (failing callbacks)", "generic (no pieces)",
-    "moments", "sine-Euler", "sine-Euler/rk4", "sine-Euler/implicit"};
+    "moments", "sine-Euler", "sine-Euler/rk4", "sine-Euler/implicit", "rigid body (huge)",
+    "sine-Euler (huge)"};
 static lpi_system *handles[TARGETS];
 static int have_fftw;
 
@@ -102,6 +105,9 @@ static void make_handles(void) {
     assert_int_equal(lpi_add_casimir(handles[GEN_FAIL], casimir_fail, NULL), LPI_OK);
     handles[GEN_EMPTY] = so3();
     assert_int_equal(lpi_moments_create(&handles[MOM]), LPI_OK);
+    const double huge[3] = {1e200, -1e200, 1e200};
+    assert_int_equal(lpi_rigid_body_create(&handles[RB_HUGE], 1.0, 2.0, 3.5), LPI_OK);
+    assert_int_equal(lpi_set_state(handles[RB_HUGE], huge, 3), LPI_OK);
     const int status = lpi_sine_euler_create(&handles[SE], 9);
     have_fftw = status == LPI_OK;
     if (!have_fftw) {
@@ -118,6 +124,11 @@ static void make_handles(void) {
         assert_int_equal(lpi_sine_euler_set_grid(handles[t], grid, 25), LPI_OK);
         assert_int_equal(lpi_set_method(handles[t], methods[t - SE_RK4]), LPI_OK);
     }
+    /* Public coordinates: Re w_(0,1) = Re w_(0,2) = 1e308 (and conjugates). */
+    double x[25] = {0};
+    x[1] = x[3] = 1e308;
+    assert_int_equal(lpi_sine_euler_create(&handles[SE_HUGE], 5), LPI_OK);
+    assert_int_equal(lpi_set_state(handles[SE_HUGE], x, 25), LPI_OK);
 }
 
 /* ---- arguments, invokers and the table ---------------------------------- */
@@ -196,8 +207,7 @@ static int call_lpi_method_reference(lpi_system *s, const args *a, lpi_system **
 }
 static int call_lpi_destroy(lpi_system *s, const args *a, lpi_system **o) {
     (void)s, (void)a, (void)o;
-    lpi_destroy(NULL);
-    return 1;
+    return lpi_destroy(NULL) == LPI_OK;
 }
 static int call_lpi_dim(lpi_system *s, const args *a, lpi_system **o) {
     (void)a, (void)o;
@@ -244,6 +254,14 @@ static int call_lpi_set_state(lpi_system *s, const args *a, lpi_system **o) {
 static int call_lpi_get_state(lpi_system *s, const args *a, lpi_system **o) {
     (void)o;
     return lpi_get_state(s, PTR(P1, out_buf), a->n);
+}
+static int observe_nothing(const lpi_system *s, int64_t step, double t, void *user) {
+    (void)s, (void)step, (void)t, (void)user;
+    return 0;
+}
+static int call_lpi_set_observer(lpi_system *s, const args *a, lpi_system **o) {
+    (void)o;
+    return lpi_set_observer(s, a->k, PTR(P1, observe_nothing), NULL);
 }
 static int call_lpi_step(lpi_system *s, const args *a, lpi_system **o) {
     (void)o;
@@ -375,6 +393,7 @@ static const double kGammasNaN[3] = {0.5, NAN, 0.5};
 static const double kGammasAsym[3] = {0.4, 0.1, 0.5};
 static const double kGammasSum[3] = {0.5, 0.5, 0.5};
 static const double kGammasInf[1] = {INFINITY};
+static const double kGammasOverflow[3] = {1.5e308, -1.7e308, 1.5e308}; /* sum test overflows */
 static const int32_t kOutOfRange[3] = {0, 1, 3}, kNegative[3] = {0, -1, 2};
 static const int32_t kPair01[2] = {0, 1}, kDup[2] = {0, 0}, kSet3[1] = {3}, kSet0[1] = {0};
 static const int32_t kSame[1] = {0}, kOne[1] = {1};
@@ -386,6 +405,7 @@ static const double kModesNotHermitian[162] = {[2] = 1.0};  /* w_(0,1) without i
 static const double kModesImaginaryW0[162] = {[1] = 1.0};   /* Im w_0 != 0 */
 static const double kGridNaN[81] = {[3] = NAN}, kGridInf[81] = {[80] = -INFINITY};
 static const double kGrid[81] = {0};
+static const double kModesOverflow[50] = {[2] = 1.7e308, [8] = 1.7e308}; /* N = 5: w_(0,1), w_(0,-1) */
 static const unsigned char kNotCheckpoint[40] = "this is not a liepoisson checkpoint....";
 
 #define C(fn, input, expected, tgt, ...) \
@@ -396,7 +416,7 @@ static const bad_case kCases[] = {
     C(lpi_version_string, "no arguments: never NULL", SENTINEL, NONE),
     C(lpi_status_name, "unknown code 12345", SENTINEL, NONE, .k = 12345),
     C(lpi_status_name, "unknown code INT_MIN", SENTINEL, NONE, .k = INT_MIN),
-    C(lpi_status_name, "unknown code 1", SENTINEL, NONE, .k = 1),
+    C(lpi_status_name, "unknown code 2", SENTINEL, NONE, .k = 2),
     C(lpi_status_message, "unknown code 12345", SENTINEL, NONE, .k = 12345),
     C(lpi_status_message, "unknown code -13000", SENTINEL, NONE, .k = -13000),
     C(lpi_method_count, "no arguments", SENTINEL, NONE),
@@ -410,7 +430,7 @@ static const bad_case kCases[] = {
     C(lpi_method_stages, "i = 100000", SENTINEL, NONE, .k = 100000),
     C(lpi_method_reference, "i = -1", SENTINEL, NONE, .k = -1),
     C(lpi_method_reference, "i = 100000", SENTINEL, NONE, .k = 100000),
-    C(lpi_destroy, "NULL handle: no-op", SENTINEL, NONE),
+    C(lpi_destroy, "NULL handle: no-op, LPI_OK", SENTINEL, NONE),
     C(lpi_dim, "NULL handle: 0", SENTINEL, NONE),
     C(lpi_time, "NULL handle: NaN", SENTINEL, NONE),
     C(lpi_casimir_count, "NULL handle: 0", SENTINEL, NONE),
@@ -483,7 +503,7 @@ static const bad_case kCases[] = {
     C(lpi_step, "dt = 0", LPI_ERR_INVALID, RB, .a = 0.0, .k = 1),
     C(lpi_step, "nsteps < 0", LPI_ERR_INVALID, RB, .a = 0.1, .k = -1),
     C(lpi_step, "nsteps = INT64_MIN", LPI_ERR_INVALID, SE, .a = 0.1, .k = INT64_MIN),
-    C(lpi_step, "dt * nsteps overflows the time", LPI_ERR_INVALID, RB, .a = 1e300, .k = INT64_MAX),
+    C(lpi_step, "dt * nsteps overflows the time", LPI_ERR_OVERFLOW, RB, .a = 1e300, .k = INT64_MAX),
     C(lpi_step, "rk4 beyond its stability limit: rolled back", LPI_ERR_NONFINITE, RB_RK4, .a = 1e3, .k = 1000),
     C(lpi_step, "implicit iteration not converging: rolled back", LPI_ERR_NO_CONVERGENCE, RB_IMP, .a = 0.5, .k = 3),
     C(lpi_step, "generic system with no pieces (call order)", LPI_ERR_INVALID, GEN_EMPTY, .a = 0.1, .k = 1),
@@ -493,12 +513,20 @@ static const bad_case kCases[] = {
     C(lpi_energy, "NULL out", LPI_ERR_NULL, RB, .nul = P1),
     C(lpi_energy, "NULL out (sine-Euler)", LPI_ERR_NULL, SE, .nul = P1),
     C(lpi_energy, "failing energy callback", LPI_ERR_CALLBACK, GEN_FAIL),
+    C(lpi_energy, "energy of |m| ~ 1e200 overflows", LPI_ERR_OVERFLOW, RB_HUGE),
+    C(lpi_energy, "energy of modes ~ 1e308 overflows (sine-Euler)", LPI_ERR_OVERFLOW, SE_HUGE),
+    C(lpi_set_observer, "NULL handle", LPI_ERR_NULL, NONE, .k = 1),
+    C(lpi_set_observer, "every = 0", LPI_ERR_INVALID, RB, .k = 0),
+    C(lpi_set_observer, "every < 0", LPI_ERR_INVALID, SE, .k = -3),
+    C(lpi_set_observer, "every = INT64_MIN (generic)", LPI_ERR_INVALID, GEN, .k = INT64_MIN),
     C(lpi_casimirs, "NULL handle", LPI_ERR_NULL, NONE, .n = 1),
     C(lpi_casimirs, "NULL out", LPI_ERR_NULL, RB, .nul = P1, .n = 1),
     C(lpi_casimirs, "n = 2", LPI_ERR_SIZE, PEND, .n = 2),
     C(lpi_casimirs, "n = 0 (moments have 2)", LPI_ERR_SIZE, MOM, .n = 0),
     C(lpi_casimirs, "n = 1 (sine-Euler has 9)", LPI_ERR_SIZE, SE, .n = 1),
     C(lpi_casimirs, "failing Casimir callback", LPI_ERR_CALLBACK, GEN_FAIL, .n = 1),
+    C(lpi_casimirs, "|m|^2 ~ 3e400 overflows", LPI_ERR_OVERFLOW, RB_HUGE, .n = 1),
+    C(lpi_casimirs, "spectrum of modes ~ 1e308 overflows (sine-Euler)", LPI_ERR_OVERFLOW, SE_HUGE, .n = 5),
     C(lpi_rigid_body_exact, "NULL handle", LPI_ERR_NULL, NONE, .a = 1),
     C(lpi_rigid_body_exact, "NULL out", LPI_ERR_NULL, RB, .nul = P1, .a = 1),
     C(lpi_rigid_body_exact, "NaN t", LPI_ERR_NONFINITE, RB, .a = NAN),
@@ -515,6 +543,7 @@ static const bad_case kCases[] = {
     C(lpi_set_composition, "Inf weight", LPI_ERR_NONFINITE, PEND, .n = 1, .x = kGammasInf),
     C(lpi_set_composition, "not symmetric", LPI_ERR_INVALID, RB, .n = 3, .x = kGammasAsym),
     C(lpi_set_composition, "weights sum to 1.5", LPI_ERR_INVALID, SE, .n = 3, .x = kGammasSum),
+    C(lpi_set_composition, "finite weights whose sum test overflows", LPI_ERR_OVERFLOW, RB, .n = 3, .x = kGammasOverflow),
     C(lpi_flows_per_step, "NULL handle", LPI_ERR_NULL, NONE),
     C(lpi_flows_per_step, "NULL out", LPI_ERR_NULL, RB, .nul = P1),
     C(lpi_set_implicit_options, "NULL handle", LPI_ERR_NULL, NONE, .a = 1e-12, .k = 10),
@@ -566,6 +595,7 @@ static const bad_case kCases[] = {
     C(lpi_sine_euler_set_modes, "NaN mode", LPI_ERR_NONFINITE, SE, .x = kModesNaN, .n = 162),
     C(lpi_sine_euler_set_modes, "not Hermitian", LPI_ERR_INVALID, SE, .x = kModesNotHermitian, .n = 162),
     C(lpi_sine_euler_set_modes, "imaginary w_0", LPI_ERR_INVALID, SE, .x = kModesImaginaryW0, .n = 162),
+    C(lpi_sine_euler_set_modes, "finite modes whose symmetrised field overflows", LPI_ERR_OVERFLOW, SE_HUGE, .x = kModesOverflow, .n = 50),
     C(lpi_sine_euler_get_modes, "NULL handle", LPI_ERR_NULL, NONE, .n = 162),
     C(lpi_sine_euler_get_modes, "a generic system (wrong kind)", LPI_ERR_INVALID, GEN, .n = 162),
     C(lpi_sine_euler_get_modes, "NULL buffer", LPI_ERR_NULL, SE, .nul = P1, .n = 162),
@@ -580,14 +610,17 @@ static const bad_case kCases[] = {
     C(lpi_sine_euler_get_grid, "moments (wrong kind)", LPI_ERR_INVALID, MOM, .n = 81),
     C(lpi_sine_euler_get_grid, "NULL buffer", LPI_ERR_NULL, SE, .nul = P1, .n = 81),
     C(lpi_sine_euler_get_grid, "n = 0", LPI_ERR_SIZE, SE, .n = 0),
+    C(lpi_sine_euler_get_grid, "grid of modes ~ 1e308 overflows", LPI_ERR_OVERFLOW, SE_HUGE, .n = 25),
     C(lpi_sine_euler_enstrophy, "NULL handle", LPI_ERR_NULL, NONE),
     C(lpi_sine_euler_enstrophy, "a pendulum (wrong kind)", LPI_ERR_INVALID, PEND),
     C(lpi_sine_euler_enstrophy, "NULL out", LPI_ERR_NULL, SE, .nul = P1),
+    C(lpi_sine_euler_enstrophy, "enstrophy of modes ~ 1e308 overflows", LPI_ERR_OVERFLOW, SE_HUGE),
     C(lpi_sine_euler_casimir_traces, "NULL handle", LPI_ERR_NULL, NONE, .k = 3),
     C(lpi_sine_euler_casimir_traces, "a rigid body (wrong kind)", LPI_ERR_INVALID, RB, .k = 3),
     C(lpi_sine_euler_casimir_traces, "NULL out", LPI_ERR_NULL, SE, .nul = P1, .k = 3),
     C(lpi_sine_euler_casimir_traces, "kmax = 0", LPI_ERR_INVALID, SE, .k = 0),
     C(lpi_sine_euler_casimir_traces, "kmax < 0", LPI_ERR_INVALID, SE, .k = -4),
+    C(lpi_sine_euler_casimir_traces, "tr W^2 of modes ~ 1e308 overflows", LPI_ERR_OVERFLOW, SE_HUGE, .k = 3),
     C(lpi_sine_euler_fft_floor, "NULL handle", LPI_ERR_NULL, NONE, .k = 1),
     C(lpi_sine_euler_fft_floor, "a rigid body (wrong kind)", LPI_ERR_INVALID, RB, .k = 1),
     C(lpi_sine_euler_fft_floor, "NULL seconds", LPI_ERR_NULL, SE, .nul = P1, .k = 1),
@@ -596,12 +629,16 @@ static const bad_case kCases[] = {
     C(lpi_sine_euler_fft_floor, "nsteps < 0", LPI_ERR_INVALID, SE, .k = -1),
     C(lpi_sine_euler_fft_floor, "rk4 (not a splitting)", LPI_ERR_INVALID, SE_RK4, .k = 1),
     C(lpi_sine_euler_fft_floor, "implicit-midpoint (not a splitting)", LPI_ERR_INVALID, SE_IMP, .k = 1),
+    C(lpi_sine_euler_fft_floor, "nsteps x flows per step overflows", LPI_ERR_OVERFLOW, SE, .k = INT64_MAX),
     C(lpi_set_threads, "NULL handle", LPI_ERR_NULL, NONE, .k = 2),
     C(lpi_set_threads, "n = 0", LPI_ERR_INVALID, SE, .k = 0),
     C(lpi_set_threads, "n < 0", LPI_ERR_INVALID, SE, .k = -2),
     C(lpi_set_threads, "n = 0 (rigid body)", LPI_ERR_INVALID, RB, .k = 0),
     C(lpi_set_threads, "n = 2 on a one-thread model", LPI_ERR_UNSUPPORTED, RB, .k = 2),
     C(lpi_set_threads, "n = 2 on a generic system", LPI_ERR_UNSUPPORTED, GEN, .k = 2),
+    C(lpi_set_threads, "n = INT32_MAX (above 4 x processors)", LPI_ERR_INVALID, SE, .k = INT32_MAX),
+    C(lpi_set_threads, "n = 100000 (above 4 x processors)", LPI_ERR_INVALID, SE, .k = 100000),
+    C(lpi_set_threads, "n = INT32_MAX on a one-thread model: bounded first", LPI_ERR_INVALID, RB, .k = INT32_MAX),
     C(lpi_fftw_wisdom_import_file, "NULL path", LPI_ERR_NULL, NONE),
     C(lpi_fftw_wisdom_import_file, "missing file", LPI_ERR_INVALID, NONE, .s = "no-such-dir/wisdom"),
     C(lpi_fftw_wisdom_export_file, "NULL path", LPI_ERR_NULL, NONE),
@@ -638,7 +675,8 @@ static const bad_case kCases[] = {
 
 /* Cases that need FFTW: a sine-Euler handle or the wisdom functions. */
 static int needs_fftw(const bad_case *c) {
-    return c->a.target >= SE || strstr(c->function, "wisdom") ||
+    const int sine_euler = (c->a.target >= SE && c->a.target <= SE_IMP) || c->a.target == SE_HUGE;
+    return sine_euler || strstr(c->function, "wisdom") ||
            (strcmp(c->function, "lpi_sine_euler_create") == 0 && c->a.nul == 0);
 }
 

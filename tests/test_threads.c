@@ -1,9 +1,17 @@
 /* Separate handles on separate threads: every kind of system (sine-Euler
  * included, so FFTW plans are made concurrently under the library's planner
  * lock) gives, to the bit, the result of the same run on one thread; failed
- * calls without a handle keep their message per thread. Built and run under
- * ThreadSanitizer by `make check-tsan`. */
+ * calls without a handle keep their message per thread. Thread counts are
+ * bounded, and threads the system refuses (here: an address-space limit too
+ * small for their stacks) give LPI_ERR_NO_MEMORY from lpi_set_threads and
+ * lpi_step instead of the OpenMP runtime ending the process. Built and run
+ * under ThreadSanitizer by `make check-tsan`. */
+#define _GNU_SOURCE
 #include <pthread.h>
+#include <sched.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "lpi_test.h"
 
@@ -137,9 +145,138 @@ static void test_handles_on_threads(void **state) {
     }
 }
 
+/* ---- thread limits -------------------------------------------------------- */
+
+static lpi_system *sine_euler_15(void) {
+    lpi_system *sys = NULL;
+    if (lpi_sine_euler_create(&sys, 15) != LPI_OK) return NULL;
+    double w[2 * 15 * 15] = {0};
+    w[2 * (2 * 15 + 1)] = 1.0, w[2 * (13 * 15 + 14)] = 1.0; /* modes (2, 1), (-2, -1) */
+    w[2 * 3] = 0.5, w[2 * 12] = 0.5;                       /* modes (0, 3), (0, -3) */
+    if (lpi_sine_euler_set_modes(sys, w, 2 * 15 * 15) != LPI_OK) return NULL;
+    return sys;
+}
+
+/* Limits the address space to what is mapped now plus `headroom` bytes. */
+static int limit_address_space(size_t headroom, struct rlimit *previous) {
+    FILE *f = fopen("/proc/self/statm", "r");
+    unsigned long pages = 0;
+    if (!f || fscanf(f, "%lu", &pages) != 1) return -1;
+    fclose(f);
+    if (getrlimit(RLIMIT_AS, previous) != 0) return -1;
+    struct rlimit low = *previous;
+    low.rlim_cur = (rlim_t)pages * (rlim_t)sysconf(_SC_PAGESIZE) + headroom;
+    return setrlimit(RLIMIT_AS, &low);
+}
+
+typedef struct {
+    lpi_system *sys;
+    pthread_mutex_t mutex;
+    pthread_cond_t go;
+    int released, status;
+} stepper;
+
+/* Waits until released, then steps on this (new) host thread. */
+static void *step_when_released(void *argument) {
+    stepper *s = argument;
+    pthread_mutex_lock(&s->mutex);
+    while (!s->released) pthread_cond_wait(&s->go, &s->mutex);
+    pthread_mutex_unlock(&s->mutex);
+    s->status = lpi_step(s->sys, 0.01, 2);
+    return NULL;
+}
+
+/* In a child process, as the limit would end it: 0 when every status is the
+ * documented one, 100 without OpenMP, else 10 + the number of the failed
+ * check (libgomp ending the process exits with 1). */
+static int run_under_a_low_limit(int n) {
+    lpi_system *sys = sine_euler_15();
+    if (!sys) return 100;
+    if (lpi_step(sys, 0.01, 1) != LPI_OK) return 11; /* plans made */
+    stepper s = {sys, PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER, 0, -1};
+    pthread_t other;
+    if (pthread_create(&other, NULL, step_when_released, &s) != 0) return 12;
+    struct rlimit previous;
+    if (limit_address_space(1 << 20, &previous) != 0) return 13;
+    /* n - 1 thread stacks do not fit: refused, and the count stays 1. */
+    const int refused = lpi_set_threads(sys, n);
+    if (refused == LPI_ERR_UNSUPPORTED) return 100; /* no OpenMP */
+    if (refused != LPI_ERR_NO_MEMORY) return 14;
+    if (strstr(lpi_last_error(sys), "refused to start thread") == NULL) return 15;
+    if (lpi_step(sys, 0.01, 2) != LPI_OK) return 16;
+    if (setrlimit(RLIMIT_AS, &previous) != 0) return 17;
+    /* With room again the count is accepted and used. */
+    if (lpi_set_threads(sys, n) != LPI_OK) return 18;
+    if (lpi_step(sys, 0.01, 2) != LPI_OK) return 19;
+    /* Another host thread needs a team of its own: under the limit, lpi_step
+     * on it is refused with a status too. */
+    if (limit_address_space(1 << 20, &previous) != 0) return 20;
+    pthread_mutex_lock(&s.mutex);
+    s.released = 1;
+    pthread_cond_signal(&s.go);
+    pthread_mutex_unlock(&s.mutex);
+    pthread_join(other, NULL);
+    if (s.status != LPI_ERR_NO_MEMORY) return 21;
+    if (setrlimit(RLIMIT_AS, &previous) != 0) return 22;
+    return lpi_destroy(sys) == LPI_OK ? 0 : 23;
+}
+
+/* In the parent the pool of OpenMP threads must not exist yet at the fork
+ * (libgomp's threads are not copied into a child), so this runs first. */
+static void test_refused_threads_give_a_status(void **state) {
+    (void)state;
+    /* An address-space limit does not mix with ASan's shadow memory or with
+     * valgrind's own mappings. */
+#if defined(__SANITIZE_ADDRESS__)
+    printf("thread limits under a low RLIMIT_AS: skipped under AddressSanitizer\n");
+    return;
+#endif
+    const char *preload = getenv("LD_PRELOAD");
+    if (preload && strstr(preload, "vgpreload")) {
+        printf("thread limits under a low RLIMIT_AS: skipped under valgrind\n");
+        return;
+    }
+    fflush(stdout);
+    const pid_t child = fork();
+    assert_true(child >= 0);
+    if (child == 0) {
+        _exit(run_under_a_low_limit(4));
+    }
+    int status = 0;
+    assert_int_equal(waitpid(child, &status, 0), child);
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 100) {
+        printf("thread limits: skipped (no FFTW or no OpenMP in this build)\n");
+        return;
+    }
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        fail_msg("under a low RLIMIT_AS the child %s %d", WIFEXITED(status) ? "failed check" :
+                 "was killed by signal", WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
+}
+
+static void test_thread_count_bound(void **state) {
+    (void)state;
+    lpi_system *sys = sine_euler_15();
+    if (!sys || lpi_set_threads(sys, 2) == LPI_ERR_UNSUPPORTED) {
+        printf("thread count bound: skipped (no FFTW or no OpenMP in this build)\n");
+        lpi_destroy(sys);
+        return;
+    }
+    cpu_set_t set;
+    assert_int_equal(sched_getaffinity(0, sizeof set, &set), 0);
+    const int bound = 4 * CPU_COUNT(&set);
+    assert_int_equal(lpi_set_threads(sys, bound), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.01, 2), LPI_OK);
+    LPI_ASSERT_FAILS(sys, lpi_set_threads(sys, bound + 1), LPI_ERR_INVALID, "lpi_set_threads");
+    LPI_ASSERT_FAILS(sys, lpi_set_threads(sys, INT32_MAX), LPI_ERR_INVALID, "lpi_set_threads");
+    assert_non_null(strstr(lpi_last_error(sys), "exceeds"));
+    lpi_destroy(sys);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_refused_threads_give_a_status),
         cmocka_unit_test(test_handles_on_threads),
+        cmocka_unit_test(test_thread_count_bound),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -7,14 +7,16 @@
 !                 and an optional integer status argument. When status is
 !                 absent, a failure stops the program with the library's
 !                 message (as Fortran I/O does without iostat=); when present,
-!                 it receives LPI_OK or the negative LPI_ERR_* code and
-!                 lpi_last_error(sys) gives the message.
+!                 it receives LPI_OK, the negative LPI_ERR_* code (then
+!                 lpi_last_error(sys) gives the message) or, from lpi_step,
+!                 the positive LPI_STOPPED (not a failure: never stops).
 ! Handles are type(c_ptr). Index sets and bracket indices are 0-based, as in C.
 ! Sine-Euler modes and grids are arrays w(0:N-1, 0:N-1) with w(a, b) = mode
 ! (a, b) (resp. the vorticity at (2 pi a/N, 2 pi b/N)); the wrappers transpose
 ! to and from the C row-major layout.
 ! Callbacks are bind(C) functions matching the abstract interfaces
-! lpi_gradient_fn, lpi_energy_fn, lpi_casimir_fn and lpi_scalar_fn.
+! lpi_gradient_fn, lpi_energy_fn, lpi_casimir_fn, lpi_scalar_fn and
+! lpi_observer_fn.
 module liepoisson
     use, intrinsic :: iso_c_binding
     implicit none
@@ -24,7 +26,8 @@ module liepoisson
     integer(c_int), parameter, public :: LPI_OK = 0, LPI_ERR_NULL = -1, LPI_ERR_INVALID = -2, &
         LPI_ERR_SIZE = -3, LPI_ERR_NONFINITE = -4, LPI_ERR_NOT_ABELIAN = -5, &
         LPI_ERR_UNSUPPORTED = -6, LPI_ERR_NO_MEMORY = -7, LPI_ERR_INTERNAL = -8, &
-        LPI_ERR_CALLBACK = -9, LPI_ERR_NO_CONVERGENCE = -10, LPI_ERR_IO = -11, LPI_ERR_FORMAT = -12
+        LPI_ERR_CALLBACK = -9, LPI_ERR_NO_CONVERGENCE = -10, LPI_ERR_IO = -11, LPI_ERR_FORMAT = -12, &
+        LPI_ERR_BUSY = -13, LPI_ERR_OVERFLOW = -14, LPI_STOPPED = 1
 
     ! ---- callback types ------------------------------------------------------
     abstract interface
@@ -55,8 +58,16 @@ module liepoisson
             real(c_double), intent(out) :: out
             type(c_ptr), value :: user
         end function
+        ! Called by lpi_step after every every-th step; non-zero stops it.
+        integer(c_int) function lpi_observer_fn(sys, step, t, user) bind(C)
+            import :: c_int, c_int64_t, c_double, c_ptr
+            type(c_ptr), value :: sys
+            integer(c_int64_t), value :: step
+            real(c_double), value :: t
+            type(c_ptr), value :: user
+        end function
     end interface
-    public :: lpi_gradient_fn, lpi_energy_fn, lpi_casimir_fn, lpi_scalar_fn
+    public :: lpi_gradient_fn, lpi_energy_fn, lpi_casimir_fn, lpi_scalar_fn, lpi_observer_fn
 
     ! ---- the C functions, one interface each ----------------------------------
     interface
@@ -112,10 +123,10 @@ module liepoisson
             import :: c_int, c_ptr
             type(c_ptr), intent(out) :: out
         end function
-        subroutine c_lpi_destroy(sys) bind(C, name="lpi_destroy")
-            import :: c_ptr
+        integer(c_int) function c_lpi_destroy(sys) bind(C, name="lpi_destroy")
+            import :: c_int, c_ptr
             type(c_ptr), value :: sys
-        end subroutine
+        end function
         integer(c_int) function c_lpi_set_method(sys, name) bind(C, name="lpi_set_method")
             import :: c_int, c_ptr, c_char
             type(c_ptr), value :: sys
@@ -147,6 +158,13 @@ module liepoisson
             type(c_ptr), value :: sys
             real(c_double), value :: dt
             integer(c_int64_t), value :: nsteps
+        end function
+        integer(c_int) function c_lpi_set_observer(sys, every, fn, user) bind(C, name="lpi_set_observer")
+            import :: c_int, c_ptr, c_int64_t, c_funptr
+            type(c_ptr), value :: sys
+            integer(c_int64_t), value :: every
+            type(c_funptr), value :: fn
+            type(c_ptr), value :: user
         end function
         real(c_double) function c_lpi_time(sys) bind(C, name="lpi_time")
             import :: c_double, c_ptr
@@ -347,7 +365,7 @@ module liepoisson
         c_lpi_method_name, c_lpi_method_order, c_lpi_method_is_poisson, c_lpi_method_stages, &
         c_lpi_method_reference, c_lpi_rigid_body_create, c_lpi_rigid_body_exact, &
         c_lpi_pendulum_create, c_lpi_destroy, c_lpi_set_method, c_lpi_set_split, c_lpi_dim, &
-        c_lpi_set_state, c_lpi_get_state, c_lpi_step, c_lpi_time, c_lpi_energy, &
+        c_lpi_set_state, c_lpi_get_state, c_lpi_step, c_lpi_set_observer, c_lpi_time, c_lpi_energy, &
         c_lpi_casimir_count, c_lpi_casimirs, c_lpi_last_error, c_lpi_set_composition, &
         c_lpi_flows_per_step, c_lpi_set_implicit_options, c_lpi_generic_create, c_lpi_add_piece, &
         c_lpi_add_casimir, c_lpi_poisson_rank, c_lpi_moments_create, &
@@ -367,7 +385,8 @@ module liepoisson
         lpi_method_name, lpi_method_order, lpi_method_is_poisson, lpi_method_stages, &
         lpi_method_reference, lpi_rigid_body_create, lpi_rigid_body_exact, lpi_pendulum_create, &
         lpi_destroy, lpi_set_method, lpi_set_split, lpi_dim, lpi_set_state, lpi_get_state, &
-        lpi_step, lpi_time, lpi_energy, lpi_casimir_count, lpi_casimirs, lpi_last_error, &
+        lpi_step, lpi_set_observer, lpi_time, lpi_energy, lpi_casimir_count, lpi_casimirs, &
+        lpi_last_error, &
         lpi_set_composition, lpi_flows_per_step, lpi_set_implicit_options, lpi_generic_create, &
         lpi_add_piece, lpi_add_casimir, lpi_poisson_rank, lpi_moments_create, &
         lpi_moments_add_product_piece, lpi_sine_euler_create, lpi_sine_euler_size, &
@@ -412,7 +431,7 @@ contains
         integer, intent(out), optional :: status
         if (present(status)) then
             status = st
-        else if (st /= LPI_OK) then
+        else if (st < 0) then
             error stop "liepoisson: "//f_string(c_lpi_status_name(st))//": "//f_string(c_lpi_last_error(sys))
         end if
     end subroutine
@@ -492,10 +511,14 @@ contains
     end subroutine
 
     ! Releases the handle and sets sys to c_null_ptr (a null handle is a no-op).
-    subroutine lpi_destroy(sys)
+    ! From one of the handle's own callbacks: LPI_ERR_BUSY, nothing released.
+    subroutine lpi_destroy(sys, status)
         type(c_ptr), intent(inout) :: sys
-        call c_lpi_destroy(sys)
-        sys = c_null_ptr
+        integer, intent(out), optional :: status
+        integer(c_int) :: st
+        st = c_lpi_destroy(sys)
+        if (st == LPI_OK) sys = c_null_ptr
+        call finish(st, sys, status)
     end subroutine
 
     subroutine lpi_set_method(sys, name, status)
@@ -546,6 +569,22 @@ contains
         integer(c_int64_t), intent(in) :: nsteps
         integer, intent(out), optional :: status
         call finish(c_lpi_step(sys, dt, nsteps), sys, status)
+    end subroutine
+
+    ! Sets the observer of lpi_step (every >= 1); without fn, removes it.
+    subroutine lpi_set_observer(sys, every, fn, user, status)
+        type(c_ptr), intent(in) :: sys
+        integer, intent(in) :: every
+        procedure(lpi_observer_fn), optional :: fn
+        type(c_ptr), intent(in), optional :: user
+        integer, intent(out), optional :: status
+        type(c_ptr) :: u
+        type(c_funptr) :: f
+        u = c_null_ptr
+        if (present(user)) u = user
+        f = c_null_funptr
+        if (present(fn)) f = c_funloc(fn)
+        call finish(c_lpi_set_observer(sys, int(every, c_int64_t), f, u), sys, status)
     end subroutine
 
     real(c_double) function lpi_time(sys)

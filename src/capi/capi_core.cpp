@@ -58,7 +58,16 @@ LPI_API int lpi_pendulum_create(lpi_system **out) {
     return create(out, "lpi_pendulum_create", [] { return lpi::make_pendulum(); });
 }
 
-LPI_API void lpi_destroy(lpi_system *sys) { delete sys; }
+LPI_API int lpi_destroy(lpi_system *sys) {
+    // Freeing the handle under a call in progress on it would leave that
+    // call working on freed memory.
+    if (const char *why = lpi::capi::refusal(sys, true)) {
+        try { lpi::capi::record(sys, std::string("lpi_destroy: ") + why); } catch (...) {}
+        return LPI_ERR_BUSY;
+    }
+    delete sys;
+    return LPI_OK;
+}
 
 LPI_API int lpi_set_method(lpi_system *sys, const char *name) {
     return guarded(sys, "lpi_set_method", [&] {
@@ -97,7 +106,19 @@ LPI_API int lpi_get_state(const lpi_system *sys, double *x, size_t n) {
 LPI_API int lpi_step(lpi_system *sys, double dt, int64_t nsteps) {
     return guarded(sys, "lpi_step", [&] {
         require(sys, "system");
-        sys->system.step(dt, nsteps);
+        return sys->system.step(dt, nsteps) ? LPI_OK : LPI_STOPPED;
+    });
+}
+
+LPI_API int lpi_set_observer(lpi_system *sys, int64_t every, lpi_observer_fn fn, void *user) {
+    return guarded(sys, "lpi_set_observer", [&] {
+        require(sys, "system");
+        if (!fn) return sys->system.set_observer(0, nullptr);
+        // While fn runs the handle is Observing: fn may read it, not change it.
+        sys->system.set_observer(every, [sys, fn, user](std::int64_t step, double t) {
+            lpi::capi::ActivityScope observing(sys, lpi::capi::Activity::Observing);
+            return fn(sys, step, t, user) != 0;
+        });
     });
 }
 

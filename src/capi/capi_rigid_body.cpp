@@ -23,8 +23,10 @@ LPI_API int lpi_rigid_body_exact(const lpi_system *sys, double t, double *out) {
                                                sys->system.model().kind());
         sys->system.get_state(m0, 3);
         lpi::rigid_body_exact(inertia, m0, t, m);
-        if (!std::isfinite(m[0]) || !std::isfinite(m[1]) || !std::isfinite(m[2]))
-            lpi::fail(LPI_ERR_NONFINITE, "the exact solution is not finite at this t");
+        // The state and t are finite: a value that is not has overflowed.
+        lpi::require_no_overflow(m, 3, [](std::size_t i) {
+            return "component " + std::to_string(i) + " of the exact solution at this t";
+        });
         out[0] = m[0], out[1] = m[1], out[2] = m[2];
     });
 }

@@ -1,5 +1,7 @@
 // The C ABI of sine-Euler, threads and FFTW wisdom.
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <vector>
@@ -30,6 +32,21 @@ lpi::SineEulerModel &sine_euler(const lpi_system *sys) {
 
 std::size_t squared(int N) { return static_cast<std::size_t>(N) * static_cast<std::size_t>(N); }
 
+// Stores public coordinates converted from modes or a grid: the input was
+// finite, so a coordinate that is not has overflowed in the conversion.
+void set_converted(lpi_system *sys, const std::vector<double> &x, const char *from) {
+    lpi::require_no_overflow(x.data(), x.size(), [from](std::size_t i) {
+        return std::string("coordinate ") + std::to_string(i) + " of the field from these " + from;
+    });
+    sys->system.set_state(x.data(), x.size());
+}
+
+// "mode (a, b)" / "grid value (a, b)" of entry i of an N x N array.
+std::string entry_name(const char *what, std::size_t i, int N) {
+    return std::string(what) + " (" + std::to_string(i / static_cast<std::size_t>(N)) + ", " +
+           std::to_string(i % static_cast<std::size_t>(N)) + ")";
+}
+
 [[maybe_unused]] void no_fftw() {
     lpi::fail(LPI_ERR_UNSUPPORTED, "FFTW wisdom needs FFTW3; this build has none");
 }
@@ -57,7 +74,7 @@ LPI_API int lpi_sine_euler_set_modes(lpi_system *sys, const double *re_im, size_
         lpi::require_length("modes", n, 2 * squared(model.order()));
         std::vector<double> x(squared(model.order()));
         model.public_from_modes(re_im, x.data());
-        sys->system.set_state(x.data(), x.size());
+        set_converted(sys, x, "modes");
     });
 }
 
@@ -78,7 +95,7 @@ LPI_API int lpi_sine_euler_set_grid(lpi_system *sys, const double *w, size_t n) 
         lpi::require_length("grid", n, squared(model.order()));
         std::vector<double> x(squared(model.order()));
         model.public_from_grid(w, x.data());
-        sys->system.set_state(x.data(), x.size());
+        set_converted(sys, x, "grid values");
     });
 }
 
@@ -87,7 +104,12 @@ LPI_API int lpi_sine_euler_get_grid(const lpi_system *sys, double *w, size_t n) 
         const auto &model = sine_euler(sys);
         require(w, "grid buffer");
         lpi::require_length("grid buffer", n, squared(model.order()));
-        model.grid(sys->system.working_state().data(), w);
+        std::vector<double> grid(n);
+        model.grid(sys->system.working_state().data(), grid.data());
+        lpi::require_no_overflow(grid.data(), n, [&](std::size_t i) {
+            return entry_name("grid value", i, model.order()) + " of this state";
+        });
+        std::memcpy(w, grid.data(), sizeof(double) * n);
     });
 }
 
@@ -95,7 +117,9 @@ LPI_API int lpi_sine_euler_enstrophy(const lpi_system *sys, double *out) {
     return guarded(sys, "lpi_sine_euler_enstrophy", [&] {
         const auto &model = sine_euler(sys);
         require(out, "out");
-        *out = model.enstrophy(sys->system.working_state().data());
+        const double enstrophy = model.enstrophy(sys->system.working_state().data());
+        lpi::require_no_overflow(&enstrophy, 1, [](std::size_t) { return std::string("the enstrophy of this state"); });
+        *out = enstrophy;
     });
 }
 
@@ -104,7 +128,12 @@ LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, d
         const auto &model = sine_euler(sys);
         require(out, "out");
         if (kmax < 1) lpi::fail(LPI_ERR_INVALID, "kmax must be >= 1, got " + std::to_string(kmax));
-        model.casimir_traces(sys->system.working_state().data(), kmax, out);
+        std::vector<double> traces(static_cast<std::size_t>(kmax));
+        model.casimir_traces(sys->system.working_state().data(), kmax, traces.data());
+        lpi::require_no_overflow(traces.data(), traces.size(), [](std::size_t i) {
+            return "(1/N) tr W^" + std::to_string(i + 1) + " of this state";
+        });
+        std::copy(traces.begin(), traces.end(), out);
     });
 }
 
@@ -127,6 +156,11 @@ LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *se
         const auto program = lpi::build_flow_program(method, model.piece_count());
         const bool seam = program.size() > 1 && program.front().piece == program.back().piece;
         const std::size_t flows = program.size() - (seam ? 1 : 0);
+        if (static_cast<std::uint64_t>(nsteps) > SIZE_MAX / flows)
+            lpi::fail(LPI_ERR_OVERFLOW, "nsteps = " + std::to_string(nsteps) + " times " +
+                                            std::to_string(flows) +
+                                            " flows per step overflows the flow count");
+        sys->system.prepare_threads();
         const auto start = std::chrono::steady_clock::now();
         const double transforms = model.run_fft_floor(flows * static_cast<std::size_t>(nsteps));
         const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
@@ -138,7 +172,7 @@ LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *se
 LPI_API int lpi_set_threads(lpi_system *sys, int32_t n) {
     return guarded(sys, "lpi_set_threads", [&] {
         require(sys, "system");
-        sys->system.set_threads(n);
+        sys->system.set_threads(n);  // bounded in the System, before the model sees n
     });
 }
 

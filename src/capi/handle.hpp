@@ -1,19 +1,37 @@
 // The opaque handle behind the C ABI and the one place where exceptions become
-// status codes. Every exported function runs its body inside guarded().
+// status codes and re-entrant calls are refused. Every exported function runs
+// its body inside guarded().
 #pragma once
 
+#include <cstddef>
 #include <new>
+#include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "../core/error.hpp"
 #include "../core/system.hpp"
 #include "liepoisson.h"
 
+namespace lpi::capi {
+
+// What a handle is doing. A call on a handle that is not Idle can only come
+// from a user callback that the library runs inside a call on that handle
+// (one handle is used by one thread at a time).
+enum class Activity : unsigned char {
+    Idle,       // no call in progress
+    Busy,       // inside a call: every further call on the handle is refused
+    Observing,  // inside the observer of lpi_step: read-only calls are allowed
+};
+
+}  // namespace lpi::capi
+
 struct lpi_system {
     explicit lpi_system(std::unique_ptr<lpi::Model> model) : system(std::move(model)) {}
     lpi::System system;
     mutable std::string last_error;
+    mutable lpi::capi::Activity activity = lpi::capi::Activity::Idle;
 };
 
 namespace lpi::capi {
@@ -25,19 +43,63 @@ inline void record(const lpi_system *sys, const std::string &message) {
     (sys ? sys->last_error : thread_error()) = message;
 }
 
-// Runs body(); maps lpi::Error to its status, std::bad_alloc to
-// LPI_ERR_NO_MEMORY and anything else to LPI_ERR_INTERNAL, recording the
-// message on sys (or the thread when sys is NULL).
+// Sets a handle's activity for the lifetime of the scope, then restores it.
+class ActivityScope {
+public:
+    ActivityScope(const lpi_system *sys, Activity activity)
+        : sys_(sys), previous_(sys ? sys->activity : Activity::Idle) {
+        if (sys_) sys_->activity = activity;
+    }
+    ~ActivityScope() {
+        if (sys_) sys_->activity = previous_;
+    }
+    ActivityScope(const ActivityScope &) = delete;
+    ActivityScope &operator=(const ActivityScope &) = delete;
+
+private:
+    const lpi_system *sys_;
+    Activity previous_;
+};
+
+// Why a call on sys must be refused now (nullptr when it may run). Functions
+// that take a const handle only read it: they may run inside the observer.
+inline const char *refusal(const lpi_system *sys, bool mutates) {
+    if (!sys || sys->activity == Activity::Idle) return nullptr;
+    if (sys->activity == Activity::Observing && !mutates) return nullptr;
+    return sys->activity == Activity::Observing
+               ? "called from this handle's observer, which may only read the handle (functions "
+                 "taking a const lpi_system *); nothing was changed"
+               : "called from a callback that the library is running inside a call on this "
+                 "handle (a piece, Casimir or product-piece callback); no call on the handle is "
+                 "allowed there, and nothing was changed";
+}
+
+// Runs body() with sys marked Busy; maps lpi::Error to its status,
+// std::bad_alloc and std::length_error to LPI_ERR_NO_MEMORY and anything else
+// to LPI_ERR_INTERNAL, recording the message on sys (or the thread when sys
+// is NULL). A body may return a status of its own (LPI_STOPPED).
 template <class Body>
-int guarded(const lpi_system *sys, const char *function, Body &&body) noexcept {
+int run_guarded(const lpi_system *sys, bool mutates, const char *function, Body &&body) noexcept {
+    if (const char *why = refusal(sys, mutates)) {
+        try { record(sys, std::string(function) + ": " + why); } catch (...) {}
+        return LPI_ERR_BUSY;
+    }
+    ActivityScope scope(sys, Activity::Busy);
     try {
-        body();
-        return LPI_OK;
+        if constexpr (std::is_void_v<decltype(body())>) {
+            body();
+            return LPI_OK;
+        } else {
+            return body();
+        }
     } catch (const lpi::Error &e) {
         try { record(sys, std::string(function) + ": " + e.what()); } catch (...) {}
         return e.status();
     } catch (const std::bad_alloc &) {
         try { record(sys, std::string(function) + ": out of memory"); } catch (...) {}
+        return LPI_ERR_NO_MEMORY;
+    } catch (const std::length_error &) {
+        try { record(sys, std::string(function) + ": a buffer of the size this needs cannot be allocated"); } catch (...) {}
         return LPI_ERR_NO_MEMORY;
     } catch (const std::exception &e) {
         try { record(sys, std::string(function) + ": internal error: " + e.what()); } catch (...) {}
@@ -46,6 +108,21 @@ int guarded(const lpi_system *sys, const char *function, Body &&body) noexcept {
         try { record(sys, std::string(function) + ": internal error"); } catch (...) {}
         return LPI_ERR_INTERNAL;
     }
+}
+
+// A function taking a mutable handle may change it; one taking a const handle
+// only reads it. The signature decides which calls an observer may make.
+template <class Body>
+int guarded(lpi_system *sys, const char *function, Body &&body) noexcept {
+    return run_guarded(sys, true, function, std::forward<Body>(body));
+}
+template <class Body>
+int guarded(const lpi_system *sys, const char *function, Body &&body) noexcept {
+    return run_guarded(sys, false, function, std::forward<Body>(body));
+}
+template <class Body>
+int guarded(std::nullptr_t, const char *function, Body &&body) noexcept {
+    return run_guarded(nullptr, false, function, std::forward<Body>(body));
 }
 
 // Rejects a NULL handle or pointer argument with LPI_ERR_NULL.

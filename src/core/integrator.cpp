@@ -1,5 +1,6 @@
 #include "integrator.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -17,6 +18,21 @@ bool all_finite(const double *x, std::size_t n) {
     return probe == 0.0;
 }
 
+RunOutcome Integrator::run(Model &model, double *state, double dt, std::int64_t n,
+                           const StepObserver &observer, StepsInProgress &progress) {
+    const std::int64_t chunk = observer.every > 0 ? observer.every : n;
+    std::int64_t done = 0;
+    while (done < n) {
+        const std::int64_t count = chunk < n - done ? chunk : n - done;
+        progress = {done + 1, done + count};
+        if (!advance(model, state, dt, count)) return {RunOutcome::NonFinite, done + count};
+        done += count;
+        if (observer.every > 0 && done % observer.every == 0 && observer.observe(done))
+            return {RunOutcome::Stopped, done};
+    }
+    return {RunOutcome::Done, n};
+}
+
 namespace {
 
 // Composes exact piece flows. When a step begins and ends with the same piece
@@ -26,37 +42,68 @@ class SplittingIntegrator final : public Integrator {
 public:
     explicit SplittingIntegrator(std::vector<Flow> program) : program_(std::move(program)) {
         merge_seam_ = program_.size() > 1 && program_.front().piece == program_.back().piece;
+        for (const Flow &f : program_) largest_ = std::max(largest_, std::fabs(f.weight));
+        if (merge_seam_)
+            largest_ = std::max(largest_, std::fabs(program_.back().weight + program_.front().weight));
     }
 
     bool advance(Model &model, double *state, double dt, std::int64_t n) override {
+        StepsInProgress progress;
+        return run(model, state, dt, n, StepObserver{}, progress).end != RunOutcome::NonFinite;
+    }
+
+    // An observed step ends with its own last flow, on a copy kept aside: the
+    // observer sees exactly the state of a run of that many steps, and the
+    // run then goes on from the copy with the merged flow, so observing
+    // changes no bit of the trajectory.
+    RunOutcome run(Model &model, double *state, double dt, std::int64_t n,
+                   const StepObserver &observer, StepsInProgress &progress) override {
         const std::size_t size = model.state_size();
         const std::size_t last = program_.size() - 1;
-        if (!merge_seam_) {
-            for (std::int64_t step = 0; step < n; ++step) {
-                for (const Flow &f : program_) model.flow(f.piece, f.weight * dt, state);
-                if ((step + 1) % kFiniteCheckInterval == 0 && !all_finite(state, size))
-                    return false;
-            }
-            return all_finite(state, size);
-        }
-        model.flow(program_[0].piece, program_[0].weight * dt, state);
-        for (std::int64_t step = 0; step < n; ++step) {
-            for (std::size_t i = 1; i < last; ++i)
+        const std::size_t inner_end = merge_seam_ ? last : program_.size();
+        // The next observed step, counted rather than found by a division
+        // per step (one division costs as much as a small model's flow).
+        std::int64_t next_observed = observer.every > 0 ? observer.every : INT64_MAX;
+        if (merge_seam_) model.flow(program_[0].piece, program_[0].weight * dt, state);
+        for (std::int64_t step = 1; step <= n; ++step) {
+            progress = {step, step};
+            for (std::size_t i = merge_seam_ ? 1 : 0; i < inner_end; ++i)
                 model.flow(program_[i].piece, program_[i].weight * dt, state);
-            const double w = program_[last].weight + (step + 1 < n ? program_[0].weight : 0.0);
-            model.flow(program_[last].piece, w * dt, state);
-            if ((step + 1) % kFiniteCheckInterval == 0 && !all_finite(state, size)) return false;
+            const bool observed = step == next_observed;
+            if (observed)
+                next_observed = observer.every <= INT64_MAX - step ? step + observer.every : INT64_MAX;
+            const bool final = step == n;
+            if (merge_seam_) {
+                if (observed && !final) pending_.assign(state, state + size);
+                if (observed || final) {
+                    model.flow(program_[last].piece, program_[last].weight * dt, state);
+                } else {
+                    const double merged = program_[last].weight + program_[0].weight;
+                    model.flow(program_[last].piece, merged * dt, state);
+                }
+            }
+            const bool checked = observed || final || step % kFiniteCheckInterval == 0;
+            if (checked && !all_finite(state, size)) return {RunOutcome::NonFinite, step};
+            if (observed && observer.observe(step)) return {RunOutcome::Stopped, step};
+            if (merge_seam_ && observed && !final) {
+                std::copy(pending_.begin(), pending_.end(), state);
+                const double merged = program_[last].weight + program_[0].weight;
+                model.flow(program_[last].piece, merged * dt, state);
+            }
         }
-        return all_finite(state, size);
+        return {RunOutcome::Done, n};
     }
 
     std::size_t evaluations_per_step() const override {
         return merge_seam_ ? program_.size() - 1 : program_.size();
     }
+    double largest_step_fraction() const override { return largest_; }
 
 private:
     std::vector<Flow> program_;
     bool merge_seam_ = false;
+    double largest_ = 0.0;
+    std::vector<double> pending_;  // an observed step's state before its last flow
 };
 
 }  // namespace

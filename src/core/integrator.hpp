@@ -5,12 +5,34 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 
 #include "methods.hpp"
 #include "model.hpp"
 
 namespace lpi {
+
+// Watches a run of steps: observe(k) is called after every `every`-th step
+// (k = steps completed in the run), with the state holding exactly what a run
+// of k steps leaves; true from it stops the run there.
+struct StepObserver {
+    std::int64_t every = 0;  // 0: nobody watches
+    std::function<bool(std::int64_t)> observe;
+};
+
+// How a run ended and the steps whose result the state holds (NonFinite: the
+// step after which the state was found non-finite; the caller restores it).
+struct RunOutcome {
+    enum End { Done, Stopped, NonFinite } end = Done;
+    std::int64_t steps = 0;
+};
+
+// The steps being computed, first..last (1-based in the run): what a failure
+// thrown from inside a step is reported against.
+struct StepsInProgress {
+    std::int64_t first = 0, last = 0;
+};
 
 class Integrator {
 public:
@@ -19,8 +41,16 @@ public:
     // state is found non-finite (checked every few steps and at the end); the
     // caller then restores its copy.
     virtual bool advance(Model &model, double *state, double dt, std::int64_t n) = 0;
+    // Advances n >= 1 steps with an optional observer. The default runs
+    // advance() in chunks of observer.every steps, which is exact for methods
+    // whose steps share nothing; the splitting integrator overrides it to
+    // keep merging flows across the observed steps.
+    virtual RunOutcome run(Model &model, double *state, double dt, std::int64_t n,
+                           const StepObserver &observer, StepsInProgress &progress);
     // Piece flows (or vector-field evaluations) per step in a long run.
     virtual std::size_t evaluations_per_step() const = 0;
+    // The largest |multiple of dt| that one flow or stage of a step takes.
+    virtual double largest_step_fraction() const { return 1.0; }
 };
 
 // How implicit methods solve their equations (fixed-point iteration).

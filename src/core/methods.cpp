@@ -277,6 +277,14 @@ Method custom_composition(const double *gammas, std::size_t n) {
         if (!std::isfinite(gammas[i]))
             fail(LPI_ERR_NONFINITE, "gammas[" + std::to_string(i) + "] = " +
                                         format_double(gammas[i]) + " is not finite");
+    // The sum of |gammas| bounds every difference, partial sum, merged flow
+    // weight and mean below: when it is finite, none of them overflows.
+    double magnitude = 0.0;
+    for (std::size_t i = 0; i < n; ++i) magnitude += std::fabs(gammas[i]);
+    if (!std::isfinite(magnitude))
+        fail(LPI_ERR_OVERFLOW, "the weights are finite, but the sum of their absolute values "
+                               "overflows a double (the weights of a composition must sum "
+                               "to 1)");
     for (std::size_t i = 0, j = n - 1; i < j; ++i, --j) {
         const double a = gammas[i], b = gammas[j];
         if (std::fabs(a - b) > kTolerance * std::fmax(std::fabs(a), std::fabs(b)))
@@ -286,12 +294,11 @@ Method custom_composition(const double *gammas, std::size_t n) {
                                       " (they must agree to a relative 1e-14)");
     }
     // Neumaier's compensated sum, so the test is not blurred by its own round-off.
-    double sum = 0.0, compensation = 0.0, magnitude = 0.0;
+    double sum = 0.0, compensation = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
         const double g = gammas[i], t = sum + g;
         compensation += std::fabs(sum) >= std::fabs(g) ? (sum - t) + g : (g - t) + sum;
         sum = t;
-        magnitude += std::fabs(g);
     }
     sum += compensation;
     if (!(std::fabs(sum - 1.0) <= kTolerance * magnitude))

@@ -1,11 +1,42 @@
 #include "system.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "error.hpp"
+#include "threads.hpp"
 
 namespace lpi {
+
+namespace {
+
+std::string short_number(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", v);
+    return text;
+}
+
+// "in step 7 of this call (t = 0.6 .. 0.7)" or "in steps 1 .. 256 ..."
+std::string steps_text(const StepsInProgress &p, double start, double dt) {
+    const double from = start + dt * static_cast<double>(p.first - 1);
+    const double to = start + dt * static_cast<double>(p.last);
+    const std::string steps = p.first == p.last
+                                  ? "step " + std::to_string(p.first)
+                                  : "steps " + std::to_string(p.first) + " .. " +
+                                        std::to_string(p.last);
+    return "in " + steps + " of this call (t = " + short_number(from) + " .. " +
+           short_number(to) + ")";
+}
+
+}  // namespace
+
+void require_no_overflow(const double *values, std::size_t n,
+                         const std::function<std::string(std::size_t)> &what) {
+    for (std::size_t i = 0; i < n; ++i)
+        if (!std::isfinite(values[i]))
+            fail(LPI_ERR_OVERFLOW, what(i) + " overflows a double");
+}
 
 void require_length(const char *what, std::size_t given, std::size_t expected) {
     if (given != expected)
@@ -80,44 +111,101 @@ void System::restore_working_state(std::vector<double> state, double time) {
     time_ = time;
 }
 
-void System::step(double dt, std::int64_t nsteps) {
+void System::set_threads(int n) {
+    check_thread_count(n);
+    model_->set_threads(n);  // throws, unchanged, if the model refuses n
+    try {
+        prepare_thread_team(n);
+    } catch (...) {
+        model_->set_threads(threads_);
+        throw;
+    }
+    threads_ = n;
+}
+
+void System::prepare_threads() const { prepare_thread_team(threads_); }
+
+void System::set_observer(std::int64_t every, Observer observer) {
+    if (observer && every < 1)
+        fail(LPI_ERR_INVALID, "every must be >= 1, got " + std::to_string(every));
+    observe_every_ = observer ? every : 0;
+    observer_ = std::move(observer);
+}
+
+bool System::step(double dt, std::int64_t nsteps) {
     if (!std::isfinite(dt)) fail(LPI_ERR_NONFINITE, "dt is not finite");
     if (dt == 0.0) fail(LPI_ERR_INVALID, "dt must be nonzero");
     if (nsteps < 0) fail(LPI_ERR_INVALID, "nsteps must be >= 0, got " + std::to_string(nsteps));
-    if (nsteps == 0) return;
+    if (nsteps == 0) return true;
     // A model whose pieces are added by the user (generic, moments) may have
     // none yet: there is no Hamiltonian to integrate.
     if (model_->piece_count() == 0)
         fail(LPI_ERR_INVALID, std::string("the ") + model_->kind() +
                                   " system has no Hamiltonian pieces yet (add them with "
                                   "lpi_add_piece)");
-    const double end_time = time_ + dt * static_cast<double>(nsteps);
-    if (!std::isfinite(end_time))
-        fail(LPI_ERR_INVALID, "dt * nsteps overflows the time variable");
+    const double start = time_;
+    if (!std::isfinite(start + dt * static_cast<double>(nsteps)))
+        fail(LPI_ERR_OVERFLOW, "the end time t + dt * nsteps = " + short_number(start) + " + " +
+                                   short_number(dt) + " * " + std::to_string(nsteps) +
+                                   " overflows a double");
+    const double fraction = integrator_->largest_step_fraction();
+    if (!std::isfinite(dt * fraction))
+        fail(LPI_ERR_OVERFLOW, "dt = " + short_number(dt) + " times the largest flow weight " +
+                                   short_number(fraction) + " of method '" + method_.name +
+                                   "' overflows a double");
+    prepare_threads();
 
+    StepObserver watch;
+    if (observer_) {
+        watch.every = observe_every_;
+        watch.observe = [&](std::int64_t done) {
+            time_ = start + dt * static_cast<double>(done);
+            return observer_(done, time_);
+        };
+    }
     saved_ = state_;
-    bool finite = false;
+    StepsInProgress progress;
+    RunOutcome outcome;
     try {
-        finite = integrator_->advance(*model_, state_.data(), dt, nsteps);
+        outcome = integrator_->run(*model_, state_.data(), dt, nsteps, watch, progress);
+    } catch (const Error &e) {
+        state_.swap(saved_);
+        time_ = start;
+        fail(e.status(), std::string(e.what()) + ", " + steps_text(progress, start, dt) +
+                             "; state rolled back");
     } catch (...) {
         state_.swap(saved_);
+        time_ = start;
         throw;
     }
-    if (!finite) {
+    if (outcome.end == RunOutcome::NonFinite) {
         state_.swap(saved_);
-        char step[32];
-        std::snprintf(step, sizeof step, "%.6g", dt);
-        fail(LPI_ERR_NONFINITE, "method '" + method_.name + "' produced a non-finite state "
-                                "with dt = " + step + "; state rolled back");
+        time_ = start;
+        fail(LPI_ERR_NONFINITE,
+             "method '" + method_.name + "' produced a non-finite state with dt = " +
+                 short_number(dt) + ", found after step " + std::to_string(outcome.steps) +
+                 " of this call (t = " +
+                 short_number(start + dt * static_cast<double>(outcome.steps)) +
+                 "; the state is checked every " + std::to_string(kFiniteCheckInterval) +
+                 " steps, at each observation and at the end); state rolled back");
     }
-    time_ = end_time;
+    time_ = start + dt * static_cast<double>(outcome.steps);
+    return outcome.end != RunOutcome::Stopped;
 }
 
-double System::energy() const { return model_->energy(state_.data()); }
+double System::energy() const {
+    const double h = model_->energy(state_.data());
+    require_no_overflow(&h, 1, [](std::size_t) { return std::string("the energy of this state"); });
+    return h;
+}
 
 void System::casimirs(double *out, std::size_t n) const {
     require_length("Casimir buffer", n, model_->casimir_count());
-    model_->casimirs(state_.data(), out);
+    std::vector<double> values(n);
+    model_->casimirs(state_.data(), values.data());
+    require_no_overflow(values.data(), n,
+                        [](std::size_t i) { return "Casimir " + std::to_string(i) + " of this state"; });
+    std::copy(values.begin(), values.end(), out);
 }
 
 }  // namespace lpi

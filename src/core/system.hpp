@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -30,7 +31,13 @@ public:
     // Piece flows (RK4: vector-field evaluations) per step in a long run.
     std::size_t flows_per_step() const { return integrator_->evaluations_per_step(); }
     void set_split(const std::string &name);
-    void set_threads(int n) { model_->set_threads(n); }
+    // Bounded by max_threads(); the model may refuse n > 1, and a count whose
+    // threads the system refuses to start fails with LPI_ERR_NO_MEMORY.
+    void set_threads(int n);
+    int threads() const { return threads_; }
+    // Readies the calling thread for the model's parallel regions (threads.hpp):
+    // every entry that runs them calls it first.
+    void prepare_threads() const;
 
     std::size_t dim() const { return model_->dim(); }
     void set_state(const double *x, std::size_t n);  // also resets time to 0
@@ -40,9 +47,18 @@ public:
     // must be the model's state_size() and every value finite.
     void restore_working_state(std::vector<double> state, double time);
 
-    void step(double dt, std::int64_t nsteps);
+    // Called by step() after every `every`-th step with the steps completed
+    // in the call and the time; true stops the call there.
+    using Observer = std::function<bool(std::int64_t step, double time)>;
+    void set_observer(std::int64_t every, Observer observer);  // empty observer: none
+
+    // Advances nsteps steps; false when the observer stopped it early (the
+    // state and time are then those of that many steps).
+    bool step(double dt, std::int64_t nsteps);
     double time() const { return time_; }
 
+    // Outputs computed from the (finite) state: a value that is not finite
+    // overflowed, and throws LPI_ERR_OVERFLOW naming it.
     double energy() const;
     std::size_t casimir_count() const { return model_->casimir_count(); }
     void casimirs(double *out, std::size_t n) const;
@@ -59,9 +75,17 @@ private:
     std::vector<double> saved_;  // the state before the step in progress
     double time_ = 0.0;
     ImplicitSettings implicit_;
+    int threads_ = 1;
+    std::int64_t observe_every_ = 0;
+    Observer observer_;
 };
 
 // Throws LPI_ERR_SIZE unless given == expected, naming what was expected.
 void require_length(const char *what, std::size_t given, std::size_t expected);
+
+// Throws LPI_ERR_OVERFLOW unless every value is finite: outputs computed from
+// a finite state that are not finite have overflowed. `what(i)` names value i.
+void require_no_overflow(const double *values, std::size_t n,
+                         const std::function<std::string(std::size_t)> &what);
 
 }  // namespace lpi

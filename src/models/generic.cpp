@@ -314,9 +314,9 @@ void GenericModel::casimirs(const double *state, double *out) const {
             fail(LPI_ERR_CALLBACK, "the callback of Casimir " + std::to_string(q) + " returned " +
                                        std::to_string(rc));
         if (!std::isfinite(value) && !casimirs_[q].builtin.empty())
-            fail(LPI_ERR_NONFINITE, "Casimir " + std::to_string(q) + " (" + casimirs_[q].builtin +
-                                        ") is not representable at this state: it overflows a "
-                                        "double");
+            fail(LPI_ERR_OVERFLOW, "Casimir " + std::to_string(q) + " (" + casimirs_[q].builtin +
+                                       ") is not representable at this state: it overflows a "
+                                       "double");
         if (!std::isfinite(value))
             fail(LPI_ERR_CALLBACK, "the callback of Casimir " + std::to_string(q) +
                                        " gave a non-finite value");
@@ -419,9 +419,27 @@ std::vector<double> singular_values(std::size_t n, std::vector<double> M) {
 }
 
 std::size_t GenericModel::poisson_rank(const double *x) const {
+    // J is linear in x and the rank test is relative, so both are scaled to
+    // a largest entry of 1: no product or sum of squares below overflows.
     const std::size_t n = dim();
+    double x_max = 0.0;
+    for (std::size_t i = 0; i < n; ++i) x_max = std::max(x_max, std::fabs(x[i]));
+    if (x_max == 0.0) return 0;
+    std::vector<double> scaled(x, x + n);
+    for (double &v : scaled) v /= x_max;
     std::vector<double> J(n * n);
-    constants_->poisson_matrix(x, J.data());
+    constants_->poisson_matrix(scaled.data(), J.data());
+    double J_max = 0.0;
+    for (std::size_t e = 0; e < J.size(); ++e) {
+        if (!std::isfinite(J[e]))
+            fail(LPI_ERR_OVERFLOW, "J(x) entry (" + std::to_string(e / n) + ", " +
+                                       std::to_string(e % n) + ") overflows a double even for "
+                                       "x scaled to max |x_i| = 1 (the structure constants are "
+                                       "too large)");
+        J_max = std::max(J_max, std::fabs(J[e]));
+    }
+    if (J_max == 0.0) return 0;
+    for (double &v : J) v /= J_max;
     const std::vector<double> sigma = singular_values(n, std::move(J));
     const double largest = sigma.empty() ? 0.0 : *std::max_element(sigma.begin(), sigma.end());
     const double tolerance = static_cast<double>(n) * DBL_EPSILON * largest;

@@ -42,7 +42,7 @@ constexpr Bracket kMomentBrackets[] = {
 // finite state never gives a NaN from inf - inf, and a Casimir whose value
 // is representable is returned even when its terms are not (entries near
 // 1e150: K ~ 1e450 terms); one that is not representable becomes +-inf,
-// which lpi_casimirs reports as LPI_ERR_NONFINITE naming the Casimir.
+// which lpi_casimirs reports as LPI_ERR_OVERFLOW naming the Casimir.
 // Where long double is double, the same code is the plain double formula.
 template <class Real>
 Real invariant_I(const Real *x) {
@@ -78,8 +78,8 @@ public:
     void flow(double t, double *x) override {
         const double b = x[0], a = x[2];
         if (!std::isfinite(a * b))
-            fail(LPI_ERR_NONFINITE, "x1 x3 = " + std::to_string(b) + " * " + std::to_string(a) +
-                                        " overflows in " + label());
+            fail(LPI_ERR_OVERFLOW, "x1 x3 = " + std::to_string(b) + " * " + std::to_string(a) +
+                                       " overflows in " + label());
         const double mu = derivative(a * b);
         const double lambda = 4.0 * x[1] * mu;
 

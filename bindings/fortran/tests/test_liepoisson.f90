@@ -35,6 +35,23 @@ contains
         squared_norm = 0
         if (c_associated(user)) squared_norm = 1  ! a failing callback when given any user pointer
     end function
+    ! Counts its calls in user, stops at the second; its own handle refuses
+    ! to change (LPI_ERR_BUSY) and to be destroyed.
+    integer(c_int) function stop_second(sys, step, t, user) bind(C)
+        use liepoisson, only: c_lpi_set_state, c_lpi_destroy, LPI_ERR_BUSY
+        type(c_ptr), value :: sys
+        integer(c_int64_t), value :: step
+        real(c_double), value :: t
+        type(c_ptr), value :: user
+        integer(c_int), pointer :: calls
+        real(c_double) :: x(3) = [9.0_c_double, 9.0_c_double, 9.0_c_double]
+        call c_f_pointer(user, calls)
+        calls = calls + 1
+        if (c_lpi_set_state(sys, x, 3_c_size_t) /= LPI_ERR_BUSY) calls = calls + 100
+        if (c_lpi_destroy(sys) /= LPI_ERR_BUSY) calls = calls + 100
+        if (step /= 5_c_int64_t * calls .or. t <= 0) calls = calls + 100
+        stop_second = merge(1, 0, calls == 2)
+    end function
 end module
 
 program test_liepoisson
@@ -49,6 +66,7 @@ program test_liepoisson
     call test_errors()
     call test_generic()
     call test_sine_euler()
+    call test_observer()
     if (failures > 0) then
         print '(i0, a)', failures, " check(s) failed"
         stop 1
@@ -64,6 +82,27 @@ contains
             failures = failures + 1
             print '(a, a)', "FAILED: ", what
         end if
+    end subroutine
+
+    subroutine test_observer()
+        type(c_ptr) :: sys
+        integer(c_int), target :: calls
+        integer :: status
+        real(c_double) :: m(3) = [1.0_c_double, 0.5_c_double, -0.3_c_double]
+        call lpi_rigid_body_create(sys, 1.0_c_double, 2.0_c_double, 3.0_c_double)
+        call lpi_set_state(sys, m)
+        calls = 0
+        call lpi_set_observer(sys, 5, stop_second, c_loc(calls))
+        call lpi_step(sys, 0.01_c_double, 100, status)
+        call check(status == LPI_STOPPED, "observer stops lpi_step with LPI_STOPPED")
+        call check(calls == 2, "observer called twice, its own handle refused (BUSY)")
+        call check(abs(lpi_time(sys) - 0.1_c_double) < 1e-15_c_double, "stopped at step 10")
+        call lpi_step(sys, 0.01_c_double, 3)  ! LPI_STOPPED never stops a program; none here
+        call lpi_set_observer(sys, 0)         ! removed
+        call lpi_step(sys, 0.01_c_double, 100)
+        call check(calls == 2, "observer removed")
+        call lpi_destroy(sys)
+        call check(.not. c_associated(sys), "destroy nulls the handle")
     end subroutine
 
     subroutine test_statuses()

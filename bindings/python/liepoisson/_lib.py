@@ -50,6 +50,7 @@ PROTOTYPES = {
     "lpi_set_state": (c_int, [c_handle, c_double_p, c_size_t]),
     "lpi_get_state": (c_int, [c_handle, c_double_p, c_size_t]),
     "lpi_step": (c_int, [c_handle, c_double, c_int64]),
+    "lpi_set_observer": (c_int, [c_handle, c_int64, c_void_p, c_void_p]),
     "lpi_time": (c_double, [c_handle]),
     "lpi_energy": (c_int, [c_handle, c_double_p]),
     "lpi_casimir_count": (c_size_t, [c_handle]),

@@ -48,13 +48,16 @@ lpi_rigid_body_create(out, I1, I2, I3) =
 lpi_rigid_body_exact(sys, t, out) =
     ccall(_sym(:lpi_rigid_body_exact), Cint, (Sys, Cdouble, Ptr{Cdouble}), sys, t, out)
 lpi_pendulum_create(out) = ccall(_sym(:lpi_pendulum_create), Cint, (Ptr{Sys},), out)
-lpi_destroy(sys) = ccall(_sym(:lpi_destroy), Cvoid, (Sys,), sys)
+lpi_destroy(sys) = ccall(_sym(:lpi_destroy), Cint, (Sys,), sys)
 lpi_set_method(sys, name) = ccall(_sym(:lpi_set_method), Cint, (Sys, Cstring), sys, name)
 lpi_set_split(sys, name) = ccall(_sym(:lpi_set_split), Cint, (Sys, Cstring), sys, name)
 lpi_dim(sys) = ccall(_sym(:lpi_dim), Csize_t, (Sys,), sys)
 lpi_set_state(sys, x, n) = ccall(_sym(:lpi_set_state), Cint, (Sys, Ptr{Cdouble}, Csize_t), sys, x, n)
 lpi_get_state(sys, x, n) = ccall(_sym(:lpi_get_state), Cint, (Sys, Ptr{Cdouble}, Csize_t), sys, x, n)
 lpi_step(sys, dt, nsteps) = ccall(_sym(:lpi_step), Cint, (Sys, Cdouble, Int64), sys, dt, nsteps)
+# fn: a @cfunction pointer of Cint (Ptr{Cvoid}, Int64, Cdouble, Ptr{Cvoid}), or C_NULL to remove.
+lpi_set_observer(sys, every, fn, user) =
+    ccall(_sym(:lpi_set_observer), Cint, (Sys, Int64, Ptr{Cvoid}, Ptr{Cvoid}), sys, every, fn, user)
 lpi_time(sys) = ccall(_sym(:lpi_time), Cdouble, (Sys,), sys)
 lpi_energy(sys, out) = ccall(_sym(:lpi_energy), Cint, (Sys, Ptr{Cdouble}), sys, out)
 lpi_casimir_count(sys) = ccall(_sym(:lpi_casimir_count), Csize_t, (Sys,), sys)
@@ -117,7 +120,8 @@ end # module C
 
 # ---- errors --------------------------------------------------------------------
 
-"""A failed call: `status` (negative code), `name` ("LPI_ERR_SIZE"), `message`."""
+"""A failed call: `status` (negative code), `name` ("LPI_ERR_SIZE"), `message`.
+Non-negative statuses (`LPI_OK`, and `LPI_STOPPED` = 1 from `lpi_step`) are not failures."""
 struct LiePoissonError <: Exception
     status::Int
     name::String
@@ -130,7 +134,7 @@ status_message(status::Integer) = unsafe_string(C.lpi_status_message(status))
 version() = VersionNumber(unsafe_string(C.lpi_version_string()))
 
 function _check(status, handle::Ptr{Cvoid} = C_NULL, cause = nothing)
-    status == 0 && return nothing
+    status >= 0 && return nothing
     message = unsafe_string(C.lpi_last_error(handle))
     # Julia has no exception chaining: a callback's exception joins the message.
     cause === nothing || (message *= " (callback threw: " * sprint(showerror, cause) * ")")
@@ -170,7 +174,8 @@ end
 
 function Base.close(sys::System)
     if sys.handle != C_NULL
-        C.lpi_destroy(sys.handle)
+        # LPI_ERR_BUSY from one of the system's own callbacks: nothing freed.
+        _check(C.lpi_destroy(sys.handle), sys.handle)
         sys.handle = C_NULL
     end
     nothing
@@ -185,7 +190,7 @@ end
 function _call(f, sys::System)
     empty!(sys.pending)
     status = GC.@preserve sys f(_h(sys))
-    if status != 0
+    if status < 0
         cause = isempty(sys.pending) ? nothing : sys.pending[1]
         empty!(sys.pending)
         _check(status, sys.handle, cause)

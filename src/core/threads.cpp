@@ -1,0 +1,160 @@
+#include "threads.hpp"
+
+#include <cctype>
+#include <condition_variable>
+#include <cstdlib>
+#include <mutex>
+#include <string>
+#include <system_error>
+#include <thread>
+#include <vector>
+
+#include "error.hpp"
+#include "lpi_config.h"
+
+#if LPI_HAVE_OPENMP
+#include <omp.h>
+#include <pthread.h>
+#endif
+
+namespace lpi {
+
+int max_threads() {
+#if LPI_HAVE_OPENMP
+    const int processors = omp_get_num_procs();
+#else
+    const int processors = static_cast<int>(std::thread::hardware_concurrency());
+#endif
+    return kMaxThreadsPerProcessor * (processors > 0 ? processors : 1);
+}
+
+void check_thread_count(int n) {
+    if (n < 1) fail(LPI_ERR_INVALID, "thread count must be >= 1, got " + std::to_string(n));
+    const int bound = max_threads();
+    if (n > bound)
+        fail(LPI_ERR_INVALID, "thread count " + std::to_string(n) + " exceeds " +
+                                  std::to_string(bound) + " (" +
+                                  std::to_string(kMaxThreadsPerProcessor) +
+                                  " x the processors available to the process)");
+}
+
+#if LPI_HAVE_OPENMP
+
+namespace {
+
+// The stack size libgomp gives its threads: OMP_STACKSIZE, else
+// GOMP_STACKSIZE ("<number>[B|K|M|G]", kilobytes by default), read once as
+// libgomp does when it loads; 0 when neither is set (default attributes).
+std::size_t parse_stack_size(const char *text) {
+    if (!text) return 0;
+    while (std::isspace(static_cast<unsigned char>(*text))) ++text;
+    char *end = nullptr;
+    const unsigned long long value = std::strtoull(text, &end, 10);
+    if (end == text) return 0;
+    while (std::isspace(static_cast<unsigned char>(*end))) ++end;
+    unsigned shift = 10;
+    switch (std::tolower(static_cast<unsigned char>(*end))) {
+    case '\0': break;
+    case 'b': shift = 0; break;
+    case 'k': shift = 10; break;
+    case 'm': shift = 20; break;
+    case 'g': shift = 30; break;
+    default: return 0;
+    }
+    return static_cast<std::size_t>(value) << shift;
+}
+
+std::size_t openmp_stack_size() {
+    static const std::size_t size = [] {
+        const std::size_t omp = parse_stack_size(std::getenv("OMP_STACKSIZE"));
+        return omp ? omp : parse_stack_size(std::getenv("GOMP_STACKSIZE"));
+    }();
+    return size;
+}
+
+// Probe threads wait until every one of them exists: an exited thread no
+// longer counts against the process limits, and the team needs them all at
+// once.
+struct Gate {
+    std::mutex mutex;
+    std::condition_variable opened;
+    bool open = false;
+};
+
+void *wait_at_gate(void *argument) {
+    auto *gate = static_cast<Gate *>(argument);
+    std::unique_lock<std::mutex> lock(gate->mutex);
+    gate->opened.wait(lock, [gate] { return gate->open; });
+    return nullptr;
+}
+
+// Starts `count` threads that all exist at once, then joins them. Returns
+// the error of the first refused thread (0 if none) and its index in *failed.
+int probe_threads(int count, int *failed) {
+    pthread_attr_t attributes;
+    if (int error = pthread_attr_init(&attributes)) return *failed = 0, error;
+    if (const std::size_t stack = openmp_stack_size())
+        pthread_attr_setstacksize(&attributes, stack);
+    Gate gate;
+    std::vector<pthread_t> started;
+    int error = 0;
+    try {
+        started.reserve(static_cast<std::size_t>(count));
+    } catch (...) {
+        pthread_attr_destroy(&attributes);
+        throw;
+    }
+    for (int i = 0; i < count && !error; ++i) {
+        pthread_t thread;
+        error = pthread_create(&thread, &attributes, wait_at_gate, &gate);
+        if (error)
+            *failed = i;
+        else
+            started.push_back(thread);
+    }
+    {
+        std::lock_guard<std::mutex> lock(gate.mutex);
+        gate.open = true;
+    }
+    gate.opened.notify_all();
+    for (pthread_t thread : started) pthread_join(thread, nullptr);
+    pthread_attr_destroy(&attributes);
+    return error;
+}
+
+}  // namespace
+
+void prepare_thread_team(int n) {
+    // The largest team this thread's OpenMP pool is known to hold: libgomp
+    // keeps the threads of the last team started on a thread (a team of one
+    // starts none) and lets the surplus go when a smaller team starts.
+    thread_local int ready = 1;
+    if (n <= ready) {
+        if (n > 1) ready = n;
+        return;
+    }
+    int failed = 0;
+    if (const int error = probe_threads(n - 1, &failed))
+        fail(LPI_ERR_NO_MEMORY,
+             "cannot run " + std::to_string(n) + " threads: the system refused to start thread " +
+                 std::to_string(failed + 2) + " of " + std::to_string(n) + " (" +
+                 std::generic_category().message(error) +
+                 "); the process is at a limit on threads or memory (ulimit -u, ulimit -v, "
+                 "cgroup pids.max): use fewer threads");
+    // Start the team once (a region with a body: an empty one is compiled
+    // away). The runtime may cap it (OMP_THREAD_LIMIT); regions asking for n
+    // then get the same team, so n is what this thread is ready for.
+#pragma omp parallel num_threads(n)
+    {
+#pragma omp barrier
+    }
+    ready = n;
+}
+
+#else
+
+void prepare_thread_team(int) {}
+
+#endif
+
+}  // namespace lpi

@@ -1,0 +1,28 @@
+// Thread counts: the bound every system shares, and the check that keeps the
+// OpenMP runtime from ending the process. libgomp calls exit() when it cannot
+// create a thread of a team ("Thread creation failed"), so before a parallel
+// region could need new threads on the calling thread the library starts and
+// joins the same number of threads itself, where a refusal is a status.
+#pragma once
+
+namespace lpi {
+
+// Threads per processor a system may use at most: enough for any sensible
+// oversubscription, while bounding the scratch memory kept per thread.
+constexpr int kMaxThreadsPerProcessor = 4;
+
+// kMaxThreadsPerProcessor x the processors available to the process.
+int max_threads();
+
+// Throws LPI_ERR_INVALID unless 1 <= n <= max_threads(), naming the bound.
+void check_thread_count(int n);
+
+// Makes an OpenMP team of n threads safe to start on the calling thread: when
+// the runtime may need to create threads for it (this thread has not yet run
+// a team of n through here since its last larger one), starts n - 1 threads
+// with the stack size OpenMP uses and joins them, then starts the team once
+// so the runtime keeps its threads. Throws LPI_ERR_NO_MEMORY, naming the
+// cause, when the system refuses a thread. Without OpenMP, or n <= 1, nothing.
+void prepare_thread_team(int n);
+
+}  // namespace lpi
