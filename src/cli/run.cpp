@@ -125,13 +125,13 @@ void check_option(int status, const lpi_system *sys, const char *option) {
 // Whether `loaded` is a state of the system `fresh` (the scene with these
 // options): same kind, size and Hamiltonian (its energy at the same state).
 std::string mismatch(lpi_system *fresh, const lpi_system *loaded) {
-    if (lpi_dim(fresh) != lpi_dim(loaded) || lpi_casimir_count(fresh) != lpi_casimir_count(loaded))
-        return "its system has another dimension";
     int32_t n_fresh = 0, n_loaded = 0;
     const bool sine_fresh = lpi_sine_euler_size(fresh, &n_fresh) == LPI_OK;
     const bool sine_loaded = lpi_sine_euler_size(loaded, &n_loaded) == LPI_OK;
     if (sine_fresh != sine_loaded) return "it holds another kind of system";
     if (n_fresh != n_loaded) return "it has N = " + std::to_string(n_loaded) + ", not " + std::to_string(n_fresh);
+    if (lpi_dim(fresh) != lpi_dim(loaded) || lpi_casimir_count(fresh) != lpi_casimir_count(loaded))
+        return "its system has another dimension";
     double m[3];
     if ((lpi_rigid_body_exact(fresh, 0.0, m) == LPI_OK) != (lpi_rigid_body_exact(loaded, 0.0, m) == LPI_OK))
         return "it holds another kind of system";
