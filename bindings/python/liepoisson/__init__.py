@@ -462,11 +462,13 @@ class System:
         if not callable(signal.getsignal(signal.SIGINT)):
             return 0
         seconds = self._seconds_per_step
-        if seconds is None:  # not measured yet: about 1 ns per flow and state entry
+        if seconds is None:
+            # Not measured yet: 1e-7 s per flow and state entry, more than any
+            # system takes (an overestimate only makes the looks more frequent).
             flows = c_size_t(1)
             if lib.lpi_flows_per_step(self._h(), byref(flows)) != 0:
                 flows.value = 1
-            seconds = 1e-9 * max(flows.value, 1) * max(self.dim, 1)
+            seconds = 1e-7 * max(flows.value, 1) * max(self.dim, 1)
         if seconds * nsteps < _OBSERVE_SECONDS:
             return 0
         return max(1, min(nsteps, int(_OBSERVE_SECONDS / max(seconds, 1e-12))))
@@ -498,7 +500,7 @@ class System:
             try:
                 self._call("lpi_step", dt, nsteps)
             finally:
-                lib.lpi_set_observer(self._handle, 0, None, None)
+                lib.lpi_set_observer(self._handle, 0, _lib.OBSERVER_FN(), None)  # NULL: removed
         finally:
             signal.signal(signal.SIGINT, previous)
         if raised:
