@@ -1,38 +1,148 @@
 #!/bin/sh
 # lpi run writes one CSV row per output interval plus the initial one, stays
-# quiet (no progress bar) when stderr is not a terminal, rejects bad options,
-# and draws vorticity snapshots for sine-Euler when FFTW and gnuplot are there.
+# quiet (no progress bar) when stderr is not a terminal, refuses every bad
+# option with exit status 2 and a message, fails (non-zero) when it cannot
+# write, stops on SIGINT with a complete last row and checkpoint (exit 130),
+# and a run interrupted and resumed ends bit for bit where the uninterrupted
+# run ends, whatever --every is.
 set -eu
 lpi="$1"; out="$2"
 rm -rf "$out"
-"$lpi" run rigid-body --method yoshida-6 --dt 0.1 --steps 50 --every 10 --out "$out" 2>"$out.err"
+mkdir -p "$out"
+"$lpi" run rigid-body --method yoshida-6 --dt 0.1 --steps 50 --every 10 --out "$out" 2>"$out.err" >/dev/null
 rows=$(wc -l < "$out/rigid-body.csv")
 [ "$rows" -eq 7 ] || { echo "expected 7 lines (header + 6 rows), got $rows"; exit 1; }
 [ ! -s "$out.err" ] || { echo "unexpected output on a non-terminal stderr:"; cat "$out.err"; exit 1; }
-if "$lpi" run rigid-body --method no-such-method --out "$out" 2>/dev/null; then
-    echo "an unknown method was accepted"; exit 1
-fi
-if "$lpi" run rigid-body --inertia 1,-2,3 --out "$out" 2>/dev/null; then
-    echo "a negative inertia was accepted"; exit 1
-fi
+
+# Every bad option: exit status 2 and a message naming the option.
+refused() {  # refused OPTION-NAME-IN-MESSAGE lpi-arguments...
+    what="$1"; shift
+    rc=0
+    "$lpi" "$@" >/dev/null 2>"$out.err" || rc=$?
+    [ "$rc" -eq 2 ] || { echo "lpi $*: exit status $rc, expected 2"; cat "$out.err"; exit 1; }
+    grep -q -e "$what" "$out.err" || { echo "lpi $*: no message naming $what:"; cat "$out.err"; exit 1; }
+}
+rb="run rigid-body --out $out/bad"
+for v in -5 0 -0 nan inf 1e400 1e-400 "" 10x " 5" 0x; do refused --until $rb --until "$v"; done
+for v in 0 -0 -1 nan -inf 1e999 "" 1e-320 0.1.2; do refused --dt $rb --dt "$v"; done
+for v in -3 0 2.9 1e400 "" 10x 9223372036854775808 18446744073709551621 nan; do refused --steps $rb --steps "$v"; done
+for v in 0 -1 0.5 9223372036854775808 ""; do refused --every $rb --every "$v"; done
+for v in 0 -1 4294967297 2147483648 1.5; do refused --threads $rb --threads "$v"; done
+for v in 1e12 4 1 -7 2.5 4294967303 ""; do refused --N run sine-euler --out "$out/bad" --N "$v"; done
+for v in -1 1.5 x; do refused --snapshots $rb --snapshots "$v"; done
+for v in -1 1.5; do refused --checkpoint-every $rb --checkpoint-every "$v"; done
+for v in 1,-2,3 1,2 1,2,3,4 1,,3 1,nan,3 a,b,c ""; do refused --inertia $rb --inertia "$v"; done
+refused --dt $rb --dt 0.1 --dt 0.2
+refused --steps $rb --steps 5 --until 3
+refused --dt $rb --dt
+refused --method $rb --method no-such-method
+refused --method $rb --method ""
+refused --out $rb --out ""
+refused --checkpoint $rb --checkpoint ""
+refused --resume $rb --resume ""
+refused --bogus $rb --bogus 1
+refused "one scene" run rigid-body pendulum
+refused "which scene" run
+refused no-such-scene run no-such-scene
+refused "less than one step" $rb --until 0.001 --dt 0.01
+refused "too many steps" $rb --until 1e300 --dt 1e-300
+refused --N report --N 1e12 --out "$out/bad"
+refused --N report --N 8 --out "$out/bad"
+refused --out report --out
+refused no-such-scene report no-such-scene
+refused --bogus report --bogus
+refused FILTER stress a b
+refused no-such-case stress no-such-case
+refused --bogus stress --bogus
+refused argument methods extra
+refused no-such-command no-such-command
+
+# Every failure: non-zero. A checkpoint that cannot be written stops the run
+# before any step (it used to fail every save and still exit 0).
+rc=0; "$lpi" run rigid-body --steps 5 --checkpoint "$out/no-such-dir/x.lpi" --out "$out/f" >/dev/null 2>&1 || rc=$?
+[ "$rc" -eq 1 ] || { echo "a checkpoint into a missing directory: exit status $rc"; exit 1; }
+rc=0; "$lpi" run rigid-body --steps 5 --out "$out/no-such-dir/deeper" >/dev/null 2>&1 || rc=$?
+[ "$rc" -eq 1 ] || { echo "an output directory that cannot be made: exit status $rc"; exit 1; }
+rc=0; "$lpi" run pendulum --resume "$out/no-such-file.lpi" --out "$out/f" >/dev/null 2>&1 || rc=$?
+[ "$rc" -eq 1 ] || { echo "a missing checkpoint: exit status $rc"; exit 1; }
+rc=0; "$lpi" run rigid-body --dt 1e308 --steps 3 --out "$out/f" >/dev/null 2>&1 || rc=$?
+[ "$rc" -eq 1 ] || { echo "a step that overflows: exit status $rc"; exit 1; }
+
 if "$lpi" run sine-euler --N 9 --dt 0.05 --steps 20 --every 2 --snapshots 5 --out "$out" >/dev/null 2>&1; then
+    have_sine_euler=1
     if command -v gnuplot >/dev/null 2>&1; then
         n=$(ls "$out"/vorticity_*.png | wc -l)
         [ "$n" -eq 3 ] || { echo "expected 3 vorticity snapshots, got $n"; exit 1; }
     fi
+else
+    have_sine_euler=0
 fi
 
-# --checkpoint / --resume: 20 steps, then 30 more from the checkpoint, end
-# exactly (to the bit) where 50 steps in one run end.
-"$lpi" run pendulum --method suzuki-4 --dt 0.05 --steps 50 --every 10 --out "$out/whole" >/dev/null
-"$lpi" run pendulum --method suzuki-4 --dt 0.05 --steps 20 --every 10 --out "$out/parts" \
-    --checkpoint "$out/pendulum.lpi" >/dev/null
-"$lpi" run pendulum --dt 0.05 --steps 30 --every 10 --out "$out/parts" --resume "$out/pendulum.lpi" >/dev/null
-whole=$(tail -1 "$out/whole/pendulum.csv" | cut -d, -f1-3,5-)
-parts=$(tail -1 "$out/parts/pendulum.csv" | cut -d, -f1-3,5-)
-[ "$whole" = "$parts" ] || { echo "resumed run differs: '$whole' vs '$parts'"; exit 1; }
-[ "$(wc -l < "$out/parts/pendulum.csv")" -eq 7 ] || { echo "resumed rows not appended"; exit 1; }
-if "$lpi" run pendulum --resume "$out/no-such-file.lpi" --out "$out" 2>/dev/null; then
-    echo "a missing checkpoint was accepted"; exit 1
+# --resume refuses a checkpoint of another scene, N or Hamiltonian.
+"$lpi" run pendulum --dt 0.05 --steps 20 --out "$out/p" --checkpoint "$out/pendulum.lpi" >/dev/null
+refused "not a checkpoint of this scene" run rigid-body --resume "$out/pendulum.lpi" --out "$out/bad"
+"$lpi" run rigid-body --dt 0.05 --steps 20 --out "$out/r" --checkpoint "$out/rigid.lpi" >/dev/null
+refused "Hamiltonian differs" run rigid-body --inertia 1,1,2 --resume "$out/rigid.lpi" --out "$out/bad"
+refused "not a whole number of steps" run rigid-body --dt 0.03 --resume "$out/rigid.lpi" --out "$out/bad"
+refused "past the run's end" run rigid-body --dt 0.05 --steps 10 --resume "$out/rigid.lpi" --out "$out/bad"
+if [ "$have_sine_euler" = 1 ]; then
+    "$lpi" run sine-euler --N 5 --dt 0.05 --steps 4 --out "$out/s" --checkpoint "$out/se5.lpi" >/dev/null
+    refused "N = 5, not 7" run sine-euler --N 7 --resume "$out/se5.lpi" --out "$out/bad"
+    refused "another" run pendulum --resume "$out/se5.lpi" --out "$out/bad"
 fi
-echo "lpi run: --checkpoint then --resume continues to the bit"
+
+# --checkpoint then --resume with the same options: the CSV (every row, to
+# the bit) is the uninterrupted run's, for --every dividing the steps or not.
+for every in 10 7; do
+    rm -rf "$out/whole" "$out/parts"
+    "$lpi" run pendulum --method suzuki-4 --dt 0.05 --steps 53 --every $every --out "$out/whole" >/dev/null
+    # A run killed after its checkpoint at row 2 (step 2 * every) left rows past it.
+    "$lpi" run pendulum --method suzuki-4 --dt 0.05 --steps $((2 * every)) --every $every \
+        --out "$out/parts" --checkpoint "$out/parts.lpi" >/dev/null
+    "$lpi" run pendulum --method suzuki-4 --dt 0.05 --steps $((4 * every)) --every $every \
+        --out "$out/parts" --checkpoint "$out/later.lpi" >/dev/null
+    "$lpi" run pendulum --method suzuki-4 --dt 0.05 --steps 53 --every $every --out "$out/parts" \
+        --resume "$out/parts.lpi" >/dev/null
+    cmp -s "$out/whole/pendulum.csv" "$out/parts/pendulum.csv" ||
+        { echo "--every $every: the resumed CSV differs:"; diff "$out/whole/pendulum.csv" "$out/parts/pendulum.csv"; exit 1; }
+done
+
+# Ctrl-C: SIGINT to a long run ends it with status 130, a complete last row
+# on the --every grid and a checkpoint from which the same command, resumed,
+# ends bit for bit where the uninterrupted run ends (a few rows further on,
+# at a step that is not a multiple of --every).
+if [ "$have_sine_euler" = 1 ]; then
+    long="sine-euler --N 9 --snapshots 0"; csv=sine-euler.csv; per_row=1000
+else
+    long="rigid-body"; csv=rigid-body.csv; per_row=100000
+fi
+for every in $per_row $((per_row * 7 / 9 + 1)); do
+    rm -rf "$out/int" "$out/ref" "$out/int.lpi"
+    "$lpi" run $long --dt 0.01 --steps 1000000000 --every $every --out "$out/int" \
+        --checkpoint "$out/int.lpi" >/dev/null &
+    pid=$!
+    # Three rows: the handler is in place; then let it run a little.
+    while [ ! -f "$out/int/$csv" ] || [ "$(wc -l < "$out/int/$csv")" -lt 3 ]; do
+        kill -0 $pid 2>/dev/null || { echo "the long run ended early"; exit 1; }
+        sleep 0.05
+    done
+    sleep 0.2
+    kill -INT $pid
+    waited=0
+    while kill -0 $pid 2>/dev/null && [ $waited -lt 300 ]; do sleep 0.1; waited=$((waited + 1)); done
+    kill -0 $pid 2>/dev/null && { kill -KILL $pid; echo "SIGINT did not stop the run within 30 s"; exit 1; }
+    rc=0; wait $pid || rc=$?
+    [ "$rc" -eq 130 ] || { echo "SIGINT: exit status $rc, expected 130"; exit 1; }
+    [ "$(tail -c 1 "$out/int/$csv" | od -An -c | tr -d ' ')" = '\n' ] || { echo "SIGINT: last row cut"; exit 1; }
+    fields=$(head -n 1 "$out/int/$csv" | tr -cd , | wc -c)
+    [ "$(tail -n 1 "$out/int/$csv" | tr -cd , | wc -c)" -eq "$fields" ] || { echo "SIGINT: last row incomplete"; exit 1; }
+    stop=$(tail -n 1 "$out/int/$csv" | cut -d, -f1)
+    [ $((stop % every)) -eq 0 ] || { echo "SIGINT: stopped at step $stop, off the --every $every grid"; exit 1; }
+    end=$((stop + 2 * every + 5))
+    "$lpi" run $long --dt 0.01 --steps $end --every $every --out "$out/int" --checkpoint "$out/int.lpi" \
+        --resume "$out/int.lpi" >/dev/null
+    "$lpi" run $long --dt 0.01 --steps $end --every $every --out "$out/ref" >/dev/null
+    cmp -s "$out/ref/$csv" "$out/int/$csv" ||
+        { echo "interrupted at $stop (--every $every) and resumed: the CSV differs"; diff "$out/ref/$csv" "$out/int/$csv" | tail -4; exit 1; }
+done
+echo "lpi run: bad options refused, failures reported, SIGINT and --resume continue to the bit"

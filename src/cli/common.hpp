@@ -4,10 +4,14 @@
 
 #include <liepoisson.h>
 
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
 #include <functional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,6 +31,109 @@ inline void check(int status, const lpi_system *sys, const char *what) {
                  lpi_status_name(status));
     std::exit(1);
 }
+
+// One strict reader of a command's arguments, used by every command for every
+// option: a value must be the whole text (no "10x", "", " 5"), numbers must be
+// finite and in range (no "nan", "1e400", 2^64), whole numbers whole ("2.9" is
+// refused, "1e6" accepted), and an option may be given once. Anything else
+// stops the command with a message and exit status 2.
+class Arguments {
+public:
+    Arguments(std::string command, int argc, char **argv)
+        : command_(std::move(command)), argc_(argc), argv_(argv) {}
+
+    bool done() const { return next_ >= argc_; }
+    // The next argument (an option name or an operand).
+    std::string next() { return argv_[next_++]; }
+
+    [[noreturn]] void fail(const std::string &message) const {
+        std::fprintf(stderr, "%s: %s\n", command_.c_str(), message.c_str());
+        std::exit(2);
+    }
+
+    // The value of `option` (just read by next()): the following argument, non-empty.
+    std::string value(const std::string &option) {
+        if (!seen_.insert(option).second) fail(option + " is given twice");
+        if (done()) fail(option + " needs a value");
+        const std::string text = argv_[next_++];
+        if (text.empty()) fail(option + ": the value is empty");
+        return text;
+    }
+
+    // A whole number in [lo, hi].
+    int64_t integer(const std::string &option, int64_t lo, int64_t hi) {
+        return whole_number(option, value(option), lo, hi);
+    }
+
+    // A finite number > 0.
+    double positive(const std::string &option) { return positive_number(option, value(option)); }
+
+    // `count` finite numbers > 0, separated by commas ("1,2,3").
+    std::vector<double> positives(const std::string &option, std::size_t count) {
+        const std::string text = value(option);
+        std::vector<double> out;
+        std::size_t from = 0;
+        for (;;) {
+            const std::size_t comma = text.find(',', from);
+            out.push_back(positive_number(option, text.substr(from, comma - from)));
+            if (comma == std::string::npos) break;
+            from = comma + 1;
+        }
+        if (out.size() != count)
+            fail(option + ": '" + text + "' is not " + std::to_string(count) + " numbers separated by commas");
+        return out;
+    }
+
+    int64_t whole_number(const std::string &option, const std::string &text, int64_t lo, int64_t hi) const {
+        const char *begin = text.c_str();
+        char *end = nullptr;
+        errno = 0;
+        long long v = std::strtoll(begin, &end, 10);
+        const bool digits_only = !text.empty() && !std::isspace(static_cast<unsigned char>(text[0])) &&
+                                 end != begin && *end == '\0';
+        if (digits_only && errno == ERANGE) fail(option + ": " + text + " is out of range" + range(lo, hi));
+        if (!digits_only) {
+            // Exponent form, when it names a whole number exactly ("1e6").
+            const double d = real(option, text);
+            if (d != std::trunc(d)) fail(option + ": '" + text + "' is not a whole number");
+            if (!(std::fabs(d) < 0x1p63)) fail(option + ": " + text + " is out of range" + range(lo, hi));
+            v = static_cast<long long>(d);
+        }
+        if (v < lo || v > hi) fail(option + ": " + text + " is out of range" + range(lo, hi));
+        return v;
+    }
+
+    double positive_number(const std::string &option, const std::string &text) const {
+        const double v = real(option, text);
+        if (!(v > 0.0)) fail(option + ": " + text + " is not > 0");
+        return v;
+    }
+
+private:
+    // A finite number that is the whole text, neither overflowing nor underflowing.
+    double real(const std::string &option, const std::string &text) const {
+        const char *begin = text.c_str();
+        char *end = nullptr;
+        errno = 0;
+        const double v = std::strtod(begin, &end);
+        if (text.empty() || std::isspace(static_cast<unsigned char>(text[0])) || end == begin || *end != '\0')
+            fail(option + ": '" + text + "' is not a number");
+        if (!std::isfinite(v)) fail(option + ": " + text + " is not finite");
+        if (errno == ERANGE) fail(option + ": " + text + " is out of the range of a double");
+        return v;
+    }
+
+    static std::string range(int64_t lo, int64_t hi) {
+        if (hi == INT64_MAX) return " (at least " + std::to_string(lo) + ")";
+        return " (" + std::to_string(lo) + " to " + std::to_string(hi) + ")";
+    }
+
+    std::string command_;
+    int argc_;
+    char **argv_;
+    int next_ = 0;
+    std::set<std::string> seen_;
+};
 
 // Owns one handle.
 class Handle {

@@ -15,51 +15,70 @@ using namespace lpi_cli;
 
 namespace {
 
+void print_scenes(FILE *to) {
+    std::fprintf(to, "scenes:\n");
+    for (const Scene &s : builtin_scenes()) {
+        std::string notes;
+        if (!s.create) notes += " (lpi report only)";
+        if (!s.in_default_report) notes += " (not in the default report)";
+        std::fprintf(to, "  %-14s %s%s\n", s.name.c_str(), s.description.c_str(), notes.c_str());
+    }
+}
+
 void print_usage(FILE *to) {
     std::fprintf(to,
                  "usage: lpi report [SCENE...] [--out DIR] [--N N]\n"
                  "           error against CPU time for every applicable method over a sweep of\n"
-                 "           step sizes; prints a table and writes CSV and PNG files to DIR\n"
-                 "           (default ./lpi-report). Without SCENE: the default scenes.\n"
-                 "           --N sets the sine-Euler scene's N (odd, default 31).\n"
+                 "           step sizes; lpi report --help for more\n"
                  "       lpi run SCENE [options]   integrate one scene; lpi run --help for the options\n"
                  "       lpi stress [--quick] [FILTER]\n"
                  "           stiff and extreme cases against every applicable method: bounded,\n"
                  "           energy error, Casimir drift and status per case, step and method\n"
+                 "       lpi methods   the integration methods: name, order, stages, reference\n"
                  "       lpi --version | --help\n"
-                 "scenes:\n");
-    for (const Scene &s : builtin_scenes())
-        std::fprintf(to, "  %-14s %s%s\n", s.name.c_str(), s.description.c_str(),
-                     s.in_default_report ? "" : " (not in the default report)");
+                 "exit status: 0 success, 1 a failure, 2 a bad option, 130 interrupted (lpi run)\n");
+    print_scenes(to);
+}
+
+void print_report_usage(FILE *to) {
+    std::fprintf(to,
+                 "usage: lpi report [SCENE...] [--out DIR] [--N N]\n"
+                 "  For each SCENE (without one: the default scenes), every applicable method\n"
+                 "  over a sweep of step sizes: a work-precision table (error at the final\n"
+                 "  time, energy error and Casimir drift against CPU time, one core, measured\n"
+                 "  in this run), then the CPU time each method needs for a given error.\n"
+                 "  --out DIR   write DIR/SCENE.csv, DIR/SCENE_energy.csv and, with gnuplot,\n"
+                 "              the PNG plots there (default ./lpi-report)\n"
+                 "  --N N       the sine-Euler scene's N (odd >= 3, default 31)\n");
+    print_scenes(to);
 }
 
 int report_command(int argc, char **argv) {
     ReportOptions options;
     SceneOptions scene_options;
     std::vector<std::string> names;
-    for (int a = 0; a < argc; ++a) {
-        if (std::strcmp(argv[a], "--out") == 0 && a + 1 < argc) {
-            options.out_dir = argv[++a];
-        } else if (std::strcmp(argv[a], "--N") == 0 && a + 1 < argc) {
-            scene_options.sine_euler_n = std::atoi(argv[++a]);
-        } else if (std::strcmp(argv[a], "--help") == 0) {
-            print_usage(stdout);
+    Arguments args("lpi report", argc, argv);
+    while (!args.done()) {
+        const std::string arg = args.next();
+        if (arg == "--out") {
+            options.out_dir = args.value(arg);
+        } else if (arg == "--N") {
+            scene_options.sine_euler_n = static_cast<int>(args.integer(arg, 3, 2147483647));
+            if (scene_options.sine_euler_n % 2 == 0) args.fail("--N must be odd");
+        } else if (arg == "--help" || arg == "-h") {
+            print_report_usage(stdout);
             return 0;
-        } else if (argv[a][0] == '-') {
-            std::fprintf(stderr, "lpi report: unknown option '%s'\n", argv[a]);
-            return 2;
+        } else if (!arg.empty() && arg[0] == '-') {
+            args.fail("unknown option '" + arg + "' (lpi report --help lists them)");
         } else {
-            names.push_back(argv[a]);
+            names.push_back(arg);
         }
     }
     const std::vector<Scene> all = builtin_scenes(scene_options);
     std::vector<const Scene *> chosen;
     for (const std::string &name : names) {
         auto it = std::find_if(all.begin(), all.end(), [&](const Scene &s) { return s.name == name; });
-        if (it == all.end()) {
-            std::fprintf(stderr, "lpi report: unknown scene '%s' (lpi --help lists them)\n", name.c_str());
-            return 2;
-        }
+        if (it == all.end()) args.fail("unknown scene '" + name + "' (lpi --help lists them)");
         chosen.push_back(&*it);
     }
     if (chosen.empty())
@@ -69,6 +88,25 @@ int report_command(int argc, char **argv) {
                 lpi_version_string());
     for (const Scene *s : chosen) run_report(*s, options);
     std::printf("\nCSV and PNG files are in %s/\n", options.out_dir.c_str());
+    return 0;
+}
+
+int methods_command(int argc, char **argv) {
+    Arguments args("lpi methods", argc, argv);
+    while (!args.done()) {
+        const std::string arg = args.next();
+        if (arg == "--help" || arg == "-h") {
+            std::printf("usage: lpi methods\n  the integration methods (lpi run --method NAME): name, order,\n"
+                        "  stages (leapfrog-equivalent cost), Poisson (keeps Casimirs to round-off),\n"
+                        "  reference\n");
+            return 0;
+        }
+        args.fail("takes no argument ('" + arg + "')");
+    }
+    std::printf("%-22s %5s %6s %7s  %s\n", "method", "order", "stages", "Poisson", "reference");
+    for (int i = 0; i < lpi_method_count(); ++i)
+        std::printf("%-22s %5d %6d %7s  %s\n", lpi_method_name(i), lpi_method_order(i), lpi_method_stages(i),
+                    lpi_method_is_poisson(i) == 1 ? "yes" : "no", lpi_method_reference(i));
     return 0;
 }
 
@@ -91,6 +129,7 @@ int main(int argc, char **argv) {
     if (command == "report") return report_command(argc - 2, argv + 2);
     if (command == "run") return run_command(argc - 2, argv + 2);
     if (command == "stress") return stress_command(argc - 2, argv + 2);
+    if (command == "methods") return methods_command(argc - 2, argv + 2);
     std::fprintf(stderr, "lpi: unknown command '%s'\n", command.c_str());
     print_usage(stderr);
     return 2;

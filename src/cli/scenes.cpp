@@ -135,6 +135,15 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         s.name = "figure2";
         s.description = "the paper's Figure 2: sine-Euler N = 7, leapfrog, dt = 0.05, 10^5 steps, "
                         "|w| = 1, H(0) = 0.75";
+        s.create = [] {
+            Handle h;
+            check(lpi_sine_euler_create(h.out(), 7), nullptr, "create sine-Euler");
+            const std::vector<double> w = figure2_field();
+            check(lpi_sine_euler_set_modes(h.get(), w.data(), w.size()), h.get(), "set modes");
+            return h;
+        };
+        s.final_time = 5000.0;
+        s.run_step = 0.05;
         s.unavailable = sine_euler_unavailable;
         s.custom_run = run_figure2;
         scenes.push_back(s);

@@ -13,8 +13,9 @@ namespace lpi_cli {
 struct Scene {
     std::string name;
     std::string description;
-    std::function<Handle()> create;  // configured system with its initial state
+    std::function<Handle()> create;  // configured system with its initial state (empty: report only)
     double final_time = 1.0;
+    double run_step = 0.01;          // lpi run's default --dt
     std::vector<double> steps;       // the sweep, largest first
     // Reference: the exact solution when the system has one, otherwise a much
     // finer run of `reference_method` with `reference_step`.

@@ -462,24 +462,30 @@ void print_usage(FILE *to) {
 int stress_command(int argc, char **argv) {
     bool quick = false;
     std::string filter;
-    for (int a = 0; a < argc; ++a) {
-        if (std::strcmp(argv[a], "--quick") == 0) {
+    Arguments args("lpi stress", argc, argv);
+    while (!args.done()) {
+        const std::string arg = args.next();
+        if (arg == "--quick") {
             quick = true;
-        } else if (std::strcmp(argv[a], "--help") == 0) {
+        } else if (arg == "--help" || arg == "-h") {
             print_usage(stdout);
             return 0;
-        } else if (argv[a][0] == '-') {
-            std::fprintf(stderr, "lpi stress: unknown option '%s'\n", argv[a]);
-            return 2;
+        } else if (!arg.empty() && arg[0] == '-') {
+            args.fail("unknown option '" + arg + "'");
+        } else if (!filter.empty()) {
+            args.fail("one FILTER only ('" + filter + "' and '" + arg + "')");
         } else {
-            filter = argv[a];
+            filter = arg;
         }
     }
+    const std::vector<Case> cases = build_cases(quick);
+    if (std::none_of(cases.begin(), cases.end(), [&](const Case &k) { return k.name.find(filter) != std::string::npos; }))
+        args.fail("no case name contains '" + filter + "'");
     std::printf("liepoisson %s: stress cases (%s)\n", lpi_version_string(), quick ? "quick" : "full");
     std::printf("energy error and Casimir drift are relative maxima over the checkpoints;\n"
                 "bounded: finite and max|x| <= 1e3 max|x(0)|; must-hold failures are marked '!!'\n");
     int violations = 0, runs = 0;
-    for (const Case &k : build_cases(quick)) {
+    for (const Case &k : cases) {
         if (!filter.empty() && k.name.find(filter) == std::string::npos) continue;
         std::printf("\n== %s (fastest period %.3g)\n", k.name.c_str(), k.period);
         std::printf("   %-9s %-9s %-22s %-22s %-7s %-10s %-10s %s\n", "dt/period", "steps",

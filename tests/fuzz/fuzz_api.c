@@ -1,8 +1,11 @@
 /* libFuzzer harness: the input bytes are a program of public API calls with
- * arguments, run on a few handles of every kind of system. Checked after
+ * arguments, run on a few handles of every kind of system: the whole API,
+ * checkpoints (buffers and files, round trips and damaged bytes), FFTW wisdom
+ * (strings and files), threads and the FFT floor included. Checked after
  * every call: no crash or sanitizer report, the status is a documented
  * code, a failed call names its function in lpi_last_error and leaves the
- * handle's state and time unchanged bit for bit. Build and run with
+ * handle's state and time unchanged bit for bit, and a checkpoint loads back
+ * to the same state and time bit for bit. Build and run with
  * tests/fuzz/run.sh. */
 #include <liepoisson.h>
 #include <math.h>
@@ -10,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 enum { kSlots = 4, kMaxCalls = 64, kMaxSteps = 40 };
 
@@ -28,29 +32,6 @@ static int32_t small_int(reader *r, int32_t lo, int32_t hi) {
     return lo + (int32_t)(byte(r) % (uint32_t)(hi - lo + 1));
 }
 
-/* Mostly meaningful values, sometimes raw bits (NaN payloads, subnormals). */
-static double number(reader *r) {
-    static const double table[] = {0.0, 1.0, -1.0, 0.5, 2.0, 3.0, 0.1, -0.3, 1e-8, 1e3,
-                                   1e300, -1e300, 1e-300, 7.0, 1e150, 1e-150};
-    const uint8_t mode = byte(r);
-    if (mode < 200) return table[mode % (sizeof table / sizeof table[0])];
-    if (mode < 210) return NAN;
-    if (mode < 220) return mode & 1 ? INFINITY : -INFINITY;
-    double d = 0.0;
-    uint8_t raw[8];
-    for (int i = 0; i < 8; ++i) raw[i] = byte(r);
-    memcpy(&d, raw, sizeof d);
-    return d;
-}
-
-static void check_status(int status) {
-    if (status > 0 || status < LPI_ERR_NO_CONVERGENCE) {
-        fprintf(stderr, "undocumented status %d\n", status);
-        abort();
-    }
-    if (strcmp(lpi_status_name(status), "LPI_UNKNOWN_STATUS") == 0) abort();
-}
-
 /* State and time of a handle, to compare bit for bit around a call. */
 typedef struct {
     double *x;
@@ -66,6 +47,90 @@ static void take(const lpi_system *sys, snapshot *s) {
     if (!s->x || lpi_get_state(sys, s->x, s->n) != LPI_OK) abort();
     s->time = lpi_time(sys);
 }
+
+/* Mostly meaningful values, sometimes raw bits (NaN payloads, subnormals). */
+static double number(reader *r) {
+    static const double table[] = {0.0, 1.0, -1.0, 0.5, 2.0, 3.0, 0.1, -0.3, 1e-8, 1e3,
+                                   1e300, -1e300, 1e-300, 7.0, 1e150, 1e-150};
+    const uint8_t mode = byte(r);
+    if (mode < 200) return table[mode % (sizeof table / sizeof table[0])];
+    if (mode < 210) return NAN;
+    if (mode < 220) return mode & 1 ? INFINITY : -INFINITY;
+    double d = 0.0;
+    uint8_t raw[8];
+    for (int i = 0; i < 8; ++i) raw[i] = byte(r);
+    memcpy(&d, raw, sizeof d);
+    return d;
+}
+
+/* Documented: a name in the header's status list. No observer is set, so no
+ * call may return a positive status. */
+static void check_status(int status) {
+    if (status > 0 || strcmp(lpi_status_name(status), "LPI_UNKNOWN_STATUS") == 0) {
+        fprintf(stderr, "undocumented status %d\n", status);
+        abort();
+    }
+}
+
+/* A private directory for checkpoint and wisdom files, made once. */
+static char scratch[64];
+static void remove_scratch(void) {
+    static const char *const names[] = {"run.lpi", "wisdom", "garbage"};
+    char path[128];
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
+        snprintf(path, sizeof path, "%s/%s", scratch, names[i]);
+        unlink(path);
+    }
+    rmdir(scratch);
+}
+static const char *scratch_path(const char *name, char *path, size_t size) {
+    if (!scratch[0]) {
+        snprintf(scratch, sizeof scratch, "/tmp/lpi-fuzz-XXXXXX");
+        if (!mkdtemp(scratch)) abort();
+        atexit(remove_scratch);
+    }
+    snprintf(path, size, "%s/%s", scratch, name);
+    return path;
+}
+
+static void write_file(const char *path, const uint8_t *data, size_t n) {
+    FILE *f = fopen(path, "wb");
+    if (!f) abort();
+    if (n) fwrite(data, 1, n, f);
+    fclose(f);
+}
+
+/* A loaded handle must hold the saved state and time to the bit. */
+static void check_same(const lpi_system *a, const lpi_system *b) {
+    snapshot sa, sb;
+    take(a, &sa);
+    take(b, &sb);
+    if (sa.n != sb.n || memcmp(sa.x, sb.x, sa.n * sizeof(double)) != 0 ||
+        memcmp(&sa.time, &sb.time, sizeof(double)) != 0) {
+        fprintf(stderr, "a checkpoint did not load back to the saved state\n");
+        abort();
+    }
+    free(sa.x);
+    free(sb.x);
+}
+
+/* A failed load leaves *out NULL with a message; a loaded handle is checked
+ * against `source` (when the bytes were not damaged) and released. */
+static void check_loaded(int status, lpi_system *loaded, const lpi_system *source, const char *function) {
+    check_status(status);
+    if (status != LPI_OK) {
+        if (loaded) abort();
+        if (!strstr(lpi_last_error(NULL), function)) {
+            fprintf(stderr, "%s failed with message '%s'\n", function, lpi_last_error(NULL));
+            abort();
+        }
+        return;
+    }
+    if (!loaded) abort();
+    if (source) check_same(source, loaded);
+    lpi_destroy(loaded);
+}
+
 
 static void compare(const lpi_system *sys, snapshot *before, int status, const char *function) {
     check_status(status);
@@ -131,7 +196,7 @@ static const char *const kSplits[] = {"casimir-shift", "axes", "standard-map", "
 static void run_call(lpi_system **slot, reader *r) {
     lpi_system *sys = *slot;
     snapshot before;
-    const uint8_t op = byte(r) % 24;
+    const uint8_t op = byte(r) % 30;
     int status = LPI_OK;
     switch (op) {
     case 0: case 1: case 2: case 3: case 4: { /* create into an empty slot */
@@ -187,7 +252,7 @@ static void run_call(lpi_system **slot, reader *r) {
         break;
     }
     case 10: case 11: case 12:
-        status = lpi_step(sys, number(r), small_int(r, -1, kMaxSteps));
+        status = lpi_step(sys, number(r), byte(r) % 16 ? small_int(r, -1, kMaxSteps) : INT64_MIN);
         compare(sys, &before, status, "lpi_step");
         break;
     case 13: {
@@ -235,7 +300,10 @@ static void run_call(lpi_system **slot, reader *r) {
     case 19: {
         int32_t N = 0;
         size_t flows = 0, rank = 0;
-        status = lpi_set_threads(sys, small_int(r, -1, 3));
+        const uint8_t threads = byte(r);
+        status = lpi_set_threads(sys, threads % 16 == 0   ? INT32_MAX
+                                      : threads % 16 == 1 ? INT32_MIN
+                                                          : small_int(r, -1, 3));
         compare(sys, &before, status, "lpi_set_threads");
         take(sys, &before);
         status = lpi_flows_per_step(sys, &flows);
@@ -285,10 +353,108 @@ static void run_call(lpi_system **slot, reader *r) {
         compare(sys, &before, status, "lpi_sine_euler_casimir_traces");
         break;
     }
-    default: {
+    case 23: {
         double out[3];
         status = lpi_rigid_body_exact(sys, number(r), out);
         compare(sys, &before, status, "lpi_rigid_body_exact");
+        break;
+    }
+    case 24: { /* checkpoint buffer: size query, short capacity, round trip, a damaged byte */
+        size_t size = 0;
+        status = lpi_save_buffer(sys, NULL, 0, &size);
+        if (status == LPI_ERR_SIZE) status = LPI_OK; /* the size query */
+        compare(sys, &before, status, "lpi_save_buffer");
+        if (status != LPI_OK || size == 0) break;
+        uint8_t *buf = malloc(size);
+        const size_t capacity = byte(r) % 8 ? size : size - 1;
+        take(sys, &before);
+        status = lpi_save_buffer(sys, buf, capacity, &size);
+        compare(sys, &before, status, "lpi_save_buffer");
+        if (status == LPI_OK) {
+            const int damaged = byte(r) % 4 == 0;
+            if (damaged) buf[(size_t)byte(r) * 257u % size] ^= (uint8_t)(1u << (byte(r) % 8));
+            lpi_system *loaded = NULL;
+            const size_t length = byte(r) % 8 ? size : (size_t)byte(r) % size;
+            status = lpi_load_buffer(&loaded, byte(r) % 16 ? buf : NULL, length);
+            check_loaded(status, loaded, damaged || length != size ? NULL : sys, "lpi_load_buffer");
+        }
+        free(buf);
+        break;
+    }
+    case 25: { /* checkpoint file: round trip, or a directory that does not exist */
+        char path[128];
+        scratch_path(byte(r) % 4 ? "run.lpi" : "no-such-dir/run.lpi", path, sizeof path);
+        status = lpi_save(sys, byte(r) % 16 ? path : NULL);
+        compare(sys, &before, status, "lpi_save");
+        if (status != LPI_OK) break;
+        lpi_system *loaded = NULL;
+        status = lpi_load(&loaded, path);
+        if (status != LPI_OK) abort(); /* what was just saved loads */
+        check_loaded(status, loaded, sys, "lpi_load");
+        break;
+    }
+    case 26: { /* checkpoint bytes from the input, as a buffer and as a file */
+        free(before.x);
+        const size_t n = r->left < 96 ? r->left : byte(r) % 96;
+        lpi_system *loaded = NULL;
+        status = lpi_load_buffer(&loaded, r->p, n);
+        check_loaded(status, loaded, NULL, "lpi_load_buffer");
+        char path[128];
+        write_file(scratch_path("garbage", path, sizeof path), r->p, n);
+        loaded = NULL;
+        status = lpi_load(&loaded, path);
+        check_loaded(status, loaded, NULL, "lpi_load");
+        r->p += n, r->left -= n;
+        return;
+    }
+    case 27: { /* wisdom as a string: size query, short buffer, round trip, input text */
+        free(before.x);
+        size_t length = 0;
+        status = lpi_fftw_wisdom_export_string(NULL, 0, &length);
+        check_status(status);
+        if (status == LPI_ERR_UNSUPPORTED) return; /* built without FFTW */
+        if (status != LPI_ERR_SIZE) abort();
+        const size_t size = byte(r) % 8 ? length + 1 : length;
+        char *text = malloc(size ? size : 1);
+        status = lpi_fftw_wisdom_export_string(text, size, &length);
+        check_status(status);
+        if (status == LPI_OK) {
+            if (strlen(text) != length) abort();
+            status = lpi_fftw_wisdom_import_string(text);
+            if (status != LPI_OK) abort(); /* exported wisdom imports */
+        }
+        free(text);
+        char input[40];
+        const size_t n = (size_t)byte(r) % sizeof input;
+        for (size_t i = 0; i < n; ++i) input[i] = (char)(byte(r) | 1);
+        input[n] = '\0';
+        status = lpi_fftw_wisdom_import_string(byte(r) % 16 ? input : NULL);
+        check_status(status);
+        return;
+    }
+    case 28: { /* wisdom files: round trip, input bytes, a missing file */
+        free(before.x);
+        char path[128], garbage[128];
+        scratch_path("wisdom", path, sizeof path);
+        status = lpi_fftw_wisdom_export_file(path);
+        check_status(status);
+        if (status == LPI_ERR_UNSUPPORTED) return;
+        if (status != LPI_OK || lpi_fftw_wisdom_import_file(path) != LPI_OK) abort();
+        const size_t n = r->left < 64 ? r->left : byte(r) % 64;
+        write_file(scratch_path("garbage", garbage, sizeof garbage), r->p, n);
+        r->p += n, r->left -= n;
+        check_status(lpi_fftw_wisdom_import_file(garbage));
+        check_status(lpi_fftw_wisdom_import_file(scratch_path("no-such-file", path, sizeof path)));
+        check_status(lpi_fftw_wisdom_export_file(scratch_path("no-such-dir/wisdom", path, sizeof path)));
+        check_status(lpi_fftw_wisdom_import_file(NULL));
+        return;
+    }
+    default: { /* the FFT floor, a few steps' worth */
+        double seconds = 0, count = 0;
+        const uint8_t which = byte(r);
+        status = lpi_sine_euler_fft_floor(sys, small_int(r, -1, 3), which % 8 ? &seconds : NULL,
+                                          which % 8 == 1 ? NULL : &count);
+        compare(sys, &before, status, "lpi_sine_euler_fft_floor");
         break;
     }
     }

@@ -13,7 +13,12 @@ off) and plain lists otherwise; inputs may be any sequence.
 """
 import collections
 import ctypes
+import numbers
+import operator
 import os
+import signal
+import threading
+import time
 import weakref
 from ctypes import byref, c_double, c_int32, c_size_t
 
@@ -43,6 +48,59 @@ def _text(raw):
     return raw.decode("utf-8", "replace") if raw is not None else None
 
 
+# ---- arguments: every value checked before ctypes converts it -----------------
+# ctypes wraps integers silently (2**64 + 5 becomes 5) and a C string ends at
+# its first NUL; every call goes through these conversions instead.
+
+_C_INTEGER_RANGES = {
+    "int": (-2 ** 31, 2 ** 31 - 1),
+    "int32": (-2 ** 31, 2 ** 31 - 1),
+    "int64": (-2 ** 63, 2 ** 63 - 1),
+    "size": (0, 2 ** (8 * ctypes.sizeof(c_size_t)) - 1),
+}
+
+
+def _integer(value, what, ctype):
+    """value as an int that fits the C type ctype ("int32", "int64", "size"):
+    TypeError for a non-integer (a float, a string, a bool), OverflowError
+    outside the type's range."""
+    if isinstance(value, bool):
+        raise TypeError("%s must be an integer, not bool" % what)
+    try:
+        v = operator.index(value)
+    except TypeError:
+        raise TypeError("%s must be an integer, not %s" % (what, type(value).__name__)) from None
+    lo, hi = _C_INTEGER_RANGES[ctype]
+    if not lo <= v <= hi:
+        raise OverflowError("%s = %d is out of range for the C type (%d .. %d)" % (what, v, lo, hi))
+    return v
+
+
+def _real(value, what):
+    """value as a float: TypeError for anything but a real number (no strings)."""
+    if isinstance(value, (bool, str, bytes)) or not isinstance(value, numbers.Real):
+        raise TypeError("%s must be a real number, not %s" % (what, type(value).__name__))
+    return float(value)
+
+
+def _c_string(value, what):
+    """A str as UTF-8 bytes for a C string: TypeError otherwise, ValueError
+    for an embedded NUL (C would stop reading there)."""
+    if not isinstance(value, str):
+        raise TypeError("%s must be a str, not %s" % (what, type(value).__name__))
+    if "\0" in value:
+        raise ValueError("%s contains a NUL character" % what)
+    return value.encode()
+
+
+def _c_path(path):
+    """A path (str, bytes or os.PathLike) as bytes for C, no embedded NUL."""
+    raw = os.fsencode(path)
+    if b"\0" in raw:
+        raise ValueError("embedded null byte in path")
+    return raw
+
+
 #: The library's version, "MAJOR.MINOR.PATCH".
 version = _text(lib.lpi_version_string())
 __version__ = version
@@ -50,11 +108,18 @@ __version__ = version
 
 def status_name(status):
     """"LPI_ERR_SIZE" for -3, "LPI_UNKNOWN_STATUS" for a value that is no status."""
-    return _text(lib.lpi_status_name(status))
+    status = _integer(status, "status", "int")
+    name = _text(lib.lpi_status_name(status))
+    if name == "LPI_UNKNOWN_STATUS" and status in _KNOWN_AHEAD:
+        return _KNOWN_AHEAD[status][0]
+    return name
 
 
 def status_message(status):
     """The one-line description of a status code."""
+    status = _integer(status, "status", "int")
+    if status in _KNOWN_AHEAD and _text(lib.lpi_status_name(status)) == "LPI_UNKNOWN_STATUS":
+        return _KNOWN_AHEAD[status][1]
     return _text(lib.lpi_status_message(status))
 
 
@@ -85,6 +150,18 @@ _ERROR_CLASSES = {
     "LPI_ERR_INTERNAL": ("InternalError", ()),
     "LPI_ERR_CALLBACK": ("CallbackError", ()),
     "LPI_ERR_NO_CONVERGENCE": ("NoConvergenceError", (ArithmeticError,)),
+    "LPI_ERR_IO": ("FileError", (OSError,)),
+    "LPI_ERR_FORMAT": ("FormatError", (ValueError,)),
+    "LPI_ERR_BUSY": ("BusyError", (RuntimeError,)),
+    "LPI_ERR_OVERFLOW": ("OverflowStatusError", (OverflowError,)),
+}
+
+# Statuses of newer libraries, by value, so that their exception classes exist
+# (and map) whatever library is loaded: value -> (name, message).
+_KNOWN_AHEAD = {
+    -13: ("LPI_ERR_BUSY", "the handle is inside one of its own callbacks"),
+    -14: ("LPI_ERR_OVERFLOW", "a result of finite inputs overflows a double"),
+    1: ("LPI_STOPPED", "the observer stopped the step loop (not an error)"),
 }
 
 #: Status codes by name, read from the library ({"LPI_OK": 0, "LPI_ERR_NULL": -1, ...}).
@@ -92,16 +169,20 @@ STATUS = {}
 _by_status = {}
 
 
+# How far the scan looks: statuses are small integers, errors negative and the
+# few non-error results (LPI_STOPPED) positive; a gap does not end the scan.
+_STATUS_SCAN = range(-64, 17)
+
+
 def _scan_statuses():
-    code = 0
-    while True:
+    for code in _STATUS_SCAN:
         name = status_name(code)
         if name == "LPI_UNKNOWN_STATUS":
-            break
+            continue
         STATUS[name] = code
         globals()[name] = code
         __all__.append(name)
-        if code != 0:
+        if code < 0:
             pyname, bases = _ERROR_CLASSES.get(name, (None, ()))
             if pyname:
                 cls = type(pyname, (LiePoissonError,) + bases,
@@ -110,7 +191,6 @@ def _scan_statuses():
                 globals()[pyname] = cls
                 __all__.append(pyname)
                 _by_status[code] = cls
-        code -= 1
 
 
 _scan_statuses()
@@ -130,6 +210,17 @@ def _check_free(status):
         _raise(status, _text(lib.lpi_last_error(None)))
 
 
+# ---- Ctrl-C during a long step ---------------------------------------------------
+# ctypes releases the GIL during a foreign call, and Python's SIGINT handler
+# only sets a flag that the main thread acts on once it is back in Python: a
+# SIGINT during lpi_step is not lost, but waits for the whole call. A step()
+# long enough to matter is therefore observed (lpi_set_observer, when the
+# library has it) about every _OBSERVE_SECONDS; observing does not change the
+# trajectory to the bit, so the cadence may follow the measured speed.
+_HAVE_OBSERVER = "lpi_set_observer" not in _lib.MISSING
+_OBSERVE_SECONDS = 0.05
+
+
 # ---- methods ----------------------------------------------------------------
 
 Method = collections.namedtuple("Method", "name order stages reference is_poisson")
@@ -147,15 +238,29 @@ def methods():
 
 # ---- arrays in and out --------------------------------------------------------
 
-def _doubles_in(values):
-    """(pointer, length, keep-alive) for a sequence of floats. A C-contiguous
-    float64 numpy array is passed as it is (no copy)."""
+def _real_array(values, what, kinds="iuf"):
+    """values as a numpy array of real (or, with kinds "iufc", complex)
+    numbers: TypeError for strings, objects, booleans and (unless allowed)
+    complex numbers, which numpy would otherwise convert or truncate."""
+    a = np.asarray(values)
+    if a.dtype.kind not in kinds:
+        raise TypeError("%s must be %s numbers, not an array of %s"
+                        % (what, "complex" if "c" in kinds else "real", a.dtype))
+    return a
+
+
+def _doubles_in(values, what="values"):
+    """(pointer, length, keep-alive) for a flat sequence of real numbers. A
+    C-contiguous float64 numpy vector is passed as it is (no copy); any other
+    real array (float32, integers, a strided view) is copied."""
     if np is not None:
         a = values
         if not (isinstance(a, np.ndarray) and a.dtype == np.float64 and a.flags.c_contiguous):
-            a = np.ascontiguousarray(values, dtype=np.float64)
+            a = np.ascontiguousarray(_real_array(values, what), dtype=np.float64)
+        if a.ndim != 1:
+            raise ValueError("%s must be one-dimensional, not of shape %s" % (what, a.shape))
         return a.ctypes.data_as(_lib.c_double_p), a.size, a
-    vals = [float(v) for v in values]
+    vals = [_real(v, what) for v in values]
     buf = (c_double * len(vals))(*vals)
     return buf, len(vals), buf
 
@@ -177,7 +282,7 @@ def _doubles_out(n, out=None):
 
 
 def _int32s(values, what):
-    vals = [int(v) for v in values]
+    vals = [_integer(v, what, "int32") for v in values]
     return (c_int32 * max(len(vals), 1))(*vals), len(vals)
 
 
@@ -192,8 +297,10 @@ def _callback_view(ptr, n):
 
 def _destroy(handle, keep):
     # keep holds the ctypes callbacks until the handle that calls them is gone.
-    lib.lpi_destroy(handle)
-    del keep[:]
+    status = lib.lpi_destroy(handle)
+    if status == 0:
+        del keep[:]
+    return status
 
 
 class System:
@@ -209,12 +316,26 @@ class System:
         self._method = "leapfrog"
         self._split = None
         self._threads = 1
+        self._seconds_per_step = None  # measured by step(), for the SIGINT observer
         self._finalizer = weakref.finalize(self, _destroy, handle, self._keep)
 
     # lifetime
     def close(self):
-        """Releases the handle now (idempotent)."""
-        self._finalizer()
+        """Releases the handle now (idempotent).
+
+        Raises
+        ------
+        BusyError
+            When called from one of this system's own callbacks (a piece, a
+            Casimir or an observer): the system stays open and unchanged.
+        """
+        if not self._finalizer.alive:
+            return
+        self._finalizer.detach()
+        status = _destroy(self._handle, self._keep)
+        if status != 0:
+            self._finalizer = weakref.finalize(self, _destroy, self._handle, self._keep)
+            _raise(status, _text(lib.lpi_last_error(self._handle)))
 
     @property
     def closed(self):
@@ -233,15 +354,17 @@ class System:
         return self._handle
 
     def _call(self, name, *args):
-        """Calls lpi_<name>(handle, *args) and raises on a failed status."""
+        """Calls lpi_<name>(handle, *args), raises on a failed (negative)
+        status and returns the status otherwise (LPI_OK, LPI_STOPPED)."""
         del self._pending[:]
         status = getattr(lib, name)(self._h(), *args)
-        if status != 0:
+        if status < 0:
             cause = self._pending[0] if self._pending else None
             del self._pending[:]
             if cause is not None and not isinstance(cause, Exception):
                 raise cause  # KeyboardInterrupt, SystemExit: not ours to wrap
             _raise(status, _text(lib.lpi_last_error(self._handle)), cause)
+        return status
 
     @property
     def last_error(self):
@@ -259,8 +382,8 @@ class System:
         self.set_method(name)
 
     def set_method(self, name):
-        self._call("lpi_set_method", str(name).encode())
-        self._method = str(name)
+        self._call("lpi_set_method", _c_string(name, "method"))
+        self._method = name
 
     @property
     def split(self):
@@ -272,12 +395,12 @@ class System:
         self.set_split(name)
 
     def set_split(self, name):
-        self._call("lpi_set_split", str(name).encode())
-        self._split = str(name)
+        self._call("lpi_set_split", _c_string(name, "split"))
+        self._split = name
 
     def set_composition(self, gammas):
         """A symmetric composition of leapfrog with weights gammas (method "custom")."""
-        ptr, n, _keep = _doubles_in(gammas)
+        ptr, n, _keep = _doubles_in(gammas, "gammas")
         self._call("lpi_set_composition", n, ptr)
         self._method = "custom"
 
@@ -287,7 +410,8 @@ class System:
         return out.value
 
     def set_implicit_options(self, tolerance=1e-13, max_iterations=100):
-        self._call("lpi_set_implicit_options", float(tolerance), int(max_iterations))
+        self._call("lpi_set_implicit_options", _real(tolerance, "tolerance"),
+                   _integer(max_iterations, "max_iterations", "int32"))
 
     @property
     def threads(self):
@@ -295,8 +419,9 @@ class System:
 
     @threads.setter
     def threads(self, n):
-        self._call("lpi_set_threads", int(n))
-        self._threads = int(n)
+        n = _integer(n, "threads", "int32")
+        self._call("lpi_set_threads", n)
+        self._threads = n
 
     # state
     @property
@@ -314,7 +439,7 @@ class System:
 
     def set_state(self, x):
         """Sets the state (length dim) and resets the time to 0."""
-        ptr, n, _keep = _doubles_in(x)
+        ptr, n, _keep = _doubles_in(x, "state")
         self._call("lpi_set_state", ptr, n)
 
     state = property(get_state, set_state)
@@ -324,8 +449,79 @@ class System:
         return lib.lpi_time(self._h())
 
     def step(self, dt, nsteps=1):
-        """Advances nsteps steps of size dt. On failure the state is unchanged."""
-        self._call("lpi_step", float(dt), int(nsteps))
+        """Advances nsteps steps of size dt. On failure the state is unchanged.
+
+        Ctrl-C (SIGINT) during a long step: with a library that has
+        lpi_set_observer, the step stops within about _OBSERVE_SECONDS and the
+        SIGINT handler runs there (KeyboardInterrupt by default), the system
+        holding exactly the state of a call of the steps done (see .time);
+        otherwise the handler runs when the whole call returns. Either way the
+        bits of a step that is not interrupted do not depend on timing."""
+        dt = _real(dt, "dt")
+        nsteps = _integer(nsteps, "nsteps", "int64")
+        started = time.perf_counter()
+        every = self._observation_interval(nsteps)
+        if every:
+            self._step_observing_sigint(dt, nsteps, every)
+        else:
+            self._call("lpi_step", dt, nsteps)
+        if nsteps > 0:
+            self._seconds_per_step = (time.perf_counter() - started) / nsteps
+
+    def _observation_interval(self, nsteps):
+        """Steps between looks for a SIGINT during step(), or 0 for none: the
+        call is short, the library has no observer, this is not the main
+        thread (only it runs signal handlers) or SIGINT has no Python handler."""
+        if not _HAVE_OBSERVER or nsteps < 2 or threading.current_thread() is not threading.main_thread():
+            return 0
+        if not callable(signal.getsignal(signal.SIGINT)):
+            return 0
+        seconds = self._seconds_per_step
+        if seconds is None:
+            # Not measured yet: 1e-7 s per flow and state entry, more than any
+            # system takes (an overestimate only makes the looks more frequent).
+            flows = c_size_t(1)
+            if lib.lpi_flows_per_step(self._h(), byref(flows)) != 0:
+                flows.value = 1
+            seconds = 1e-7 * max(flows.value, 1) * max(self.dim, 1)
+        if seconds * nsteps < _OBSERVE_SECONDS:
+            return 0
+        return max(1, min(nsteps, int(_OBSERVE_SECONDS / max(seconds, 1e-12))))
+
+    def _step_observing_sigint(self, dt, nsteps, every):
+        # SIGINT only sets a flag during the call; the observer runs the
+        # handler that was in place, and stops the step if that raised.
+        received, raised = [], []
+        previous = signal.getsignal(signal.SIGINT)
+
+        def run_previous_handler():
+            del received[:]
+            previous(signal.SIGINT, None)
+
+        def observe(sys, step, t, user):
+            if not received:
+                return 0
+            try:
+                run_previous_handler()
+            except BaseException as e:  # noqa: B902 - must not cross into C
+                raised.append(e)
+                return 1
+            return 0
+
+        observer = _lib.OBSERVER_FN(observe)
+        signal.signal(signal.SIGINT, lambda signum, frame: received.append(signum))
+        try:
+            self._call("lpi_set_observer", every, observer, None)
+            try:
+                self._call("lpi_step", dt, nsteps)
+            finally:
+                lib.lpi_set_observer(self._handle, 0, _lib.OBSERVER_FN(), None)  # NULL: removed
+        finally:
+            signal.signal(signal.SIGINT, previous)
+        if raised:
+            raise raised[0]
+        if received:  # arrived after the last observation
+            run_previous_handler()
 
     def energy(self):
         out = c_double()
@@ -345,7 +541,7 @@ class System:
     # checkpoints
     def save(self, path):
         """Writes a checkpoint to path atomically (lpi_save)."""
-        self._call("lpi_save", os.fsencode(path))
+        self._call("lpi_save", _c_path(path))
 
     def save_bytes(self):
         """The checkpoint as bytes (lpi_save_buffer)."""
@@ -372,6 +568,7 @@ class System:
         self._handle = handle
         self._keep, self._pending = [], []
         self._method, self._split, self._threads = method, None, 1
+        self._seconds_per_step = None
         self._finalizer = weakref.finalize(self, _destroy, handle, self._keep)
         return self
 
@@ -386,12 +583,12 @@ class RigidBody(System):
     Splits "casimir-shift" (default) and "axes"."""
 
     def __init__(self, I1, I2, I3):
-        super().__init__("lpi_rigid_body_create", float(I1), float(I2), float(I3))
+        super().__init__("lpi_rigid_body_create", _real(I1, "I1"), _real(I2, "I2"), _real(I3, "I3"))
 
     def exact(self, t):
         """The exact solution at time self.time + t from the current state (unchanged)."""
         ptr, result = _doubles_out(3)
-        self._call("lpi_rigid_body_exact", float(t), ptr)
+        self._call("lpi_rigid_body_exact", _real(t, "t"), ptr)
         return result()
 
 
@@ -420,11 +617,11 @@ class Generic(System):
         rows = [tuple(b) for b in brackets]
         if any(len(r) != 4 for r in rows):
             raise ValueError("each bracket is (i, j, k, c)")
-        i, nnz = _int32s([r[0] for r in rows], "i")
-        j, _ = _int32s([r[1] for r in rows], "j")
-        k, _ = _int32s([r[2] for r in rows], "k")
-        c = (c_double * max(nnz, 1))(*[float(r[3]) for r in rows])
-        super().__init__("lpi_generic_create", int(dim), nnz, i, j, k, c)
+        i, nnz = _int32s([r[0] for r in rows], "bracket index i")
+        j, _ = _int32s([r[1] for r in rows], "bracket index j")
+        k, _ = _int32s([r[2] for r in rows], "bracket index k")
+        c = (c_double * max(nnz, 1))(*[_real(r[3], "bracket coefficient") for r in rows])
+        super().__init__("lpi_generic_create", _integer(dim, "dim", "size"), nnz, i, j, k, c)
 
     def _guard(self, body):
         """Wraps a callback body: any exception is kept for the caller and
@@ -444,7 +641,7 @@ class Generic(System):
     def add_piece(self, indices, gradient, energy):
         """Appends the piece H(x_sigma), sigma = indices (abelian). gradient(x_sigma)
         returns the n partial derivatives, energy(x_sigma) the value."""
-        idx, n = _int32s(indices, "indices")
+        idx, n = _int32s(indices, "piece index")
 
         def grad_body(m, x, out, user):
             g = gradient(_callback_view(x, m))
@@ -474,7 +671,7 @@ class Generic(System):
         """Numerical rank of the Poisson matrix at x (default: the current state)."""
         if x is None:
             x = self.get_state()
-        ptr, n, _keep = _doubles_in(x)
+        ptr, n, _keep = _doubles_in(x, "x")
         out = c_size_t()
         self._call("lpi_poisson_rank", ptr, n, byref(out))
         return out.value
@@ -508,7 +705,7 @@ class SineEuler(System):
     library (UnsupportedError otherwise)."""
 
     def __init__(self, N):
-        super().__init__("lpi_sine_euler_create", int(N))
+        super().__init__("lpi_sine_euler_create", _integer(N, "N", "int32"))
 
     @property
     def N(self):
@@ -533,12 +730,14 @@ class SineEuler(System):
         if np is not None:
             a = modes
             if not (isinstance(a, np.ndarray) and a.dtype == np.complex128 and a.flags.c_contiguous):
-                a = np.ascontiguousarray(modes, dtype=np.complex128)
+                a = np.ascontiguousarray(_real_array(modes, "modes", "iufc"), dtype=np.complex128)
             self._call("lpi_sine_euler_set_modes", a.ctypes.data_as(_lib.c_double_p), 2 * a.size)
             return
         flat = []
         for row in modes:
             for z in row:
+                if isinstance(z, (bool, str, bytes)) or not isinstance(z, numbers.Number):
+                    raise TypeError("modes must be complex numbers, not %s" % type(z).__name__)
                 z = complex(z)
                 flat.extend((z.real, z.imag))
         buf = (c_double * max(len(flat), 1))(*flat)
@@ -559,9 +758,9 @@ class SineEuler(System):
     def set_grid(self, w):
         """Sets the vorticity from its N x N grid values; time reset to 0."""
         if np is not None:
-            ptr, n, _keep = _doubles_in(np.asarray(w, dtype=np.float64).reshape(-1))
+            ptr, n, _keep = _doubles_in(_real_array(w, "grid").astype(np.float64).reshape(-1), "grid")
         else:
-            ptr, n, _keep = _doubles_in([v for row in w for v in row])
+            ptr, n, _keep = _doubles_in([v for row in w for v in row], "grid")
         self._call("lpi_sine_euler_set_grid", ptr, n)
 
     grid = property(get_grid, set_grid)
@@ -573,16 +772,17 @@ class SineEuler(System):
 
     def casimir_traces(self, kmax):
         """[(1/N) tr W^k for k = 1 .. kmax]."""
-        ptr, result = _doubles_out(max(int(kmax), 0))
+        kmax = _integer(kmax, "kmax", "int32")
+        ptr, result = _doubles_out(max(kmax, 0))
         if kmax < 1:  # let the library name the error
             ptr = (c_double * 1)()
-        self._call("lpi_sine_euler_casimir_traces", int(kmax), ptr)
+        self._call("lpi_sine_euler_casimir_traces", kmax, ptr)
         return result()
 
     def fft_floor(self, nsteps):
         """(seconds per step, transforms per step) of FFTW alone for nsteps steps."""
         sec, count = c_double(), c_double()
-        self._call("lpi_sine_euler_fft_floor", int(nsteps), byref(sec), byref(count))
+        self._call("lpi_sine_euler_fft_floor", _integer(nsteps, "nsteps", "int64"), byref(sec), byref(count))
         return sec.value, count.value
 
 
@@ -593,13 +793,13 @@ def load(path):
     saved trajectory bit for bit. The method's name is not stored in the object
     (its .method is None) but the library uses the saved one."""
     handle = ctypes.c_void_p()
-    _check_free(lib.lpi_load(byref(handle), os.fsencode(path)))
+    _check_free(lib.lpi_load(byref(handle), _c_path(path)))
     return System._adopt(handle)
 
 
 def load_bytes(data):
     """A system restored from checkpoint bytes (lpi_load_buffer)."""
-    data = bytes(data)
+    data = bytes(memoryview(data))  # bytes-like only: bytes(5) would be five zeros
     handle = ctypes.c_void_p()
     _check_free(lib.lpi_load_buffer(byref(handle), data, len(data)))
     return System._adopt(handle)
@@ -608,15 +808,15 @@ def load_bytes(data):
 # ---- FFTW wisdom (process-wide) -----------------------------------------------
 
 def fftw_wisdom_import_file(path):
-    _check_free(lib.lpi_fftw_wisdom_import_file(os.fsencode(path)))
+    _check_free(lib.lpi_fftw_wisdom_import_file(_c_path(path)))
 
 
 def fftw_wisdom_export_file(path):
-    _check_free(lib.lpi_fftw_wisdom_export_file(os.fsencode(path)))
+    _check_free(lib.lpi_fftw_wisdom_export_file(_c_path(path)))
 
 
 def fftw_wisdom_import_string(wisdom):
-    _check_free(lib.lpi_fftw_wisdom_import_string(wisdom.encode()))
+    _check_free(lib.lpi_fftw_wisdom_import_string(_c_string(wisdom, "wisdom")))
 
 
 def fftw_wisdom_export_string():

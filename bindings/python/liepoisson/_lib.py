@@ -24,6 +24,7 @@ GRADIENT_FN = CFUNCTYPE(c_int, c_size_t, c_double_p, c_double_p, c_void_p)
 ENERGY_FN = CFUNCTYPE(c_int, c_size_t, c_double_p, c_double_p, c_void_p)
 CASIMIR_FN = CFUNCTYPE(c_int, c_size_t, c_double_p, c_double_p, c_void_p)
 SCALAR_FN = CFUNCTYPE(c_int, c_double, c_double_p, c_void_p)
+OBSERVER_FN = CFUNCTYPE(c_int, c_handle, c_int64, c_double, c_void_p)
 
 # Every public function of include/liepoisson.h: name -> (restype, argtypes).
 # A function added to the header gets one row here (tests/check_bindings.sh
@@ -43,14 +44,14 @@ PROTOTYPES = {
     "lpi_rigid_body_create": (c_int, [c_handle_p, c_double, c_double, c_double]),
     "lpi_rigid_body_exact": (c_int, [c_handle, c_double, c_double_p]),
     "lpi_pendulum_create": (c_int, [c_handle_p]),
-    "lpi_destroy": (None, [c_handle]),
+    "lpi_destroy": (c_int, [c_handle]),
     "lpi_set_method": (c_int, [c_handle, c_char_p]),
     "lpi_set_split": (c_int, [c_handle, c_char_p]),
     "lpi_dim": (c_size_t, [c_handle]),
     "lpi_set_state": (c_int, [c_handle, c_double_p, c_size_t]),
     "lpi_get_state": (c_int, [c_handle, c_double_p, c_size_t]),
     "lpi_step": (c_int, [c_handle, c_double, c_int64]),
-    "lpi_set_observer": (c_int, [c_handle, c_int64, c_void_p, c_void_p]),
+    "lpi_set_observer": (c_int, [c_handle, c_int64, OBSERVER_FN, c_void_p]),
     "lpi_time": (c_double, [c_handle]),
     "lpi_energy": (c_int, [c_handle, c_double_p]),
     "lpi_casimir_count": (c_size_t, [c_handle]),

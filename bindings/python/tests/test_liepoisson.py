@@ -244,6 +244,30 @@ class TestGeneric(unittest.TestCase):
         g.step(0.1, 10)
         self.assertAlmostEqual(g.time, t0 + 1.0, places=12)
 
+    def test_callback_cannot_close_or_change_its_own_system(self):
+        g = lp.Generic(3, SO3)
+        seen = []
+
+        def grad(x):
+            for intrusion in (g.close, lambda: setattr(g, "method", "rk4"),
+                              lambda: setattr(g, "state", [0.0, 0.0, 1.0])):
+                try:
+                    intrusion()
+                except lp.BusyError as e:
+                    seen.append(e.status)
+            return [x[0]]
+
+        g.add_piece([0], grad, lambda x: 0.5 * x[0] ** 2)
+        g.state = [1.0, 0.5, -0.3]
+        g.step(0.1, 2)
+        self.assertEqual(seen, [lp.LPI_ERR_BUSY] * len(seen))
+        self.assertGreaterEqual(len(seen), 3)
+        self.assertFalse(g.closed)
+        self.assertEqual(g.method, "leapfrog")
+        self.assertAlmostEqual(g.time, 0.2, places=14)
+        g.close()
+        self.assertTrue(g.closed)
+
     def test_bad_callback_results(self):
         g = lp.Generic(3, SO3)
         g.add_piece([0], lambda x: [1.0, 2.0], lambda x: 0.0)  # wrong length

@@ -1,0 +1,293 @@
+"""Every argument is checked before ctypes converts it (ctypes wraps integers
+silently and ends C strings at a NUL), statuses map to exception classes by
+value, and Ctrl-C during a long step is never lost."""
+import os
+import signal
+import tempfile
+import threading
+import time
+import unittest
+
+import liepoisson as lp
+
+np = lp.np
+SO3 = [(0, 1, 2, -1.0), (0, 2, 1, 1.0), (1, 2, 0, -1.0)]
+
+
+def as_list(a):
+    return [float(v) for v in (a.tolist() if np is not None and isinstance(a, np.ndarray) else a)]
+
+
+def rigid_body():
+    b = lp.RigidBody(1.0, 2.0, 3.0)
+    b.state = [1.0, 0.5, -0.3]
+    return b
+
+
+def sine_euler_or_skip(test, N=5):
+    try:
+        return lp.SineEuler(N)
+    except lp.UnsupportedError:
+        test.skipTest("built without FFTW")
+
+
+class TestIntegerRanges(unittest.TestCase):
+    def assert_unchanged(self, system, state, t):
+        self.assertEqual(as_list(system.state), state)
+        self.assertEqual(system.time, t)
+
+    def test_step_counts(self):
+        with rigid_body() as b:
+            b.step(0.01, 3)
+            state, t = as_list(b.state), b.time
+            for n in (2 ** 64 + 5, 2 ** 63, -2 ** 63 - 1, 10 ** 30):
+                with self.assertRaises(OverflowError):
+                    b.step(0.01, n)
+                self.assert_unchanged(b, state, t)
+            for n in (2.9, 5.0, "5", True, None):
+                with self.assertRaises(TypeError):
+                    b.step(0.01, n)
+                self.assert_unchanged(b, state, t)
+            with self.assertRaises(lp.InvalidArgumentError):  # in range, refused by the library
+                b.step(0.01, -3)
+            self.assert_unchanged(b, state, t)
+
+    def test_step_sizes(self):
+        with rigid_body() as b:
+            state = as_list(b.state)
+            for dt in (float("nan"), float("inf"), -float("inf")):
+                with self.assertRaises(lp.LiePoissonError):
+                    b.step(dt, 2)
+                self.assert_unchanged(b, state, 0.0)
+            for dt in ("0.01", b"0.01", None, 1j):
+                with self.assertRaises(TypeError):
+                    b.step(dt, 2)
+            with self.assertRaises(OverflowError):
+                b.step(10 ** 400, 1)  # an int too large for a double
+            self.assert_unchanged(b, state, 0.0)
+
+    def test_numpy_integers_are_integers(self):
+        if np is None:
+            self.skipTest("numpy not available")
+        with rigid_body() as a, rigid_body() as b:
+            a.step(0.01, np.int64(7))
+            b.step(0.01, 7)
+            self.assertEqual(as_list(a.state), as_list(b.state))
+            with self.assertRaises(TypeError):
+                a.step(0.01, np.float64(7.0))
+
+    def test_sizes_of_systems(self):
+        for N in (2 ** 32 + 5, 2 ** 31, -2 ** 31 - 1):
+            with self.assertRaises(OverflowError):
+                lp.SineEuler(N)
+        with self.assertRaises(TypeError):
+            lp.SineEuler(5.0)
+        for dim in (2 ** 64 + 3, -1):
+            with self.assertRaises(OverflowError):
+                lp.Generic(dim, SO3)
+        for bad in ((2 ** 32, 1, 2, -1.0), (0, -2 ** 31 - 1, 2, 1.0), (0, 1, 2 ** 31, 1.0)):
+            with self.assertRaises(OverflowError):
+                lp.Generic(3, [bad])
+        with self.assertRaises(TypeError):
+            lp.Generic(3, [(0, 1, 2, "1.0")])
+
+    def test_threads_and_implicit_options(self):
+        with rigid_body() as b:
+            for n in (2 ** 32 + 1, 2 ** 31, -2 ** 31 - 1):
+                with self.assertRaises(OverflowError):
+                    b.threads = n
+                self.assertEqual(b.threads, 1)
+            with self.assertRaises(TypeError):
+                b.threads = 1.5
+            with self.assertRaises(OverflowError):
+                b.set_implicit_options(1e-13, 2 ** 32 + 100)
+            with self.assertRaises(TypeError):
+                b.set_implicit_options("1e-13", 100)
+
+    def test_piece_indices(self):
+        g = lp.Generic(3, SO3)
+        for idx in ([2 ** 32], [0, 2 ** 31], [-2 ** 31 - 1]):
+            with self.assertRaises(OverflowError):
+                g.add_piece(idx, lambda x: [0.0] * len(x), lambda x: 0.0)
+        with self.assertRaises(TypeError):
+            g.add_piece([0.0], lambda x: [0.0], lambda x: 0.0)
+        g.add_piece([0], lambda x: [x[0]], lambda x: 0.5 * x[0] ** 2)  # the handle still works
+        g.state = [1.0, 0.5, -0.3]
+        g.step(0.01, 2)
+        g.close()
+
+    def test_sine_euler_counts(self):
+        with self.assertRaises(OverflowError):
+            lp.SineEuler(2 ** 32 + 5)
+        s = sine_euler_or_skip(self)
+        with s:
+            with self.assertRaises(OverflowError):
+                s.casimir_traces(2 ** 32 + 2)
+            with self.assertRaises(OverflowError):
+                s.fft_floor(2 ** 64 + 1)
+            with self.assertRaises(TypeError):
+                s.fft_floor(1.5)
+            self.assertEqual(len(s.casimir_traces(2)), 2)
+
+    def test_status_functions(self):
+        with self.assertRaises(OverflowError):
+            lp.status_name(2 ** 40 - 3)  # ctypes would have asked for -3
+        with self.assertRaises(OverflowError):
+            lp.status_message(2 ** 32 - 3)
+        self.assertEqual(lp.status_name(-3), "LPI_ERR_SIZE")
+
+
+class TestArraysAndStrings(unittest.TestCase):
+    def test_states_must_be_real_vectors(self):
+        with rigid_body() as b:
+            state = as_list(b.state)
+            for bad in (["1", "2", "3"], [1.0, None, 2.0], [1j, 0.0, 0.0]):
+                with self.assertRaises(TypeError):
+                    b.state = bad
+                self.assertEqual(as_list(b.state), state)
+
+    def test_numpy_arrays_of_other_kinds(self):
+        if np is None:
+            self.skipTest("numpy not available")
+        with rigid_body() as b:
+            b.state = np.array([1.0, 0.5, -0.25], dtype=np.float32)  # exact in float32
+            self.assertEqual(as_list(b.state), [1.0, 0.5, -0.25])
+            b.state = np.arange(9.0)[::3]  # non-contiguous: copied
+            self.assertEqual(as_list(b.state), [0.0, 3.0, 6.0])
+            with self.assertRaises(TypeError):
+                b.state = np.array([1.0, 0.5, -0.3], dtype=np.complex128)  # would drop the imaginary parts
+            with self.assertRaises(TypeError):
+                b.state = np.array(["1", "2", "3"])
+            with self.assertRaises(TypeError):
+                b.state = np.array([True, False, True])
+            with self.assertRaises(ValueError):
+                b.state = np.ones((3, 1))
+            self.assertEqual(as_list(b.state), [0.0, 3.0, 6.0])
+        s = sine_euler_or_skip(self)
+        with s:
+            with self.assertRaises(TypeError):
+                s.modes = np.full((5, 5), "x")
+            grid = s.grid
+            s.grid = np.asfortranarray(grid)  # another memory order, same values
+            self.assertEqual(s.grid.tolist(), grid.tolist())
+
+    def test_strings_are_whole(self):
+        with rigid_body() as b, tempfile.TemporaryDirectory() as d:
+            with self.assertRaises(ValueError):
+                b.method = "leapfrog\0yoshida-6"  # C would read "leapfrog"
+            with self.assertRaises(TypeError):
+                b.method = b"leapfrog"
+            self.assertEqual(b.method, "leapfrog")
+            with self.assertRaises(ValueError):
+                b.save(os.path.join(d, "a.lpi\0b"))
+            self.assertEqual(os.listdir(d), [])
+            with self.assertRaises(ValueError):
+                lp.load(os.path.join(d, "a.lpi\0b"))
+        with self.assertRaises(TypeError):
+            lp.load_bytes(5)  # bytes(5) would be five zero bytes
+        with self.assertRaises(TypeError):
+            lp.fftw_wisdom_import_string(b"(fftw-3.3.10 fftw_wisdom)")
+        with self.assertRaises(ValueError):
+            lp.fftw_wisdom_import_string("(fftw\0")
+
+
+class TestStatuses(unittest.TestCase):
+    def test_newer_statuses_map_by_value(self):
+        self.assertEqual(lp.BusyError.status, -13)
+        self.assertTrue(issubclass(lp.BusyError, lp.LiePoissonError))
+        self.assertEqual(lp.OverflowStatusError.status, -14)
+        self.assertTrue(issubclass(lp.OverflowStatusError, OverflowError))
+        self.assertTrue(issubclass(lp.OverflowStatusError, lp.LiePoissonError))
+        self.assertEqual(lp.status_name(-13), "LPI_ERR_BUSY")
+        self.assertEqual(lp.status_name(-14), "LPI_ERR_OVERFLOW")
+        self.assertEqual(lp.LPI_STOPPED, 1)
+        self.assertEqual(lp.STATUS["LPI_STOPPED"], 1)
+        self.assertFalse(any(cls.status > 0 for cls in lp._by_status.values()))  # STOPPED is no error
+        self.assertTrue(issubclass(lp.FileError, OSError))
+        self.assertTrue(issubclass(lp.FormatError, ValueError))
+        for status, cls in ((-13, lp.BusyError), (-14, lp.OverflowStatusError), (-11, lp.FileError)):
+            with self.assertRaises(cls) as cm:
+                lp._raise(status, "detail")
+            self.assertEqual(cm.exception.status, status)
+            self.assertEqual(cm.exception.message, "detail")
+
+    def test_unknown_statuses_still_raise(self):
+        with self.assertRaises(lp.LiePoissonError) as cm:
+            lp._raise(-63, "from a newer library")
+        self.assertIs(type(cm.exception), lp.LiePoissonError)
+        self.assertEqual(cm.exception.status_name, "LPI_UNKNOWN_STATUS")
+
+    def test_file_and_format_errors(self):
+        with self.assertRaises(lp.FileError):
+            lp.load("/nonexistent/dir/run.lpi")
+        with self.assertRaises(lp.FormatError):
+            lp.load_bytes(b"not a checkpoint")
+
+
+def steps_for(seconds):
+    """A step count that takes about `seconds` for rigid_body() here (only
+    sizes the run; nothing is asserted about time)."""
+    with rigid_body() as b:
+        n, elapsed = 1000, 0.0
+        while elapsed < 0.05:
+            n *= 4
+            start = time.perf_counter()
+            b.step(1e-3, n)
+            elapsed = time.perf_counter() - start
+        return int(n * seconds / elapsed)
+
+
+@unittest.skipIf(threading.current_thread() is not threading.main_thread(), "signals need the main thread")
+class TestInterrupt(unittest.TestCase):
+    def interrupt_soon(self):
+        timer = threading.Timer(0.1, os.kill, (os.getpid(), signal.SIGINT))
+        timer.start()
+        self.addCleanup(timer.join)
+
+    def test_sigint_during_a_long_step_is_not_lost(self):
+        n = steps_for(1.0)
+        with rigid_body() as b:
+            self.interrupt_soon()
+            with self.assertRaises(KeyboardInterrupt):
+                b.step(1e-3, n)
+            done = round(b.time / 1e-3)
+            self.assertEqual(b.time, 1e-3 * done)
+            if lp._HAVE_OBSERVER:
+                # Stopped early, holding exactly the state of a call of `done` steps.
+                self.assertLess(done, n)
+                with rigid_body() as ref:
+                    ref.step(1e-3, done)
+                    self.assertEqual(as_list(b.state), as_list(ref.state))
+            else:
+                self.assertEqual(done, n)  # the handler ran when the call returned
+            b.step(1e-3, 10)  # and the handle goes on
+
+    def test_observing_keeps_the_bits(self):
+        if not lp._HAVE_OBSERVER:
+            self.skipTest("the library has no lpi_set_observer: Ctrl-C waits for the whole call")
+        saved = lp._OBSERVE_SECONDS
+        lp._OBSERVE_SECONDS = 1e-9  # observe nearly every step
+        self.addCleanup(setattr, lp, "_OBSERVE_SECONDS", saved)
+        with rigid_body() as a, rigid_body() as b:
+            a.method = b.method = "yoshida-6"
+            a.step(0.01, 1001)  # observed
+            self.assertEqual(lp.lib.lpi_step(b._h(), 0.01, 1001), 0)  # one plain call
+            self.assertEqual(as_list(a.state), as_list(b.state))
+            self.assertEqual(a.time, b.time)
+
+    def test_a_handler_that_does_not_raise_lets_the_step_finish(self):
+        if not lp._HAVE_OBSERVER:
+            self.skipTest("the library has no lpi_set_observer")
+        calls = []
+        previous = signal.signal(signal.SIGINT, lambda signum, frame: calls.append(signum))
+        self.addCleanup(signal.signal, signal.SIGINT, previous)
+        n = steps_for(0.5)
+        with rigid_body() as b:
+            self.interrupt_soon()
+            b.step(1e-3, n)
+            self.assertEqual(round(b.time / 1e-3), n)
+        self.assertEqual(calls, [signal.SIGINT])
+
+
+if __name__ == "__main__":
+    unittest.main()
