@@ -17,11 +17,12 @@ namespace {
 
 void print_usage(FILE *to) {
     std::fprintf(to,
-                 "usage: lpi report [SCENE...] [--out DIR] [--N N]\n"
+                 "usage: lpi report [SCENE...] [--out DIR] [--N N] [--T T]\n"
                  "           error against CPU time for every applicable method over a sweep of\n"
                  "           step sizes; prints a table and writes CSV and PNG files to DIR\n"
                  "           (default ./lpi-report). Without SCENE: the default scenes.\n"
-                 "           --N sets the sine-Euler scene's N (odd, default 31).\n"
+                 "           --N sets the sine-Euler scenes' N (odd, default 31); --T the\n"
+                 "           sine-euler-long scene's final time (default 2000).\n"
                  "       lpi run SCENE [options]   integrate one scene; lpi run --help for the options\n"
                  "       lpi stress [--quick] [FILTER]\n"
                  "           stiff and extreme cases against every applicable method: bounded,\n"
@@ -42,6 +43,8 @@ int report_command(int argc, char **argv) {
             options.out_dir = argv[++a];
         } else if (std::strcmp(argv[a], "--N") == 0 && a + 1 < argc) {
             scene_options.sine_euler_n = std::atoi(argv[++a]);
+        } else if (std::strcmp(argv[a], "--T") == 0 && a + 1 < argc) {
+            scene_options.long_run_time = std::strtod(argv[++a], nullptr);
         } else if (std::strcmp(argv[a], "--help") == 0) {
             print_usage(stdout);
             return 0;
