@@ -516,7 +516,7 @@ void run_long_scene(const LongRunScene &scene, const std::string &out_dir) {
     std::printf("\n== %s: %s, %s\n", scene.name.c_str(), scene.description.c_str(), scene.setting.c_str());
     std::printf("   energy error and drift of the spectrum of W (all Casimirs; largest eigenvalue change\n"
                 "   over the largest |eigenvalue|), sampled at the same %d times in every run; CPU time\n"
-                "   of the steps alone. %s\n",
+                "   of the steps alone.\n   %s\n",
                 samples, scene.exclusion_reason.c_str());
     std::printf("%-14s %8s %9s %10s %11s %11s %11s  %s\n", "method", "dt", "steps", "cpu [s]",
                 "max|dH/H|", "max|dC|/|C|", "at T", "status");
