@@ -10,9 +10,20 @@
 #include <string>
 #include <vector>
 
+// OpenBLAS's own call, when OpenBLAS is the BLAS the library loaded (weak:
+// null otherwise, and no link dependency).
+extern "C" void openblas_set_num_threads(int) __attribute__((weak));
+
 namespace lpi_cli {
 
 namespace {
+
+// The report measures one core. OpenBLAS would otherwise spread the Casimir
+// spectra (LAPACK) over helper threads that then busy-wait for about a tenth
+// of a second, on the process's CPU clock, inside the next timed steps.
+void measure_on_one_core() {
+    if (openblas_set_num_threads) openblas_set_num_threads(1);
+}
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -226,6 +237,7 @@ bool plot(const std::string &dir, const Scene &scene, const std::vector<std::str
 }  // namespace
 
 void run_report(const Scene &scene, const ReportOptions &options) {
+    measure_on_one_core();
     mkdir(options.out_dir.c_str(), 0777);
     const std::string why_not = scene.unavailable();
     if (!why_not.empty()) {
@@ -504,6 +516,7 @@ bool plot_long(const std::string &base, const LongRunScene &scene, const std::ve
 }  // namespace
 
 void run_long_scene(const LongRunScene &scene, const std::string &out_dir) {
+    measure_on_one_core();
     if (!(scene.final_time > 0.0) || !std::isfinite(scene.final_time)) {
         std::fprintf(stderr, "lpi report: %s needs --T > 0\n", scene.name.c_str());
         std::exit(2);
@@ -551,9 +564,10 @@ void run_long_scene(const LongRunScene &scene, const std::string &out_dir) {
         double LongRow::*measure;
         double limit;
     };
-    const Bound bounds[] = {{"max|dH/H| < 1e-3", &LongRow::energy_error, 1e-3},
+    const Bound bounds[] = {{"max|dH/H| < 1e-2", &LongRow::energy_error, 1e-2},
+                            {"max|dH/H| < 1e-3", &LongRow::energy_error, 1e-3},
+                            {"max|dH/H| < 1e-4", &LongRow::energy_error, 1e-4},
                             {"max|dH/H| < 1e-5", &LongRow::energy_error, 1e-5},
-                            {"max|dH/H| < 1e-7", &LongRow::energy_error, 1e-7},
                             {"max|dC|/|C| < 1e-9", &LongRow::casimir_drift, 1e-9}};
     std::printf("\n   CPU seconds of each method's cheapest run that stays within the bound to T = %g\n"
                 "   (- = none of its runs does):\n   %-14s", scene.final_time, "method");
