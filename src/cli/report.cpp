@@ -302,8 +302,13 @@ void run_report(const Scene &scene, const ReportOptions &options) {
         // A composition of s leapfrog stages sweeps steps s times larger, so
         // every method spans about the same range of cost.
         const double stretch = std::max(1, lpi_method_stages(i));
+        int64_t previous_steps = 0;
         for (double base_dt : scene.steps) {
             const double dt = std::min(base_dt * stretch, scene.final_time);
+            // Stretched steps near T round to the same step count: measure it once.
+            const int64_t steps = std::max<int64_t>(1, std::llround(scene.final_time / dt));
+            if (steps == previous_steps) continue;
+            previous_steps = steps;
             std::vector<Sample> *history = base_dt == history_dt ? &histories[method] : nullptr;
             const Row r = measure(scene, method, lpi_method_order(i), dt, reference, options, history);
             rows.push_back(r);
