@@ -10,7 +10,7 @@ scenes=$(sed -n '/^scenes:/,$p' "$out/help" | sed -n 's/^  \([a-z0-9-]*\) .*/\1/
 [ -n "$scenes" ] || { echo "lpi --help lists no scene"; exit 1; }
 for scene in $scenes; do
     if grep -q "^  $scene .*(lpi report only)" "$out/help"; then
-        set -- report "$scene" --N 5 --out "$out/$scene"
+        set -- report "$scene" --N 5 --T 5 --out "$out/$scene"
     else
         set -- run "$scene" --steps 3 --N 5 --out "$out/$scene"
     fi

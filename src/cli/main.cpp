@@ -21,13 +21,13 @@ void print_scenes(FILE *to) {
         std::string notes;
         if (!s.create) notes += " (lpi report only)";
         if (!s.in_default_report) notes += " (not in the default report)";
-        std::fprintf(to, "  %-14s %s%s\n", s.name.c_str(), s.description.c_str(), notes.c_str());
+        std::fprintf(to, "  %-16s %s%s\n", s.name.c_str(), s.description.c_str(), notes.c_str());
     }
 }
 
 void print_usage(FILE *to) {
     std::fprintf(to,
-                 "usage: lpi report [SCENE...] [--out DIR] [--N N]\n"
+                 "usage: lpi report [SCENE...] [--out DIR] [--N N] [--T T]\n"
                  "           error against CPU time for every applicable method over a sweep of\n"
                  "           step sizes; lpi report --help for more\n"
                  "       lpi run SCENE [options]   integrate one scene; lpi run --help for the options\n"
@@ -42,14 +42,15 @@ void print_usage(FILE *to) {
 
 void print_report_usage(FILE *to) {
     std::fprintf(to,
-                 "usage: lpi report [SCENE...] [--out DIR] [--N N]\n"
+                 "usage: lpi report [SCENE...] [--out DIR] [--N N] [--T T]\n"
                  "  For each SCENE (without one: the default scenes), every applicable method\n"
                  "  over a sweep of step sizes: a work-precision table (error at the final\n"
                  "  time, energy error and Casimir drift against CPU time, one core, measured\n"
                  "  in this run), then the CPU time each method needs for a given error.\n"
                  "  --out DIR   write DIR/SCENE.csv, DIR/SCENE_energy.csv and, with gnuplot,\n"
                  "              the PNG plots there (default ./lpi-report)\n"
-                 "  --N N       the sine-Euler scene's N (odd >= 3, default 31)\n");
+                 "  --N N       the sine-Euler scenes' N (odd >= 3, default 31)\n"
+                 "  --T T       the sine-euler-long scene's final time (default 2000)\n");
     print_scenes(to);
 }
 
@@ -65,6 +66,8 @@ int report_command(int argc, char **argv) {
         } else if (arg == "--N") {
             scene_options.sine_euler_n = static_cast<int>(args.integer(arg, 3, 2147483647));
             if (scene_options.sine_euler_n % 2 == 0) args.fail("--N must be odd");
+        } else if (arg == "--T") {
+            scene_options.long_run_time = args.positive(arg);
         } else if (arg == "--help" || arg == "-h") {
             print_report_usage(stdout);
             return 0;

@@ -10,9 +10,20 @@
 #include <string>
 #include <vector>
 
+// OpenBLAS's own call, when OpenBLAS is the BLAS the library loaded (weak:
+// null otherwise, and no link dependency).
+extern "C" void openblas_set_num_threads(int) __attribute__((weak));
+
 namespace lpi_cli {
 
 namespace {
+
+// The report measures one core. OpenBLAS would otherwise spread the Casimir
+// spectra (LAPACK) over helper threads that then busy-wait for about a tenth
+// of a second, on the process's CPU clock, inside the next timed steps.
+void measure_on_one_core() {
+    if (openblas_set_num_threads) openblas_set_num_threads(1);
+}
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -51,6 +62,35 @@ std::vector<double> reference_state(const Scene &scene) {
     return state_of(h.get());
 }
 
+// Drift of a sine-Euler spectrum: the largest change of an eigenvalue of W
+// relative to the largest |eigenvalue|. Relative to each eigenvalue itself,
+// an eigenvalue near zero would turn round-off into an arbitrarily large
+// "drift"; this measure is bounded by |dW| / |W| (Weyl), so it reads the same
+// for every field.
+double spectrum_drift(const std::vector<double> &spectrum, const std::vector<double> &spectrum0) {
+    double scale = 0.0, change = 0.0;
+    for (std::size_t i = 0; i < spectrum0.size(); ++i) {
+        scale = std::max(scale, std::fabs(spectrum0[i]));
+        change = std::max(change, std::fabs(spectrum[i] - spectrum0[i]));
+    }
+    return scale > 0.0 ? change / scale : change;
+}
+
+// Casimir drift: separate Casimirs (|m|^2; the moments' I and K) each
+// relative to itself, a spectrum as above.
+double casimir_drift(bool spectrum, const std::vector<double> &c, const std::vector<double> &c0) {
+    if (spectrum) return spectrum_drift(c, c0);
+    double drift = 0.0;
+    for (std::size_t i = 0; i < c.size(); ++i)
+        drift = std::max(drift, std::fabs(c[i] - c0[i]) / std::max(std::fabs(c0[i]), 1e-300));
+    return drift;
+}
+
+bool is_sine_euler(const lpi_system *sys) {
+    int32_t N = 0;
+    return lpi_sine_euler_size(sys, &N) == LPI_OK;
+}
+
 // One (method, dt) cell: a timed pass (one lpi_step call, repeated until the
 // clock resolves it), then a diagnostic pass sampling energy and Casimirs.
 Row measure(const Scene &scene, const char *method, int order, double dt,
@@ -86,6 +126,7 @@ Row measure(const Scene &scene, const char *method, int order, double dt,
     check(lpi_set_method(h.get(), method), h.get(), "set method");
     const double h0 = energy_of(h.get());
     const std::vector<double> c0 = casimirs_of(h.get());
+    const bool spectrum = is_sine_euler(h.get());
     const int64_t samples = std::min<int64_t>(row.steps, options.samples);
     int64_t done = 0;
     for (int64_t k = 1; k <= samples; ++k) {
@@ -93,10 +134,7 @@ Row measure(const Scene &scene, const char *method, int order, double dt,
         if (lpi_step(h.get(), row.dt, target - done) != LPI_OK) break;
         done = target;
         const double de = std::fabs((energy_of(h.get()) - h0) / h0);
-        const std::vector<double> c = casimirs_of(h.get());
-        double dc = 0.0;
-        for (std::size_t i = 0; i < c.size(); ++i)
-            dc = std::max(dc, std::fabs(c[i] - c0[i]) / std::max(std::fabs(c0[i]), 1e-300));
+        const double dc = casimir_drift(spectrum, casimirs_of(h.get()), c0);
         row.energy_error = std::max(row.energy_error, de);
         row.casimir_drift = std::max(row.casimir_drift, dc);
         if (history) history->push_back({lpi_time(h.get()), de, dc});
@@ -152,48 +190,71 @@ void write_history(const std::string &path, const std::map<std::string, std::vec
     std::fclose(f);
 }
 
-bool is_poisson(const std::string &method) {
+// Index of a registered method, -1 if none has that name.
+int method_index(const std::string &method) {
     for (int i = 0; i < lpi_method_count(); ++i)
-        if (method == lpi_method_name(i)) return lpi_method_is_poisson(i) == 1;
-    return false;
+        if (method == lpi_method_name(i)) return i;
+    return -1;
 }
 
+bool is_poisson(const std::string &method) { return lpi_method_is_poisson(method_index(method)) == 1; }
+
 bool have_gnuplot() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
+
+// The i-th method's colour in a plot: ten that read apart on white (no yellow).
+std::string plot_colour(std::size_t i) {
+    static const char *const colours[] = {"#0072b2", "#d55e00", "#009e73", "#cc79a7", "#56b4e9",
+                                          "#e69f00", "#000000", "#8c564b", "#7f7f7f", "#bcbd22"};
+    return std::string("rgb '") + colours[i % 10] + "'";
+}
+
+// The i-th method of a plot: its own colour and point shape (filled shapes
+// first); the baselines (not Poisson maps) dashed, so the two families read
+// apart at a glance.
+std::string plot_style(std::size_t i, const std::string &method) {
+    static const int shapes[] = {7, 5, 9, 11, 13, 6, 4, 8, 10, 12, 1, 2, 3};
+    char text[96];
+    std::snprintf(text, sizeof text, "lc %s pt %d dt %d", plot_colour(i).c_str(), shapes[i % 13],
+                  is_poisson(method) ? 1 : 2);
+    return text;
+}
+
+// Starts a gnuplot script: CSV input, PNG output, log-log axes labelled at
+// the decades, a grid and the key outside.
+FILE *open_plot_script(const std::string &path) {
+    FILE *f = std::fopen(path.c_str(), "w");
+    if (f)
+        std::fprintf(f, "set datafile separator ','\nset terminal pngcairo size 1000,700 enhanced\n"
+                        "set logscale xy\nset grid xtics ytics mxtics mytics lw 0.5, lw 0.2\n"
+                        "set key outside right\nset format y '10^{%%L}'\nset format x '10^{%%L}'\n");
+    return f;
+}
 
 // Draws the work-precision and energy plots with gnuplot from the CSV files.
 bool plot(const std::string &dir, const Scene &scene, const std::vector<std::string> &methods) {
     const std::string script = dir + "/" + scene.name + ".gp";
-    FILE *f = std::fopen(script.c_str(), "w");
+    FILE *f = open_plot_script(script);
     if (!f) return false;
     const std::string base = dir + "/" + scene.name;
     std::fprintf(f,
-                 "set datafile separator ','\nset terminal pngcairo size 1000,700 noenhanced\n"
-                 "set logscale xy\nset grid\nset key outside right\nset format y '%%.0e'\nset format x '%%.0e'\n"
                  "set output '%s_work_precision.png'\n"
                  "set title '%s: error at T = %g against CPU time'\n"
-                 "set xlabel 'CPU seconds'\nset ylabel 'error |x(T) - x_ref(T)|'\nplot ",
+                 "set xlabel 'CPU seconds'\nset ylabel 'error |x(T) - x_{ref}(T)|'\nplot ",
                  base.c_str(), scene.name.c_str(), scene.final_time);
-    // Each method its own colour and point shape; the baselines (not Poisson
-    // maps) dashed, so the two families read apart at a glance.
-    auto style = [&](std::size_t i) {
-        char text[96];
-        std::snprintf(text, sizeof text, "lc %zu pt %zu dt %d", i % 8 + 1, i % 13 + 1,
-                      is_poisson(methods[i]) ? 1 : 2);
-        return std::string(text);
-    };
     for (std::size_t i = 0; i < methods.size(); ++i)
         std::fprintf(f, "%s'%s.csv' using (strcol(2) eq '%s' && strcol(10) eq 'LPI_OK' ? $6 : 1/0):7 "
                         "with linespoints %s title '%s'",
-                     i ? ", " : "", base.c_str(), methods[i].c_str(), style(i).c_str(),
-                     methods[i].c_str());
+                     i ? ", " : "", base.c_str(), methods[i].c_str(),
+                     plot_style(i, methods[i]).c_str(), methods[i].c_str());
     std::fprintf(f,
                  "\nset output '%s_energy.png'\nset title '%s: relative energy error against time'\n"
-                 "unset logscale x\nset xlabel 'time'\nset ylabel '|H(t) - H(0)| / |H(0)|'\nplot ",
+                 "unset logscale x\nset format x '%%g'\nset xlabel 'time'\n"
+                 "set ylabel '|H(t) - H(0)| / |H(0)|'\nplot ",
                  base.c_str(), scene.name.c_str());
     for (std::size_t i = 0; i < methods.size(); ++i)
         std::fprintf(f, "%s'%s_energy.csv' using (strcol(1) eq '%s' ? $3 : 1/0):($4 > 0 ? $4 : 1/0) "
-                        "with lines lc %zu dt %d title '%s'",
-                     i ? ", " : "", base.c_str(), methods[i].c_str(), i % 8 + 1,
+                        "with lines lc %s dt %d title '%s'",
+                     i ? ", " : "", base.c_str(), methods[i].c_str(), plot_colour(i).c_str(),
                      is_poisson(methods[i]) ? 1 : 2, methods[i].c_str());
     std::fprintf(f, "\n");
     std::fclose(f);
@@ -203,6 +264,7 @@ bool plot(const std::string &dir, const Scene &scene, const std::vector<std::str
 }  // namespace
 
 void run_report(const Scene &scene, const ReportOptions &options) {
+    measure_on_one_core();
     mkdir(options.out_dir.c_str(), 0777);
     const std::string why_not = scene.unavailable();
     if (!why_not.empty()) {
@@ -240,8 +302,13 @@ void run_report(const Scene &scene, const ReportOptions &options) {
         // A composition of s leapfrog stages sweeps steps s times larger, so
         // every method spans about the same range of cost.
         const double stretch = std::max(1, lpi_method_stages(i));
+        int64_t previous_steps = 0;
         for (double base_dt : scene.steps) {
             const double dt = std::min(base_dt * stretch, scene.final_time);
+            // Stretched steps near T round to the same step count: measure it once.
+            const int64_t steps = std::max<int64_t>(1, std::llround(scene.final_time / dt));
+            if (steps == previous_steps) continue;
+            previous_steps = steps;
             std::vector<Sample> *history = base_dt == history_dt ? &histories[method] : nullptr;
             const Row r = measure(scene, method, lpi_method_order(i), dt, reference, options, history);
             rows.push_back(r);
@@ -311,6 +378,251 @@ void run_report(const Scene &scene, const ReportOptions &options) {
         std::printf("   gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n");
     else if (plot(options.out_dir, scene, methods))
         std::printf("   wrote %s_work_precision.png and %s_energy.png\n", base.c_str(), base.c_str());
+    else
+        std::printf("   gnuplot failed: see %s.gp\n", base.c_str());
+}
+
+// ---- Long runs: what each method buys over the whole run -------------------
+
+namespace {
+
+struct LongRow {
+    int run = 0;  // row number, keys the history CSV
+    std::string method;
+    double dt = 0.0;
+    int64_t steps = 0;
+    double cpu = 0.0;  // seconds inside lpi_step only: diagnostics are not timed
+    double energy_error = 0.0, casimir_drift = 0.0;  // maxima over the samples
+    double final_casimir_drift = 0.0;
+    double reached = 0.0;  // time reached: the final time unless a step failed
+    int status = LPI_OK;
+    std::vector<Sample> history;
+};
+
+// One run to the final time in `samples` equal chunks of whole steps; after
+// each chunk the energy error and the spectrum drift are sampled. A failed
+// step ends the run: the row keeps the status, the time reached and the
+// maxima up to there.
+LongRow long_run(const LongRunScene &scene, const std::string &method, double dt, int samples) {
+    const double interval = scene.final_time / samples;
+    const int64_t per_sample = std::max<int64_t>(1, std::llround(interval / dt));
+    LongRow row;
+    row.method = method;
+    row.dt = interval / static_cast<double>(per_sample);
+    row.steps = per_sample * samples;
+    Handle h = scene.create();
+    check(lpi_set_method(h.get(), method.c_str()), h.get(), "set method");
+    // Warm up (FFTW plans are made on a system's first step), then start again.
+    const std::vector<double> x0 = state_of(h.get());
+    if (lpi_step(h.get(), row.dt, 1) == LPI_OK)
+        check(lpi_set_state(h.get(), x0.data(), x0.size()), h.get(), "set state");
+    const double h0 = energy_of(h.get());
+    const std::vector<double> spectrum0 = casimirs_of(h.get());
+    for (int k = 1; k <= samples; ++k) {
+        const double t0 = cpu_seconds();
+        row.status = lpi_step(h.get(), row.dt, per_sample);
+        row.cpu += cpu_seconds() - t0;
+        if (row.status != LPI_OK) break;  // reported in the row, not fatal
+        const Sample s{lpi_time(h.get()), std::fabs((energy_of(h.get()) - h0) / h0),
+                       spectrum_drift(casimirs_of(h.get()), spectrum0)};
+        row.energy_error = std::max(row.energy_error, s.energy_error);
+        row.casimir_drift = std::max(row.casimir_drift, s.casimir_drift);
+        row.final_casimir_drift = s.casimir_drift;
+        row.reached = s.time;
+        row.history.push_back(s);
+    }
+    return row;
+}
+
+std::string format_steps(const std::vector<double> &steps) {
+    std::string text;
+    for (double dt : steps) {
+        char item[32];
+        std::snprintf(item, sizeof item, "%s%g", text.empty() ? "" : ", ", dt);
+        text += item;
+    }
+    return text;
+}
+
+void write_long_csv(const std::string &base, const LongRunScene &scene, const std::vector<LongRow> &rows) {
+    FILE *f = std::fopen((base + ".csv").c_str(), "w");
+    FILE *g = std::fopen((base + "_history.csv").c_str(), "w");
+    if (!f || !g) {
+        std::fprintf(stderr, "lpi: cannot write %s.csv and %s_history.csv\n", base.c_str(), base.c_str());
+        if (f) std::fclose(f);
+        if (g) std::fclose(g);
+        return;
+    }
+    std::fprintf(f, "scene,run,method,order,poisson,dt,steps,cpu_seconds,max_energy_error,"
+                    "max_casimir_drift,final_casimir_drift,reached_time,status\n");
+    std::fprintf(g, "run,method,dt,time,energy_error,casimir_drift\n");
+    for (const LongRow &r : rows) {
+        const int i = method_index(r.method);
+        std::fprintf(f, "%s,%d,%s,%d,%d,%.17g,%lld,%.6e,%.6e,%.6e,%.6e,%.10g,%s\n", scene.name.c_str(),
+                     r.run, r.method.c_str(), lpi_method_order(i), lpi_method_is_poisson(i), r.dt,
+                     static_cast<long long>(r.steps), r.cpu, r.energy_error, r.casimir_drift,
+                     r.final_casimir_drift, r.reached, lpi_status_name(r.status));
+        for (const Sample &s : r.history)
+            std::fprintf(g, "%d,%s,%.17g,%.10g,%.6e,%.6e\n", r.run, r.method.c_str(), r.dt, s.time,
+                         s.energy_error, s.casimir_drift);
+    }
+    std::fclose(f);
+    std::fclose(g);
+}
+
+// Max energy error and max Casimir drift against CPU time (one curve per
+// method through its step sizes), and both against time for the run of each
+// method whose CPU time is nearest `history_cpu`.
+bool plot_long(const std::string &base, const LongRunScene &scene, const std::vector<LongRow> &rows,
+               const std::vector<std::string> &methods, double history_cpu) {
+    FILE *f = open_plot_script(base + ".gp");
+    if (!f) return false;
+    const char *energy_label = "|H(t) - H(0)| / |H(0)|";
+    const char *casimir_label = "max_i |{/Symbol l}_i(t) - {/Symbol l}_i(0)| / max_i |{/Symbol l}_i(0)|";
+    struct Panel {
+        const char *file, *title, *label;
+        int column;  // in SCENE.csv
+    };
+    const Panel panels[] = {{"energy", "energy error", energy_label, 9},
+                            {"casimirs", "Casimir drift (spectrum of W)", casimir_label, 10}};
+    std::fprintf(f, "set key below\nset xlabel 'CPU seconds (the steps only)'\n");
+    for (const Panel &p : panels) {
+        std::fprintf(f, "set output '%s_%s.png'\nset title '%s, %s: maximum %s over the run' noenhanced\n"
+                        "set ylabel 'max_{t <= T} %s'\nplot ",
+                     base.c_str(), p.file, scene.name.c_str(), scene.setting.c_str(), p.title, p.label);
+        for (std::size_t i = 0; i < methods.size(); ++i) {
+            std::vector<double> steps;
+            for (const LongRow &r : rows)
+                if (r.method == methods[i] && r.status == LPI_OK) steps.push_back(r.dt);
+            std::fprintf(f, "%s'%s.csv' using (strcol(3) eq '%s' && strcol(13) eq 'LPI_OK' ? $8 : 1/0):"
+                            "($%d > 0 ? $%d : 1/0) with linespoints %s lw 1.5 ps 1.5 title '%s, dt = %s' noenhanced",
+                         i ? ", " : "", base.c_str(), methods[i].c_str(), p.column, p.column,
+                         plot_style(i, methods[i]).c_str(), methods[i].c_str(), format_steps(steps).c_str());
+        }
+        std::fprintf(f, "\n");
+    }
+    // Against time: one panel per measure, the key once, on the right.
+    std::fprintf(f, "set terminal pngcairo size 1000,900 enhanced\nset output '%s_history.png'\n"
+                    "set multiplot layout 2,1 title '%s, %s: each method at its run nearest %.3g CPU seconds' noenhanced\n"
+                    "unset logscale x\nset format x '%%g'\nset xlabel 'time'\n"
+                    "set key default\nset key outside right top vertical\n"
+                    "set lmargin 12\nset rmargin at screen 0.72\n",
+                 base.c_str(), scene.name.c_str(), scene.setting.c_str(), history_cpu);
+    const Panel *history_panels[] = {&panels[0], &panels[1]};
+    for (const Panel *p : history_panels) {
+        std::fprintf(f, "set title '%s' noenhanced\nset ylabel '%s'\nplot ", p->title, p->label);
+        for (std::size_t i = 0; i < methods.size(); ++i) {
+            const LongRow *nearest = nullptr;
+            for (const LongRow &r : rows)
+                if (r.method == methods[i] && r.status == LPI_OK &&
+                    (!nearest || std::fabs(std::log(r.cpu / history_cpu)) <
+                                     std::fabs(std::log(nearest->cpu / history_cpu))))
+                    nearest = &r;
+            if (!nearest) continue;
+            const int column = p == &panels[0] ? 5 : 6;  // in SCENE_history.csv
+            std::fprintf(f, "%s'%s_history.csv' using ($1 == %d ? $4 : 1/0):($%d > 0 ? $%d : 1/0) "
+                            "with lines lc %s dt %d lw 1.5 title '%s, dt = %g' noenhanced",
+                         i ? ", " : "", base.c_str(), nearest->run, column, column, plot_colour(i).c_str(),
+                         is_poisson(methods[i]) ? 1 : 2, methods[i].c_str(), nearest->dt);
+        }
+        std::fprintf(f, "\nunset key\n");
+    }
+    std::fprintf(f, "unset multiplot\n");
+    std::fclose(f);
+    return std::system(("gnuplot '" + base + ".gp' 2>/dev/null").c_str()) == 0;
+}
+
+}  // namespace
+
+void run_long_scene(const LongRunScene &scene, const std::string &out_dir) {
+    measure_on_one_core();
+    if (!(scene.final_time > 0.0) || !std::isfinite(scene.final_time)) {
+        std::fprintf(stderr, "lpi report: %s needs --T > 0\n", scene.name.c_str());
+        std::exit(2);
+    }
+    double largest_step = 0.0;
+    for (const LongRunSweep &sweep : scene.sweeps)
+        for (double dt : sweep.steps) largest_step = std::max(largest_step, dt);
+    const int samples = static_cast<int>(std::clamp(std::floor(scene.final_time / largest_step), 1.0,
+                                                     static_cast<double>(scene.max_samples)));
+    std::printf("\n== %s: %s, %s\n", scene.name.c_str(), scene.description.c_str(), scene.setting.c_str());
+    std::printf("   energy error and drift of the spectrum of W (all Casimirs; largest eigenvalue change\n"
+                "   over the largest |eigenvalue|), sampled at the same %d times in every run; CPU time\n"
+                "   of the steps alone.\n   %s\n",
+                samples, scene.exclusion_reason.c_str());
+    std::printf("%-14s %8s %9s %10s %11s %11s %11s  %s\n", "method", "dt", "steps", "cpu [s]",
+                "max|dH/H|", "max|dC|/|C|", "at T", "status");
+    std::vector<LongRow> rows;
+    std::vector<std::string> methods;
+    const std::vector<bool> accepted = accepted_methods(scene.create);
+    for (const LongRunSweep &sweep : scene.sweeps) {
+        const int i = method_index(sweep.method);
+        if (i < 0 || !accepted[static_cast<std::size_t>(i)]) {
+            std::printf("%-14s not available in this build\n", sweep.method.c_str());
+            continue;
+        }
+        methods.push_back(sweep.method);
+        for (double dt : sweep.steps) {
+            LongRow r = long_run(scene, sweep.method, dt, samples);
+            r.run = static_cast<int>(rows.size());
+            char status[96] = "";
+            if (r.status != LPI_OK)
+                std::snprintf(status, sizeof status, "%s at t = %.4g", lpi_status_name(r.status), r.reached);
+            std::printf("%-14s %8.4g %9lld %10.3e %11.3e %11.3e %11.3e  %s\n", r.method.c_str(), r.dt,
+                        static_cast<long long>(r.steps), r.cpu, r.energy_error, r.casimir_drift,
+                        r.final_casimir_drift, status);
+            std::fflush(stdout);
+            rows.push_back(std::move(r));
+        }
+    }
+
+    // Where each method wins: its cheapest run that keeps a bound over the
+    // whole run.
+    struct Bound {
+        const char *what;
+        double LongRow::*measure;
+        double limit;
+    };
+    const Bound bounds[] = {{"max|dH/H| < 1e-2", &LongRow::energy_error, 1e-2},
+                            {"max|dH/H| < 1e-3", &LongRow::energy_error, 1e-3},
+                            {"max|dH/H| < 1e-4", &LongRow::energy_error, 1e-4},
+                            {"max|dH/H| < 1e-5", &LongRow::energy_error, 1e-5},
+                            {"max|dC|/|C| < 1e-9", &LongRow::casimir_drift, 1e-9}};
+    std::printf("\n   CPU seconds of each method's cheapest run that stays within the bound to T = %g\n"
+                "   (- = none of its runs does):\n   %-14s", scene.final_time, "method");
+    for (const Bound &b : bounds) std::printf(" %19s", b.what);
+    std::printf("\n");
+    for (const std::string &m : methods) {
+        std::printf("   %-14s", m.c_str());
+        for (const Bound &b : bounds) {
+            const LongRow *cheapest = nullptr;
+            for (const LongRow &r : rows)
+                if (r.method == m && r.status == LPI_OK && r.*b.measure < b.limit &&
+                    (!cheapest || r.cpu < cheapest->cpu))
+                    cheapest = &r;
+            if (cheapest)
+                std::printf(" %9.3g (dt %5.3g)", cheapest->cpu, cheapest->dt);
+            else
+                std::printf(" %19s", "-");
+        }
+        std::printf("\n");
+    }
+
+    mkdir(out_dir.c_str(), 0777);
+    const std::string base = out_dir + "/" + scene.name;
+    write_long_csv(base, scene, rows);
+    std::printf("   wrote %s.csv and %s_history.csv (every sample of every run)\n", base.c_str(), base.c_str());
+    // The history plot compares the methods at about equal cost: the
+    // geometric mean of all successful runs' CPU times.
+    double log_sum = 0.0;
+    int count = 0;
+    for (const LongRow &r : rows)
+        if (r.status == LPI_OK && r.cpu > 0.0) log_sum += std::log(r.cpu), ++count;
+    if (!have_gnuplot())
+        std::printf("   gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n");
+    else if (count > 0 && plot_long(base, scene, rows, methods, std::exp(log_sum / count)))
+        std::printf("   wrote %s_energy.png, %s_casimirs.png and %s_history.png\n", base.c_str(), base.c_str(),
+                    base.c_str());
     else
         std::printf("   gnuplot failed: see %s.gp\n", base.c_str());
 }

@@ -33,11 +33,34 @@ struct Scene {
 };
 
 struct SceneOptions {
-    int sine_euler_n = 31;  // lpi report sine-euler --N
+    int sine_euler_n = 31;  // lpi report sine-euler --N (both sine-Euler scenes)
+    double long_run_time = 2000.0;  // lpi report sine-euler-long --T
     double inertia[3] = {1.0, 2.0, 3.0};  // lpi run rigid-body --inertia
 };
 
 std::vector<Scene> builtin_scenes(const SceneOptions &options = {});
+
+// A long-run scene: each method at its own step sizes, run to final_time
+// once per step size, with the maximum energy error and Casimir drift over the
+// whole run set against the CPU time the steps took (sine-euler-long).
+struct LongRunSweep {
+    std::string method;
+    std::vector<double> steps;  // largest first
+};
+struct LongRunScene {
+    std::string name;
+    std::string description;
+    std::string setting;  // the size and final time, for titles: "N = 31, T = 2000"
+    std::function<Handle()> create;
+    double final_time = 1.0;
+    // Diagnostics at the same equally spaced times for every run: at most this
+    // many, and never closer than the largest step of the sweep.
+    int max_samples = 500;
+    std::vector<LongRunSweep> sweeps;
+    std::string exclusion_reason;  // registered methods left out, and why
+};
+
+void run_long_scene(const LongRunScene &scene, const std::string &out_dir);
 
 // The Figure 2 scene: a long leapfrog run, energy error and Casimir drift
 // against time, written as CSV and PNG under out_dir.

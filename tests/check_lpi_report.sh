@@ -1,0 +1,122 @@
+#!/bin/sh
+# check_lpi_report.sh LPI OUTDIR SCENE [OPTION...]
+# Runs `lpi report SCENE` and checks, from its exit status and its CSV files,
+# the property that scene exists to show. Exits 77 when the build cannot run
+# the scene (no FFTW or no LAPACK), 1 on any failed check.
+set -u
+lpi=$1 out=$2 scene=$3
+shift 3
+rm -rf "$out"
+log=$out.log
+"$lpi" report "$scene" --out "$out" "$@" >"$log" 2>&1
+status=$?
+cat "$log"
+if grep -q "== $scene: skipped in this build" "$log"; then
+    echo "SKIP: $scene cannot run in this build"
+    exit 77
+fi
+if [ "$status" -ne 0 ]; then
+    echo "FAIL: lpi report $scene exited with status $status"
+    exit 1
+fi
+fail() {
+    echo "FAIL: $*"
+    exit 1
+}
+
+case $scene in
+rigid-body)
+    # rigid-body.csv: scene,method,order,dt,steps,cpu_seconds,error,
+    # max_energy_error,max_casimir_drift,status; rows by method, largest dt first.
+    csv=$out/rigid-body.csv
+    [ -s "$csv" ] || fail "no $csv"
+    awk -F, '
+        NR == 1 { next }
+        $10 != "LPI_OK" { print "FAIL: " $2 " at dt " ($4 + 0) ": " $10; bad = 1 }
+        # The splitting methods keep the Casimir |m|^2 to round-off.
+        $2 != "rk4" && $2 != "implicit-midpoint" && !($9 < 1e-13) {
+            print "FAIL: " $2 " at dt " ($4 + 0) " changed |m|^2 by " $9; bad = 1 }
+        # rk4 does not: at its largest step the drift is far above round-off.
+        $2 == "rk4" && !seen_rk4++ && !($9 > 1e-8) {
+            print "FAIL: rk4 at dt " ($4 + 0) " kept |m|^2 to " $9 " (the column measures nothing?)"; bad = 1 }
+        # Leapfrog is second order: the last two halvings of dt divide the error by 4.
+        $2 == "leapfrog" { previous = last; last = $7 }
+        END {
+            if (!(last > 0 && previous > 0)) { print "FAIL: no leapfrog sweep"; exit 1 }
+            order = log(previous / last) / log(2)
+            printf "leapfrog: measured order %.3f\n", order
+            if (order < 1.9 || order > 2.1) { print "FAIL: leapfrog order " order; bad = 1 }
+            exit bad
+        }' "$csv" || exit 1
+    ;;
+figure2)
+    grep -q "bounded, no secular growth" "$log" || fail "the energy error grows"
+    # figure2.csv: time,energy_error,c2_drift,spectrum_drift, every 100 steps.
+    awk -F, '
+        NR == 1 { next }
+        { e = $2 < 0 ? -$2 : $2; if (e > worst) worst = e; c2 = $3 }
+        END {
+            printf "max |dH/H| %.3e, C2 drift after 1e5 steps %.3e\n", worst, c2
+            # The paper: about 5e-5 and 5e-15 per step.
+            if (!(worst > 0 && worst < 1e-4)) { print "FAIL: energy error " worst; exit 1 }
+            if (!(c2 < 5e-10)) { print "FAIL: C2 drift " c2; exit 1 }
+        }' "$out/figure2.csv" || exit 1
+    ;;
+sine-euler-long)
+    # sine-euler-long.csv: scene,run,method,order,poisson,dt,steps,cpu_seconds,
+    # max_energy_error,max_casimir_drift,final_casimir_drift,reached_time,status;
+    # _history.csv: run,method,dt,time,energy_error,casimir_drift.
+    csv=$out/sine-euler-long.csv
+    [ -s "$csv" ] || fail "no $csv"
+    awk -F, '
+        FNR == 1 { next }
+        FILENAME ~ /_history.csv$/ { n[$1]++; t[$1, n[$1]] = $4; e[$1, n[$1]] = $5; c[$1, n[$1]] = $6; next }
+        { method[$2] = $3; poisson[$2] = $5; dt[$2] = $6; status[$2] = $13 }
+        END {
+            for (r in method) {
+                name = method[r] " dt " (dt[r] + 0)
+                # A baseline may fail (it says so in its row); a splitting may not.
+                if (status[r] != "LPI_OK") {
+                    print (poisson[r] == 1 ? "FAIL: " : "note: ") name ": " status[r]
+                    if (poisson[r] == 1) bad = 1
+                    continue
+                }
+                last = n[r]; half = int(last / 2)
+                if (last < 8) { print "FAIL: " name ": " last " samples"; bad = 1; continue }
+                if (poisson[r] == 1) {
+                    ++splittings
+                    # The splitting keeps every Casimir to round-off ...
+                    for (k = 1; k <= last; ++k)
+                        if (!(c[r, k] < 1e-12)) {
+                            print "FAIL: " name ": Casimir drift " c[r, k] " at t = " t[r, k]; bad = 1; break }
+                    # ... and its energy error stays bounded: small everywhere,
+                    # and for leapfrog (whose error is smooth enough to
+                    # compare) no larger over the second half than twice the
+                    # first. Higher orders at large steps fluctuate more.
+                    first = 0; second = 0
+                    for (k = 1; k <= last; ++k)
+                        if (k <= half) { if (e[r, k] > first) first = e[r, k] }
+                        else if (e[r, k] > second) second = e[r, k]
+                    printf "%s: max |dH/H| %.3e then %.3e, max Casimir drift below 1e-12\n", name, first, second
+                    if (!(first < 0.1 && second < 0.1) || method[r] == "leapfrog" && !(second <= 2 * first)) {
+                        print "FAIL: " name ": the energy error grows"; bad = 1 }
+                }
+                if (method[r] == "rk4-matrix") {
+                    ++rk4
+                    # rk4-matrix drifts secularly: far above round-off, and
+                    # at the end at least ten times its drift at the first sample.
+                    printf "%s: Casimir drift %.3e at t = %g, %.3e at t = %g\n", name,
+                           c[r, 1], t[r, 1], c[r, last], t[r, last]
+                    if (!(c[r, last] > 1e-10 && c[r, last] > 10 * c[r, 1])) {
+                        print "FAIL: " name ": no secular Casimir drift"; bad = 1 }
+                }
+            }
+            if (splittings < 3 || rk4 < 2) { print "FAIL: " splittings " splitting runs, " rk4 " rk4-matrix runs"; bad = 1 }
+            exit bad
+        }' "$csv" "$out/sine-euler-long_history.csv" || exit 1
+    ;;
+*)
+    fail "no check written for scene $scene"
+    ;;
+esac
+echo "PASS: lpi report $scene"
