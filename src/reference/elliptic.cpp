@@ -37,26 +37,28 @@ double carlson_rf_of_squares(double x, double y, double z) {
     return carlson_rf(0.25 * (x * x + lambda), 0.25 * (y * y + lambda), 0.25 * (z * z + lambda));
 }
 
-// The arithmetic-geometric mean of (1, kc) with the c_n the Landen
-// transformation needs: a_{n+1} = (a_n + b_n) / 2, b_{n+1} = sqrt(a_n b_n),
-// c_{n+1} = (a_n - b_n) / 2, c_0 = k. K = pi / (2 a_N).
-struct Agm {
-    static constexpr int kMaxSteps = 40;  // kc = 1e-300 needs 13
-    double a[kMaxSteps + 1], c[kMaxSteps + 1];
+// The descending Gauss transformation (Abramowitz & Stegun 16.12) from
+// modulus k_j to k_{j+1} = (1 - kc_j) / (1 + kc_j), kc_{j+1} = 2 sqrt(kc_j) /
+// (1 + kc_j), argument u / (1 + k_{j+1}), repeated until k is below 1e-8 and
+// the functions are circular to round-off (14 steps from kc = 1e-300). K =
+// (pi / 2) prod (1 + k_j).
+struct GaussChain {
+    static constexpr int kMaxSteps = 32;
+    double k[kMaxSteps + 1], kc[kMaxSteps + 1];
     int steps = 0;
+    double argument_scale = 1.0;  // prod_{j >= 1} (1 + k_j)
 
-    explicit Agm(double kc) {
-        a[0] = 1.0;
-        c[0] = std::sqrt((1.0 - kc) * (1.0 + kc));
-        double b = kc;
-        while (steps < kMaxSteps && c[steps] > 1e-16 * a[steps]) {
-            a[steps + 1] = 0.5 * (a[steps] + b);
-            c[steps + 1] = 0.5 * (a[steps] - b);
-            b = std::sqrt(a[steps] * b);
+    explicit GaussChain(double complement) {
+        kc[0] = complement;
+        k[0] = std::sqrt((1.0 - complement) * (1.0 + complement));
+        while (k[steps] > 1e-8 && steps < kMaxSteps) {
+            k[steps + 1] = (1.0 - kc[steps]) / (1.0 + kc[steps]);
+            kc[steps + 1] = 2.0 * std::sqrt(kc[steps]) / (1.0 + kc[steps]);
+            argument_scale *= 1.0 + k[steps + 1];
             ++steps;
         }
     }
-    double quarter_period() const { return kPi / (2.0 * a[steps]); }
+    double quarter_period() const { return 0.5 * kPi * argument_scale; }
 };
 
 }  // namespace
@@ -66,22 +68,39 @@ JacobiSnCnDn jacobi_sncndn(double u, double kc) {
         const double sech = 1.0 / std::cosh(u);
         return {std::tanh(u), sech, sech};
     }
-    const Agm agm(kc);
-    u = std::remainder(u, 4.0 * agm.quarter_period());
-    double phi = std::ldexp(agm.a[agm.steps] * u, agm.steps);
-    for (int j = agm.steps; j > 0; --j)
-        phi = 0.5 * (phi + std::asin(agm.c[j] / agm.a[j] * std::sin(phi)));
-    const double sn = std::sin(phi), cn = std::cos(phi);
-    // dn^2 = 1 - k^2 sn^2 = cn^2 + kc^2 sn^2: two nonnegative terms, no
-    // cancellation where dn is small (near u = K beside the separatrix).
-    return {sn, cn, std::hypot(cn, kc * sn)};
+    // u = r + 2K q with |r| <= K; sn(r + 2K) = -sn(r), cn(r + 2K) = -cn(r).
+    const GaussChain chain(kc);
+    const double half_period = 2.0 * chain.quarter_period();
+    const double q = std::nearbyint(u / half_period);
+    const double v = std::fma(-q, half_period, u) / chain.argument_scale;  // in [-pi/2, pi/2]
+    double sn = std::sin(v), cn = std::cos(v), dn = std::hypot(cn, chain.kc[chain.steps] * sn);
+    // Back up the chain (A&S 16.12.2-4):
+    //   sn = (1 + k) s / (1 + k s^2), cn = c d / (1 + k s^2),
+    //   dn = (1 - k s^2) / (1 + k s^2) = sqrt(cn^2 + kc^2 sn^2),
+    // with s, c, d at modulus k and kc that of the level reached. sn keeps its
+    // absolute accuracy (the map contracts near |sn| = 1). The product keeps
+    // the relative accuracy of a tiny cn (near u = K beside the separatrix),
+    // but where cn is near 1 it would double the error of 1 - cn at every
+    // level: there cn = sqrt(1 - sn^2). dn takes the rational form unless
+    // 1 - k s^2 cancels; then the two nonnegative terms.
+    for (int j = chain.steps; j > 0; --j) {
+        const double ks2 = chain.k[j] * sn * sn, denominator = 1.0 + ks2;
+        cn = cn * dn / denominator;
+        dn = (1.0 - ks2) / denominator;
+        sn = (1.0 + chain.k[j]) * sn / denominator;
+        if (std::fabs(cn) > std::fabs(sn)) cn = std::copysign(std::sqrt((1.0 - sn) * (1.0 + sn)), cn);
+        if (ks2 > 0.5) dn = std::hypot(cn, chain.kc[j - 1] * sn);
+    }
+    const bool odd = std::fmod(q, 2.0) != 0.0;
+    return {odd ? -sn : sn, odd ? -cn : cn, dn};
 }
 
-double jacobi_argument(double sn, double cn, double dn, double kc) {
-    const double in_first_half = sn * carlson_rf_of_squares(std::fabs(cn), dn, 1.0);  // |u| <= K
-    if (cn >= 0.0) return in_first_half;
-    // u and 2K - u (or -2K - u) share sn and dn; cn changes sign.
-    return std::copysign(2.0 * Agm(kc).quarter_period(), sn) - in_first_half;
+JacobiArgument jacobi_argument(double sn, double cn, double dn) {
+    // F(am | k) = sn R_F(cn^2, dn^2, 1) for |u| <= K; u and 2K - u share sn
+    // and dn while cn changes sign, and 2K - u = (-u) + 2K.
+    const double first_half = sn * carlson_rf_of_squares(std::fabs(cn), dn, 1.0);
+    if (cn >= 0.0) return {first_half, false};
+    return {-first_half, true};
 }
 
 }  // namespace lpi

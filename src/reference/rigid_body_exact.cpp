@@ -104,10 +104,11 @@ void triaxial_body(const double I[3], const double m[3], double t, double out[3]
     // kc <= 1 exactly; rounding may leave it an ulp above.
     const double kc =
         std::min(1.0, std::ldexp(std::sqrt(std::fabs(S) / P_c), pair_exponent) / A_c);
-    const double u0 = jacobi_argument(root_bc * m[b] / A_a, m[a] / A_a, std::fabs(m[c]) / A_c, kc);
-    const JacobiSnCnDn f = jacobi_sncndn(u0 + lambda * t, kc);
-    out[a] = A_a * f.cn;
-    out[b] = A_b * f.sn;
+    const JacobiArgument u0 = jacobi_argument(root_bc * m[b] / A_a, m[a] / A_a, std::fabs(m[c]) / A_c);
+    const JacobiSnCnDn f = jacobi_sncndn(u0.offset + lambda * t, kc);
+    const double shift = u0.half_period ? -1.0 : 1.0;  // sn, cn of u + 2K
+    out[a] = shift * A_a * f.cn;
+    out[b] = shift * A_b * f.sn;
     out[c] = sigma * A_c * f.dn;
 }
 
