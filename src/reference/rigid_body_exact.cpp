@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 
 #include "elliptic.hpp"
 
@@ -53,7 +52,7 @@ void symmetric_top(const double I[3], const double m[3], int r, double t, double
 // modulus k. Every quantity is formed from the data without cancellation:
 //   A_a^2 = m_a^2 + d_bc m_b^2,  A_c^2 = m_c^2 + d_ab m_b^2,  A_b = A_a / sqrt(d_bc),
 // with d_bc = (w_b - w_c) / (w_a - w_c), d_ab = 1 - d_bc, w = 1/I from
-// differences of the I themselves; kc^2 = 1 - k^2 = S / (P_c A_c^2) where
+// differences of the I themselves; kc^2 = 1 - k^2 = |S| / (P_c A_c^2) where
 //   S = P_hi m_hi^2 - P_lo m_lo^2,  P_hi = I_lo (I_hi - I_mid),  P_lo = I_hi (I_mid - I_lo)
 // is I_lo I_mid I_hi times the distance from the separatrix (its sign says the
 // side, P_c is the weight of m_c in it). S is a true cancellation beside the
