@@ -99,7 +99,9 @@ LPI_API int lpi_rigid_body_create(lpi_system **out, double I1, double I2, double
 /* The exact free rigid-body solution (Jacobi elliptic functions): out = m at
  * time lpi_time(sys) + t, starting from the current state, which is not
  * changed. Every case: either side of the separatrix, the separatrix,
- * symmetric bodies, steady rotation. LPI_ERR_UNSUPPORTED for other systems. */
+ * symmetric bodies (closed form), near and on the axes; a steady rotation
+ * comes back unchanged. Error a few 1e-15 |m|, growing like the round-off
+ * times the number of turns. LPI_ERR_UNSUPPORTED for other systems. */
 LPI_API int lpi_rigid_body_exact(const lpi_system *sys, double t, double *out);
 
 /* Planar pendulum on e(2): H = x3^2/2 + x2, Casimir x1^2 + x2^2.

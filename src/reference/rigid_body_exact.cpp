@@ -7,59 +7,139 @@
 
 namespace lpi {
 
-// Relabel the axes (a, b, c) so that m_c never vanishes and m_a, m_b oscillate:
-// c is the axis of largest inertia below the separatrix (2H < |m|^2 / I_mid),
-// of smallest inertia above it. In those labels (Landau & Lifshitz, Mechanics,
-// section 37)
+namespace {
+
+// Just enough double-double arithmetic to form one difference of products
+// to relative accuracy ~u^2 of its terms (Dekker; Ogita, Rump & Oishi 2005).
+struct DoubleDouble {
+    double hi, lo;
+};
+DoubleDouble exact_product(double a, double b) {
+    const double p = a * b;
+    return {p, std::fma(a, b, -p)};
+}
+DoubleDouble exact_difference(double a, double b) {
+    const double s = a - b, bb = s - a;
+    return {s, (a - (s - bb)) - (b + bb)};
+}
+DoubleDouble product(DoubleDouble x, DoubleDouble y) {
+    DoubleDouble p = exact_product(x.hi, y.hi);
+    p.lo += x.hi * y.lo + x.lo * y.hi;
+    const double hi = p.hi + p.lo;
+    return {hi, p.lo - (hi - p.hi)};
+}
+double rounded_difference(DoubleDouble x, DoubleDouble y) {
+    const DoubleDouble d = exact_difference(x.hi, y.hi);
+    return d.hi + (d.lo + (x.lo - y.lo));
+}
+
+// Two equal moments I_p = I_q (p, q, r cyclic): m_r is constant and (m_p, m_q)
+// turns at the rate Omega = m_r (1/I_r - 1/I_p). With m_r = 0 (m in the plane
+// of the equal axes, or a sphere) Omega = 0 and m is returned bit for bit.
+void symmetric_top(const double I[3], const double m[3], int r, double t, double out[3]) {
+    const int p = (r + 1) % 3, q = (r + 2) % 3;
+    const double omega = m[r] * ((I[p] - I[r]) / (I[r] * I[p]));
+    const double c = std::cos(omega * t), s = std::sin(omega * t);
+    out[p] = m[p] * c + m[q] * s;
+    out[q] = m[q] * c - m[p] * s;
+    out[r] = m[r];
+}
+
+// Distinct moments. Relabel the axes (a, b, c), b the middle one, so that m_c
+// never vanishes: c is the axis of largest inertia below the separatrix, of
+// smallest above it. Then (Landau & Lifshitz, Mechanics, section 37)
 //   m_a = A_a cn(u), m_b = A_b sn(u), m_c = sigma A_c dn(u), u = u0 + lambda t,
-// with A_a, A_c from |m|^2 and 2H, and the parameter and rate from the
-// equations of motion. An odd relabelling reverses time (the cross product
-// changes sign), which lambda absorbs.
-void rigid_body_exact(const double inertia[3], const double m0[3], double t, double out[3]) {
-    const double M2 = m0[0] * m0[0] + m0[1] * m0[1] + m0[2] * m0[2];
-    const double E = m0[0] * m0[0] / inertia[0] + m0[1] * m0[1] / inertia[1] +
-                     m0[2] * m0[2] / inertia[2];  // twice the energy
+// modulus k. Every quantity is formed from the data without cancellation:
+//   A_a^2 = m_a^2 + d_bc m_b^2,  A_c^2 = m_c^2 + d_ab m_b^2,  A_b = A_a / sqrt(d_bc),
+// with d_bc = (w_b - w_c) / (w_a - w_c), d_ab = 1 - d_bc, w = 1/I from
+// differences of the I themselves; kc^2 = 1 - k^2 = |S| / (P_c A_c^2) where
+//   S = P_hi m_hi^2 - P_lo m_lo^2,  P_hi = I_lo (I_hi - I_mid),  P_lo = I_hi (I_mid - I_lo)
+// is I_lo I_mid I_hi times the distance from the separatrix (its sign says the
+// side, P_c is the weight of m_c in it). S is a true cancellation beside the
+// separatrix, and the period there depends on log kc, so S is formed in
+// double-double. S = 0 is the separatrix itself: the heteroclinic orbit
+//   m_a = sigma_a A_a sech u, m_b = A_b tanh u, m_c = sigma A_c sech u.
+// An odd relabelling reverses time (the cross product changes sign), which
+// lambda absorbs. Two zero components (a steady rotation) are caught before.
+void triaxial_body(const double I[3], const double m[3], double t, double out[3]) {
     int order[3] = {0, 1, 2};
-    std::sort(order, order + 3, [&](int x, int y) { return inertia[x] < inertia[y]; });
+    std::sort(order, order + 3, [&](int x, int y) { return I[x] < I[y]; });
     const int lo = order[0], mid = order[1], hi = order[2];
 
-    int a, b, c;
-    if (E <= M2 / inertia[mid]) {
-        a = lo, b = mid, c = hi;
-    } else {
-        a = hi, b = mid, c = lo;
-    }
-    const double wa = 1.0 / inertia[a], wb = 1.0 / inertia[b], wc = 1.0 / inertia[c];
-    // Parity of (a, b, c) as a permutation of (0, 1, 2).
-    const bool even = (b == (a + 1) % 3);
+    // The pair (m_lo, m_hi) is scaled by a power of two so that its squares
+    // neither underflow nor lose bits near the middle axis.
+    const int pair_exponent = std::ilogb(std::max(std::fabs(m[lo]), std::fabs(m[hi])));
+    const double m_lo = std::ldexp(m[lo], -pair_exponent), m_hi = std::ldexp(m[hi], -pair_exponent);
+    const DoubleDouble P_hi = product({I[lo], 0.0}, exact_difference(I[hi], I[mid]));
+    const DoubleDouble P_lo = product({I[hi], 0.0}, exact_difference(I[mid], I[lo]));
+    const double S = rounded_difference(product(exact_product(m_hi, m_hi), P_hi),
+                                        product(exact_product(m_lo, m_lo), P_lo));
 
-    const double span = wa - wc;  // nonzero unless the body is a sphere
-    if (span == 0.0 || M2 == 0.0) {
-        std::copy(m0, m0 + 3, out);  // every vector is a steady rotation
-        return;
-    }
-    const double Aa2 = std::max(0.0, (E - M2 * wc) / span);
-    const double Ac2 = std::max(0.0, (M2 * wa - E) / span);
-    const double Aa = std::sqrt(Aa2), Ac = std::sqrt(Ac2);
-    if (Aa == 0.0 || Ac == 0.0) {
-        std::copy(m0, m0 + 3, out);  // steady rotation about axis c (or a)
-        return;
-    }
-    double m = Aa2 * (wa - wb) / (Ac2 * (wb - wc));
-    m = std::clamp(m, 0.0, 1.0);
-    const double Ab = std::sqrt(Aa2 + m * Ac2);
-    const double sigma = m0[c] < 0.0 ? -1.0 : 1.0;
-    // From dm_b/dt = m_c m_a (w_a - w_c) in even labels: Ab lambda = sigma Ac Aa (w_a - w_c).
-    double lambda = sigma * Ac * Aa * span / Ab;
+    const bool circles_hi = S >= 0.0;
+    const int a = circles_hi ? lo : hi, b = mid, c = circles_hi ? hi : lo;
+    const double P_c = circles_hi ? P_hi.hi + P_hi.lo : P_lo.hi + P_lo.lo;
+    const double d_bc = I[a] * std::fabs(I[b] - I[c]) / (I[b] * std::fabs(I[a] - I[c]));
+    const double d_ab = I[c] * std::fabs(I[a] - I[b]) / (I[b] * std::fabs(I[a] - I[c]));
+    const double span = (I[c] - I[a]) / (I[a] * I[c]);  // w_a - w_c
+    const double root_bc = std::sqrt(d_bc);
+    const double A_a = std::hypot(m[a], root_bc * m[b]);
+    const double A_b = A_a / root_bc;
+    const double A_c = std::hypot(m[c], std::sqrt(d_ab) * m[b]);
+    const double sigma = m[c] < 0.0 ? -1.0 : 1.0;
+    const bool even = (b == (a + 1) % 3);
+    // From dm_b/dt = m_a m_c (w_a - w_c) in even labels.
+    double lambda = sigma * A_c * root_bc * span;
     if (!even) lambda = -lambda;
 
-    // Phase: sn(u0) = m_b / A_b, cn(u0) = m_a / A_a, i.e. amplitude phi0.
-    const double phi0 = std::atan2(m0[b] / Ab, m0[a] / Aa);
-    const double u0 = elliptic_f(phi0, m);
-    const JacobiSnCnDn f = jacobi_sncndn(u0 + lambda * t, m);
-    out[a] = Aa * f.cn;
-    out[b] = Ab * f.sn;
-    out[c] = sigma * Ac * f.dn;
+    if (S == 0.0) {
+        const double sigma_a = m[a] < 0.0 ? -1.0 : 1.0;
+        const double u = std::asinh(root_bc * m[b] / std::fabs(m[a])) + sigma_a * lambda * t;
+        const double sech = 1.0 / std::cosh(u);
+        out[a] = sigma_a * A_a * sech;
+        out[b] = A_b * std::tanh(u);
+        out[c] = sigma * A_c * sech;
+        return;
+    }
+    // kc <= 1 exactly; rounding may leave it an ulp above.
+    const double kc =
+        std::min(1.0, std::ldexp(std::sqrt(std::fabs(S) / P_c), pair_exponent) / A_c);
+    const JacobiArgument u0 = jacobi_argument(root_bc * m[b] / A_a, m[a] / A_a, std::fabs(m[c]) / A_c);
+    const JacobiSnCnDn f = jacobi_sncndn(u0.offset + lambda * t, kc);
+    const double shift = u0.half_period ? -1.0 : 1.0;  // sn, cn of u + 2K
+    out[a] = shift * A_a * f.cn;
+    out[b] = shift * A_b * f.sn;
+    out[c] = sigma * A_c * f.dn;
+}
+
+}  // namespace
+
+void rigid_body_exact(const double inertia[3], const double m0[3], double t, double out[3]) {
+    std::copy(m0, m0 + 3, out);
+    const int zeros = (m0[0] == 0.0) + (m0[1] == 0.0) + (m0[2] == 0.0);
+    if (zeros >= 2) return;  // at rest, or a steady rotation about an axis
+
+    // dm/dt = m x (m / I) is homogeneous: m -> 2^e m, I -> 2^f I maps the
+    // solution at t to the one at 2^(e-f) t. Scaling to magnitudes near 1
+    // keeps squares and products of large or small data finite and exact.
+    const int m_exponent = std::ilogb(std::max({std::fabs(m0[0]), std::fabs(m0[1]), std::fabs(m0[2])}));
+    const int i_exponent = std::ilogb(std::max({inertia[0], inertia[1], inertia[2]}));
+    double I[3], m[3];
+    for (int k = 0; k < 3; ++k) {
+        I[k] = std::ldexp(inertia[k], -i_exponent);
+        m[k] = std::ldexp(m0[k], -m_exponent);
+    }
+    const double scaled_t = std::ldexp(t, m_exponent - i_exponent);
+
+    if (I[0] == I[1]) {
+        symmetric_top(I, m, 2, scaled_t, out);
+    } else if (I[1] == I[2]) {
+        symmetric_top(I, m, 0, scaled_t, out);
+    } else if (I[0] == I[2]) {
+        symmetric_top(I, m, 1, scaled_t, out);
+    } else {
+        triaxial_body(I, m, scaled_t, out);
+    }
+    for (int k = 0; k < 3; ++k) out[k] = std::ldexp(out[k], m_exponent);
 }
 
 }  // namespace lpi
