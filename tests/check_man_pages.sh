@@ -6,7 +6,7 @@
 #    directory only);
 #  - every family page in man3 has RETURN VALUE and EXAMPLES; the EXAMPLES
 #    program (the .EX/.EE blocks) compiles against include/ with warnings as
-#    errors, so an example cannot rot;
+#    errors, so an example cannot rot, and fits 80 columns;
 #  - every status a page names exists, and lpi_last_error(3) lists them all;
 #  - every .TH line carries the same date and the header's version;
 #  - liepoisson(7) and lpi(1) name the licence and the file that holds it;
@@ -119,6 +119,8 @@ for page in "$root"/man/man3/*.3; do
         continue
     fi
     sed -i -e 's/\\&//g' -e 's/\\-/-/g' -e "s/\\\\(aq/'/g" -e 's/\\(dq/"/g' -e 's/\\e/\\/g' "$program"
+    long=$(awk 'length($0) > 71 { print FILENAME ":" FNR ": " $0 }' "$program")
+    [ -z "$long" ] || complain "$rel: EXAMPLES lines longer than 71 columns overflow an 80-column terminal:" "$long"
     if ! grep -q 'int main(' "$program"; then
         complain "$rel: EXAMPLES has no complete program (.EX ... int main( ... .EE)"; continue
     fi
