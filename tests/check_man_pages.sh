@@ -97,17 +97,23 @@ fi
 # ---- The licence, named where a user looks for it -------------------------
 head -n1 "$root/LICENSE" | grep -q '^BSD 3-Clause License$' || complain "LICENSE is not the BSD 3-Clause text"
 for page in man/man7/liepoisson.7 man/man1/lpi.1; do
-    copyright=$(section "$root/$page" COPYRIGHT)
+    copyright=$(section "$root/$page" COPYRIGHT | sed 's/\\-/-/g')
     echo "$copyright" | grep -q 'BSD-3-Clause' && echo "$copyright" | grep -q 'LICENSE' ||
         complain "$page: COPYRIGHT must name BSD-3-Clause and the file LICENSE"
 done
 
 # ---- Examples: every family page has one, and it compiles -----------------
 cc=${CC:-cc}
+programs=""
 for page in "$root"/man/man3/*.3; do
     [ -L "$page" ] && continue
     rel=${page#"$root/"}
     grep -q '^\.SH "\{0,1\}RETURN VALUE"\{0,1\}$' "$page" || complain "$rel: no RETURN VALUE section"
+    # Every function behind the C API wrapper can return these three.
+    errors=$(section "$page" ERRORS)
+    for code in LPI_ERR_NULL LPI_ERR_NO_MEMORY LPI_ERR_INTERNAL; do
+        [ -z "$errors" ] || echo "$errors" | grep -q "^\.B $code\$" || complain "$rel: ERRORS does not list $code"
+    done
     examples=$(section "$page" EXAMPLES)
     if [ -z "$examples" ]; then complain "$rel: no EXAMPLES section"; continue; fi
     # The program is the text of the .EX/.EE blocks with roff escapes undone;
@@ -124,10 +130,16 @@ for page in "$root"/man/man3/*.3; do
     if ! grep -q 'int main(' "$program"; then
         complain "$rel: EXAMPLES has no complete program (.EX ... int main( ... .EE)"; continue
     fi
-    if ! out=$($cc -std=c99 -Wall -Wextra -Wpedantic -Werror -fsyntax-only -I "$root/include" "$program" 2>&1); then
-        complain "$rel: the EXAMPLES program does not compile:"; echo "$out"
-    fi
+    programs="$programs $program"
 done
+# One compiler run for all (its messages name the page: lpi_step.c is the
+# program of man3/lpi_step.3).
+# shellcheck disable=SC2086 # the file names have no spaces
+if [ -n "$programs" ] && ! out=$($cc -std=c99 -Wall -Wextra -Wpedantic -Werror -fsyntax-only \
+    -I "$root/include" $programs 2>&1); then
+    complain "EXAMPLES programs that do not compile (NAME.c is the program of man3/NAME.3):"
+    echo "$out"
+fi
 
 # ---- Rendering: groff, mandoc's lint, and man -l from the source tree -----
 need_tool() {
@@ -141,27 +153,24 @@ need_tool() {
 }
 have_mandoc=0; need_tool mandoc "the lint" && have_mandoc=1
 have_man=0; need_tool man "the man -l check" && have_man=1
-for page in "$root"/man/man*/*.[1-9]; do
-    rel=${page#"$root/"}
-    if [ ! -L "$page" ]; then
-        out=$(groff -man -ww -z "$page" 2>&1)
-        [ -z "$out" ] || complain "$rel: groff: $out"
-        if [ $have_mandoc -eq 1 ]; then
-            out=$(mandoc -T lint -W warning "$page" 2>&1)
-            [ -z "$out" ] || complain "$out"
-        fi
-    fi
-done
-# What a user types in the tree (no pager, a fixed width and locale), for
-# every page at once (one man run is slow); page by page only on a failure.
+# Each tool reads every page in one run; their messages name the file.
+# shellcheck disable=SC2046 # the page names have no spaces
+set -- $(cd "$root" && for page in man/man*/*.[1-9]; do [ -L "$page" ] || echo "$page"; done)
+out=$(cd "$root" && groff -man -ww -z "$@" 2>&1)
+[ -z "$out" ] || complain "groff: $out"
+if [ $have_mandoc -eq 1 ]; then
+    out=$(cd "$root" && mandoc -T lint -W warning "$@" 2>&1)
+    [ -z "$out" ] || complain "$out"
+fi
+# What a user types in the tree (no pager, a fixed width and locale): every
+# page, and one symbolic link (the others are checked above to point at a
+# page beside them, which man -l then reads the same way). Page by page only
+# on a failure, to name it.
 if [ $have_man -eq 1 ]; then
+    for link in "$root"/man/man3/*.3; do [ -L "$link" ] && set -- "$@" "${link#"$root/"}" && break; done
     man_l() { (cd "$root" && LC_ALL=C MANWIDTH=80 MANPAGER=cat PAGER=cat man -l "$@" 2>"$work/man.err"); }
-    pages=$(cd "$root" && ls man/man*/*.[1-9])
-    # shellcheck disable=SC2086 # the page names have no spaces
-    shown=$(man_l $pages | grep -c '^NAME$')
-    if [ -s "$work/man.err" ] || [ "$shown" -ne "$(echo "$pages" | wc -l)" ]; then
-        for rel in $pages; do
-            name=${rel##*/}
+    if [ "$(man_l "$@" | grep -c '^NAME$')" -ne $# ] || [ -s "$work/man.err" ]; then
+        for rel in "$@"; do
             out=$(man_l "$rel")
             if [ -s "$work/man.err" ]; then complain "man -l $rel:"; cat "$work/man.err"; fi
             echo "$out" | grep -q '^NAME$' || complain "man -l $rel shows no NAME section"
