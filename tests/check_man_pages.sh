@@ -6,21 +6,25 @@
 #    directory only);
 #  - every family page in man3 has RETURN VALUE and EXAMPLES; the EXAMPLES
 #    program (the .EX/.EE blocks) compiles against include/ with warnings as
-#    errors, so an example cannot rot, and fits 80 columns;
+#    errors, runs against the built library, and fits 80 columns;
 #  - every status a page names exists, and lpi_last_error(3) lists them all;
 #  - every .TH line carries the same date and the header's version;
 #  - liepoisson(7) and lpi(1) name the licence and the file that holds it;
 #  - every page reads with `man -l` from the source tree, and is clean under
 #    groff -ww and `mandoc -T lint -W warning`.
-#   tests/check_man_pages.sh SOURCE_DIR
-# CC (default cc) compiles the examples. man and mandoc are used when
+#   tests/check_man_pages.sh SOURCE_DIR [LIBRARY_DIR]
+# With LIBRARY_DIR (where libliepoisson.so is) the examples are also linked
+# and run, and must exit 0. CC (default cc) compiles them, with
+# LPI_EXAMPLE_CFLAGS added when linking (a sanitized library needs its
+# runtime in the program too). man and mandoc are used when
 # installed (scripts/install-deps installs them); with CI=true a missing one
 # is a failure, so CI cannot pass without the lint.
 set -u
 root=$(cd "$1" && pwd)
+libdir=${2:+$(cd "$2" && pwd)}
 header="$root/include/liepoisson.h"
 status=0
-complain() { echo "$*"; status=1; }
+complain() { printf '%s\n' "$*"; status=1; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
@@ -59,7 +63,7 @@ done
 statuses=$(sed -n 's/^ *X(\(LPI_[A-Z_]*\), *[-+]\{0,1\}[0-9]*,.*/\1/p' "$header")
 [ -n "$statuses" ] || complain "no status codes found in the LPI_STATUS_LIST of $header"
 for used in $(cat "$root"/man/man*/*.[1-9] | grep -o 'LPI_ERR_[A-Z][A-Z_]*\|LPI_OK\|LPI_STOPPED' | sort -u); do
-    echo "$statuses" | grep -qx "$used" || complain "the man pages name $used, which is not a status of the header"
+    printf '%s\n' "$statuses" | grep -qx "$used" || complain "the man pages name $used, which is not a status of the header"
 done
 for code in $statuses; do
     section "$root/man/man3/lpi_last_error.3" DESCRIPTION | grep -q "^\.B $code\$" ||
@@ -76,14 +80,14 @@ for page in "$root"/man/man*/*.[1-9]; do
     base=${page##*/}
     th=$(grep -m1 '^\.TH ' "$page")
     # .TH TITLE SECTION DATE "SOURCE" "MANUAL"
-    title=$(echo "$th" | awk '{ print $2 }')
-    sec=$(echo "$th" | awk '{ print $3 }')
-    date=$(echo "$th" | awk '{ print $4 }')
-    source=$(echo "$th" | sed -n 's/^\.TH [^ ]* [^ ]* [^ ]* "\([^"]*\)" "liepoisson manual"$/\1/p')
-    expected_title=$(echo "${base%.*}" | tr 'a-z' 'A-Z')
+    title=$(printf '%s\n' "$th" | awk '{ print $2 }')
+    sec=$(printf '%s\n' "$th" | awk '{ print $3 }')
+    date=$(printf '%s\n' "$th" | awk '{ print $4 }')
+    source=$(printf '%s\n' "$th" | sed -n 's/^\.TH [^ ]* [^ ]* [^ ]* "\([^"]*\)" "liepoisson manual"$/\1/p')
+    expected_title=$(printf '%s\n' "${base%.*}" | tr 'a-z' 'A-Z')
     [ "$title" = "$expected_title" ] || complain "$rel: .TH title $title, expected $expected_title"
     [ "$sec" = "${base##*.}" ] || complain "$rel: .TH section $sec, expected ${base##*.}"
-    echo "$date" | grep -qx '[0-9]\{4\}-[0-9][0-9]-[0-9][0-9]' || complain "$rel: .TH date '$date' is not YYYY-MM-DD"
+    printf '%s\n' "$date" | grep -qx '[0-9]\{4\}-[0-9][0-9]-[0-9][0-9]' || complain "$rel: .TH date '$date' is not YYYY-MM-DD"
     [ "$source" = "$version" ] ||
         complain "$rel: .TH must end with \"$version\" \"liepoisson manual\" (the version of include/liepoisson.h); it is: $th"
     dates="$dates$date $rel
@@ -98,13 +102,14 @@ fi
 head -n1 "$root/LICENSE" | grep -q '^BSD 3-Clause License$' || complain "LICENSE is not the BSD 3-Clause text"
 for page in man/man7/liepoisson.7 man/man1/lpi.1; do
     copyright=$(section "$root/$page" COPYRIGHT | sed 's/\\-/-/g')
-    echo "$copyright" | grep -q 'BSD-3-Clause' && echo "$copyright" | grep -q 'LICENSE' ||
+    printf '%s\n' "$copyright" | grep -q 'BSD-3-Clause' && printf '%s\n' "$copyright" | grep -q 'LICENSE' ||
         complain "$page: COPYRIGHT must name BSD-3-Clause and the file LICENSE"
 done
 
 # ---- Examples: every family page has one, and it compiles -----------------
 cc=${CC:-cc}
 programs=""
+examples_checked=compile
 for page in "$root"/man/man3/*.3; do
     [ -L "$page" ] && continue
     rel=${page#"$root/"}
@@ -112,14 +117,14 @@ for page in "$root"/man/man3/*.3; do
     # Every function behind the C API wrapper can return these three.
     errors=$(section "$page" ERRORS)
     for code in LPI_ERR_NULL LPI_ERR_NO_MEMORY LPI_ERR_INTERNAL; do
-        [ -z "$errors" ] || echo "$errors" | grep -q "^\.B $code\$" || complain "$rel: ERRORS does not list $code"
+        [ -z "$errors" ] || printf '%s\n' "$errors" | grep -q "^\.B $code\$" || complain "$rel: ERRORS does not list $code"
     done
     examples=$(section "$page" EXAMPLES)
     if [ -z "$examples" ]; then complain "$rel: no EXAMPLES section"; continue; fi
     # The program is the text of the .EX/.EE blocks with roff escapes undone;
     # a request inside a block would render differently from what compiles.
     program="$work/$(basename "$page" .3).c"
-    echo "$examples" | awk '/^\.EE/ { code = 0 } code { print } /^\.EX/ { code = 1 }' >"$program"
+    printf '%s\n' "$examples" | awk '/^\.EE/ { code = 0 } code { print } /^\.EX/ { code = 1 }' >"$program"
     if grep -q "^[.']" "$program"; then
         complain "$rel: a roff request inside an .EX block of EXAMPLES:"; grep -n "^[.']" "$program"
         continue
@@ -133,12 +138,46 @@ for page in "$root"/man/man3/*.3; do
     programs="$programs $program"
 done
 # One compiler run for all (its messages name the page: lpi_step.c is the
-# program of man3/lpi_step.3).
-# shellcheck disable=SC2086 # the file names have no spaces
-if [ -n "$programs" ] && ! out=$($cc -std=c99 -Wall -Wextra -Wpedantic -Werror -fsyntax-only \
+# program of man3/lpi_step.3): objects when they are to run, else a syntax
+# check.
+# shellcheck disable=SC2086 # the file names have no spaces; LPI_EXAMPLE_CFLAGS is a list
+if [ -n "$libdir" ]; then
+    compile="-c ${LPI_EXAMPLE_CFLAGS:-}"
+else
+    compile=-fsyntax-only
+fi
+# shellcheck disable=SC2086
+if [ -n "$programs" ] && ! out=$(cd "$work" && $cc -std=c99 -Wall -Wextra -Wpedantic -Werror $compile \
     -I "$root/include" $programs 2>&1); then
     complain "EXAMPLES programs that do not compile (NAME.c is the program of man3/NAME.3):"
-    echo "$out"
+    printf '%s\n' "$out"
+elif [ -n "$libdir" ]; then
+    examples_checked="compile and run"
+    # Linked against the built library and run, each in a directory of its
+    # own (some write files), all at once: an example that no longer works
+    # fails here.
+    for program in $programs; do
+        name=$(basename "$program" .c)
+        mkdir "$work/$name"
+        (
+            cd "$work/$name" || exit 1
+            # shellcheck disable=SC2086
+            if ! $cc ${LPI_EXAMPLE_CFLAGS:-} "$work/$name.o" -L "$libdir" -lliepoisson -lm \
+                -Wl,-rpath,"$libdir" -o example >log 2>&1; then
+                echo "does not link:" >failed
+            elif ! ./example >log 2>&1; then
+                echo "fails:" >failed
+            fi
+        ) &
+    done
+    wait
+    for program in $programs; do
+        name=$(basename "$program" .c)
+        if [ -f "$work/$name/failed" ]; then
+            complain "man/man3/$name.3: the EXAMPLES program $(cat "$work/$name/failed")"
+            cat "$work/$name/log"
+        fi
+    done
 fi
 
 # ---- Rendering: groff, mandoc's lint, and man -l from the source tree -----
@@ -155,7 +194,7 @@ have_mandoc=0; need_tool mandoc "the lint" && have_mandoc=1
 have_man=0; need_tool man "the man -l check" && have_man=1
 # Each tool reads every page in one run; their messages name the file.
 # shellcheck disable=SC2046 # the page names have no spaces
-set -- $(cd "$root" && for page in man/man*/*.[1-9]; do [ -L "$page" ] || echo "$page"; done)
+set -- $(cd "$root" && for page in man/man*/*.[1-9]; do [ -L "$page" ] || printf '%s\n' "$page"; done)
 out=$(cd "$root" && groff -man -ww -z "$@" 2>&1)
 [ -z "$out" ] || complain "groff: $out"
 if [ $have_mandoc -eq 1 ]; then
@@ -173,10 +212,10 @@ if [ $have_man -eq 1 ]; then
         for rel in "$@"; do
             out=$(man_l "$rel")
             if [ -s "$work/man.err" ]; then complain "man -l $rel:"; cat "$work/man.err"; fi
-            echo "$out" | grep -q '^NAME$' || complain "man -l $rel shows no NAME section"
+            printf '%s\n' "$out" | grep -q '^NAME$' || complain "man -l $rel shows no NAME section"
         done
     fi
 fi
 
-[ $status -eq 0 ] && echo "man pages: $(echo "$names" | wc -w) functions covered, examples compile, one date and version, all pages render cleanly"
+[ $status -eq 0 ] && echo "man pages: $(printf '%s\n' "$names" | wc -w) functions covered, examples $examples_checked, one date and version, all pages render cleanly"
 exit $status
