@@ -15,8 +15,8 @@
 #   tests/check_man_pages.sh SOURCE_DIR [LIBRARY_DIR]
 # With LIBRARY_DIR (where libliepoisson.so is) the examples are also linked
 # and run, and must exit 0. CC (default cc) compiles them, with
-# LPI_EXAMPLE_CFLAGS added when linking (a sanitized library needs its
-# runtime in the program too). man and mandoc are used when
+# LPI_EXAMPLE_CFLAGS added when they are built to run (a sanitized library
+# needs its runtime in the program too). man and mandoc are used when
 # installed (scripts/install-deps installs them); with CI=true a missing one
 # is a failure, so CI cannot pass without the lint.
 set -u
@@ -62,7 +62,7 @@ done
 # ---- Statuses: only real ones, and the full list on lpi_last_error(3) -----
 statuses=$(sed -n 's/^ *X(\(LPI_[A-Z_]*\), *[-+]\{0,1\}[0-9]*,.*/\1/p' "$header")
 [ -n "$statuses" ] || complain "no status codes found in the LPI_STATUS_LIST of $header"
-for used in $(cat "$root"/man/man*/*.[1-9] | grep -o 'LPI_ERR_[A-Z][A-Z_]*\|LPI_OK\|LPI_STOPPED' | sort -u); do
+for used in $(cat "$root"/man/man*/*.[1-9] | grep -o 'LPI_ERR_[A-Z][A-Z_]*\|LPI_OK' | sort -u); do
     printf '%s\n' "$statuses" | grep -qx "$used" || complain "the man pages name $used, which is not a status of the header"
 done
 for code in $statuses; do
@@ -106,7 +106,7 @@ for page in man/man7/liepoisson.7 man/man1/lpi.1; do
         complain "$page: COPYRIGHT must name BSD-3-Clause and the file LICENSE"
 done
 
-# ---- Examples: every family page has one, and it compiles -----------------
+# ---- Family pages: RETURN VALUE, ERRORS, an EXAMPLES program that works --
 cc=${CC:-cc}
 programs=""
 examples_checked=compile
@@ -139,8 +139,7 @@ for page in "$root"/man/man3/*.3; do
 done
 # One compiler run for all (its messages name the page: lpi_step.c is the
 # program of man3/lpi_step.3): objects when they are to run, else a syntax
-# check.
-# shellcheck disable=SC2086 # the file names have no spaces; LPI_EXAMPLE_CFLAGS is a list
+# check. The file names have no spaces; LPI_EXAMPLE_CFLAGS is a list.
 if [ -n "$libdir" ]; then
     compile="-c ${LPI_EXAMPLE_CFLAGS:-}"
 else
