@@ -84,7 +84,7 @@ for page in "$root"/man/man*/*.[1-9]; do
     sec=$(printf '%s\n' "$th" | awk '{ print $3 }')
     date=$(printf '%s\n' "$th" | awk '{ print $4 }')
     source=$(printf '%s\n' "$th" | sed -n 's/^\.TH [^ ]* [^ ]* [^ ]* "\([^"]*\)" "liepoisson manual"$/\1/p')
-    expected_title=$(printf '%s\n' "${base%.*}" | tr 'a-z' 'A-Z')
+    expected_title=$(printf '%s\n' "${base%.*}" | tr '[:lower:]' '[:upper:]')
     [ "$title" = "$expected_title" ] || complain "$rel: .TH title $title, expected $expected_title"
     [ "$sec" = "${base##*.}" ] || complain "$rel: .TH section $sec, expected ${base##*.}"
     printf '%s\n' "$date" | grep -qx '[0-9]\{4\}-[0-9][0-9]-[0-9][0-9]' || complain "$rel: .TH date '$date' is not YYYY-MM-DD"
@@ -102,8 +102,9 @@ fi
 head -n1 "$root/LICENSE" | grep -q '^BSD 3-Clause License$' || complain "LICENSE is not the BSD 3-Clause text"
 for page in man/man7/liepoisson.7 man/man1/lpi.1; do
     copyright=$(section "$root/$page" COPYRIGHT | sed 's/\\-/-/g')
-    printf '%s\n' "$copyright" | grep -q 'BSD-3-Clause' && printf '%s\n' "$copyright" | grep -q 'LICENSE' ||
+    if ! printf '%s\n' "$copyright" | grep -q 'BSD-3-Clause' || ! printf '%s\n' "$copyright" | grep -q 'LICENSE'; then
         complain "$page: COPYRIGHT must name BSD-3-Clause and the file LICENSE"
+    fi
 done
 
 # ---- Family pages: RETURN VALUE, ERRORS, an EXAMPLES program that works --
