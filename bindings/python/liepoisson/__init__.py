@@ -221,6 +221,21 @@ _HAVE_OBSERVER = "lpi_set_observer" not in _lib.MISSING
 _OBSERVE_SECONDS = 0.05
 
 
+def _dividing_cadence(every, wanted):
+    """The library observer's cadence when a caller's observer (every) and the
+    SIGINT watch (about wanted steps) share it: a divisor of every, so that the
+    caller's steps are all observed, near wanted, else every itself (then
+    Ctrl-C is looked for at the caller's observations only)."""
+    if every <= wanted:
+        return every
+    parts = -(-every // wanted)  # the fewest parts of at most wanted steps
+    # cadences from wanted down to about wanted / 2, trying at most 64
+    for n in range(parts, min(2 * parts, parts + 63) + 1):
+        if every % n == 0:
+            return every // n
+    return every
+
+
 # ---- methods ----------------------------------------------------------------
 
 Method = collections.namedtuple("Method", "name order stages reference is_poisson")
@@ -448,25 +463,71 @@ class System:
     def time(self):
         return lib.lpi_time(self._h())
 
-    def step(self, dt, nsteps=1):
-        """Advances nsteps steps of size dt. On failure the state is unchanged.
+    def step(self, dt, nsteps=1, *, observer=None, every=1):
+        """Advance the system by `nsteps` steps of size `dt`.
 
-        Ctrl-C (SIGINT) during a long step: with a library that has
-        lpi_set_observer, the step stops within about _OBSERVE_SECONDS and the
-        SIGINT handler runs there (KeyboardInterrupt by default), the system
-        holding exactly the state of a call of the steps done (see .time);
-        otherwise the handler runs when the whole call returns. Either way the
-        bits of a step that is not interrupted do not depend on timing."""
+        Parameters
+        ----------
+        dt : float
+            The step size: finite and nonzero; negative integrates backwards.
+        nsteps : int, optional
+            The number of steps, >= 0 (default 1).
+        observer : callable, optional
+            ``observer(system, step, t)``, called after every `every`-th step
+            with this system, the number of steps done so far in this call and
+            the time reached. The system then holds exactly the state a call of
+            `step` steps would leave, and observing changes no bit of the
+            trajectory. The observer may read the system (state, energy,
+            Casimirs, ``save``); changing it raises `BusyError`. A truthy return
+            stops the run after that step; an exception stops it there too and
+            then propagates from ``step``.
+        every : int, optional
+            Steps between two calls of `observer`, >= 1 (default 1).
+
+        Returns
+        -------
+        int
+            The number of steps done: `nsteps`, or fewer when the observer (or
+            Ctrl-C) stopped the run; ``time`` has then advanced by that many
+            steps.
+
+        Raises
+        ------
+        NonFiniteError, CallbackError
+            A step failed; the state and time are those before the call.
+        UnsupportedError
+            `observer` given, but the loaded library has no lpi_set_observer.
+
+        Notes
+        -----
+        Ctrl-C (SIGINT) during a long call: with a library that has
+        lpi_set_observer, the run stops within about a twentieth of a second
+        and the SIGINT handler runs there (``KeyboardInterrupt`` by default),
+        the system holding exactly the state of a call of the steps done;
+        otherwise the handler runs when the whole call returns. With an
+        observer, Ctrl-C is looked for at a cadence that divides `every` (at
+        the observer's own calls when no such cadence is near the wanted one).
+        """
         dt = _real(dt, "dt")
         nsteps = _integer(nsteps, "nsteps", "int64")
+        every = _integer(every, "every", "int64")
+        if every < 1:
+            raise ValueError("every must be >= 1, not %d" % every)
+        if observer is not None:
+            if not callable(observer):
+                raise TypeError("observer must be callable, not %s" % type(observer).__name__)
+            if not _HAVE_OBSERVER:
+                _raise(STATUS["LPI_ERR_UNSUPPORTED"], "the loaded library has no lpi_set_observer")
         started = time.perf_counter()
-        every = self._observation_interval(nsteps)
-        if every:
-            self._step_observing_sigint(dt, nsteps, every)
-        else:
+        sigint_every = self._observation_interval(nsteps)
+        if observer is None and not sigint_every:
             self._call("lpi_step", dt, nsteps)
-        if nsteps > 0:
-            self._seconds_per_step = (time.perf_counter() - started) / nsteps
+            done = nsteps
+        else:
+            done = self._step_observed(dt, nsteps, observer, every, sigint_every)
+        if done > 0:
+            self._seconds_per_step = (time.perf_counter() - started) / done
+        return done
 
     def _observation_interval(self, nsteps):
         """Steps between looks for a SIGINT during step(), or 0 for none: the
@@ -488,40 +549,55 @@ class System:
             return 0
         return max(1, min(nsteps, int(_OBSERVE_SECONDS / max(seconds, 1e-12))))
 
-    def _step_observing_sigint(self, dt, nsteps, every):
+    def _step_observed(self, dt, nsteps, observer, every, sigint_every):
+        """lpi_step under one library observer that serves both the caller's
+        observer (at the multiples of every) and the SIGINT watch (about every
+        sigint_every steps; 0: none). Returns the steps done."""
+        if observer is None:
+            cadence = sigint_every
+        elif sigint_every:
+            cadence = _dividing_cadence(every, sigint_every)
+        else:
+            cadence = every
         # SIGINT only sets a flag during the call; the observer runs the
         # handler that was in place, and stops the step if that raised.
-        received, raised = [], []
-        previous = signal.getsignal(signal.SIGINT)
+        received, raised, stopped_at = [], [], []
+        previous = signal.getsignal(signal.SIGINT) if sigint_every else None
 
         def run_previous_handler():
             del received[:]
             previous(signal.SIGINT, None)
 
-        def observe(sys, step, t, user):
-            if not received:
-                return 0
+        def observe(handle, step, t, user):
             try:
-                run_previous_handler()
+                if received:
+                    run_previous_handler()
+                if observer is not None and step % every == 0 and observer(self, step, t):
+                    stopped_at.append(step)
+                    return 1
             except BaseException as e:  # noqa: B902 - must not cross into C
                 raised.append(e)
+                stopped_at.append(step)
                 return 1
             return 0
 
-        observer = _lib.OBSERVER_FN(observe)
-        signal.signal(signal.SIGINT, lambda signum, frame: received.append(signum))
+        c_observer = _lib.OBSERVER_FN(observe)
+        if sigint_every:
+            signal.signal(signal.SIGINT, lambda signum, frame: received.append(signum))
         try:
-            self._call("lpi_set_observer", every, observer, None)
+            self._call("lpi_set_observer", cadence, c_observer, None)
             try:
                 self._call("lpi_step", dt, nsteps)
             finally:
                 lib.lpi_set_observer(self._handle, 0, _lib.OBSERVER_FN(), None)  # NULL: removed
         finally:
-            signal.signal(signal.SIGINT, previous)
+            if sigint_every:
+                signal.signal(signal.SIGINT, previous)
         if raised:
             raise raised[0]
         if received:  # arrived after the last observation
             run_previous_handler()
+        return stopped_at[0] if stopped_at else nsteps
 
     def energy(self):
         out = c_double()
