@@ -53,8 +53,11 @@ bench: build
 	@cmake --build $(BUILD) -j $(JOBS) $(BUILD_ARGS) --target benchmarks
 	@for b in $(BUILD)/tests/bench/bench_*; do [ -x "$$b" ] && "$$b"; done
 
+# Quiet, but says where the Python package went (and whether python3 finds it).
 install: build
-	@DESTDIR="$(DESTDIR)" cmake --install $(BUILD) --prefix $(PREFIX) $(STATUS_OUT)
+	@DESTDIR="$(DESTDIR)" cmake --install $(BUILD) --prefix $(PREFIX) >$(BUILD)/install.log || \
+	    { cat $(BUILD)/install.log; exit 1; }
+	@if [ "$(V)" = 0 ]; then sed -n 's/^-- liepoisson: //p' $(BUILD)/install.log; else cat $(BUILD)/install.log; fi
 	@echo "liepoisson $(VERSION) installed in $(DESTDIR)$(PREFIX)"
 
 abi-baseline: build
