@@ -13,10 +13,12 @@ off) and plain lists otherwise; inputs may be any sequence.
 """
 import collections
 import ctypes
+import math
 import numbers
 import operator
 import os
 import signal
+import sys
 import threading
 import time
 import weakref
@@ -37,7 +39,7 @@ HAVE_NUMPY = np is not None
 
 __all__ = [
     "version", "methods", "Method", "status_name", "status_message", "HAVE_NUMPY",
-    "System", "RigidBody", "Pendulum", "Generic", "Moments", "SineEuler",
+    "System", "Trajectory", "RigidBody", "Pendulum", "Generic", "Moments", "SineEuler",
     "load", "load_bytes", "fftw_wisdom_import_file", "fftw_wisdom_export_file",
     "fftw_wisdom_import_string", "fftw_wisdom_export_string",
     "LiePoissonError",
@@ -310,6 +312,34 @@ def _callback_view(ptr, n):
 
 # ---- systems ------------------------------------------------------------------
 
+class Trajectory:
+    """States recorded by `System.integrate` at the requested times.
+
+    Attributes
+    ----------
+    t : numpy.ndarray or list of float
+        The times reached, shape ``(m,)``.
+    y : numpy.ndarray or list of list of float
+        The states, one row per time: shape ``(m, dim)``.
+    energy : numpy.ndarray or list of float or None
+        The energy at each time, when asked for.
+    casimirs : numpy.ndarray or list of list of float or None
+        The Casimirs at each time (shape ``(m, casimir_count)``), when asked for.
+    """
+
+    __slots__ = ("t", "y", "energy", "casimirs")
+
+    def __init__(self, t, y, energy=None, casimirs=None):
+        self.t, self.y, self.energy, self.casimirs = t, y, energy, casimirs
+
+    def __len__(self):
+        return len(self.t)
+
+    def __repr__(self):
+        return "<Trajectory of %d times%s%s>" % (len(self.t), ", energy" if self.energy is not None else "",
+                                                 ", casimirs" if self.casimirs is not None else "")
+
+
 def _destroy(handle, keep):
     # keep holds the ctypes callbacks until the handle that calls them is gone.
     status = lib.lpi_destroy(handle)
@@ -529,6 +559,94 @@ class System:
             self._seconds_per_step = (time.perf_counter() - started) / done
         return done
 
+    def integrate(self, t_eval, dt, *, energy=False, casimirs=False):
+        """Integrate with fixed steps through the times `t_eval`, keeping the states there.
+
+        Like ``scipy.integrate.solve_ivp(..., t_eval=...)`` with a fixed step:
+        the system starts from its current state and time and ends at the last
+        requested time.
+
+        Parameters
+        ----------
+        t_eval : sequence of float
+            The times at which to record the state, in the direction of `dt`
+            (non-decreasing for dt > 0, non-increasing for dt < 0), none before
+            the current time. Each must be a whole number of steps from the
+            current time (to a millionth of a step, or the rounding of a long
+            run): the step is not stretched to meet a time.
+        dt : float
+            The step size, finite and nonzero.
+        energy : bool, optional
+            Also record the energy at each time (default False).
+        casimirs : bool, optional
+            Also record the Casimirs at each time (default False).
+
+        Returns
+        -------
+        Trajectory
+            ``.t`` the times reached (``t_eval`` up to the rounding of the
+            library's time), ``.y`` the states, one row per time (shape
+            ``(len(t), dim)``; note: scipy's ``.y`` is the transpose),
+            ``.energy`` and ``.casimirs`` when asked for (else None).
+
+        Raises
+        ------
+        ValueError
+            A time is not a whole number of steps from the current time, or
+            lies behind the previous one; nothing has been stepped then.
+        NonFiniteError, CallbackError
+            A step failed: the system holds the state of the last requested
+            time reached.
+
+        Examples
+        --------
+        >>> body = RigidBody(1.0, 2.0, 3.0)
+        >>> body.state = [1.0, 0.5, -0.3]
+        >>> sol = body.integrate([0.0, 0.5, 1.0], 0.01, casimirs=True)
+        >>> len(sol.t), len(sol.y[0])
+        (3, 3)
+        """
+        dt = _real(dt, "dt")
+        if not math.isfinite(dt) or dt == 0.0:
+            raise ValueError("dt must be finite and nonzero, not %r" % dt)
+        times = [_real(t, "t_eval entry") for t in (t_eval.tolist() if np is not None
+                                                   and isinstance(t_eval, np.ndarray) else t_eval)]
+        start = self.time
+        counts, previous = [], 0
+        for t in times:
+            exact = (t - start) / dt
+            n = round(exact) if math.isfinite(exact) else -1
+            if abs(exact - n) > max(1e-6, 8 * sys.float_info.epsilon * abs(exact)):
+                raise ValueError("t_eval entry %r is %.6g steps of %r from the time %r: not a whole number"
+                                 % (t, exact, dt, start))
+            if n < previous:
+                raise ValueError("t_eval entry %r lies behind %s (steps of %r from the time %r)"
+                                 % (t, "the previous one" if counts else "the current time", dt, start))
+            counts.append(n)
+            previous = n
+        dim, ncas = self.dim, self.casimir_count
+        out_t = [0.0] * len(times)
+        out_e = [0.0] * len(times) if energy else None
+        if np is not None:
+            out_y = np.empty((len(times), dim))
+            out_c = np.empty((len(times), ncas)) if casimirs else None
+        else:
+            out_y, out_c = [None] * len(times), ([None] * len(times) if casimirs else None)
+        done = 0
+        for i, n in enumerate(counts):
+            if n > done:
+                done += self.step(dt, n - done)
+            out_t[i] = self.time
+            out_y[i] = self.get_state(out_y[i] if np is not None else None)
+            if energy:
+                out_e[i] = self.energy()
+            if casimirs:
+                out_c[i] = self.casimirs(out_c[i] if np is not None else None)
+        if np is not None:
+            out_t = np.array(out_t)
+            out_e = np.array(out_e) if energy else None
+        return Trajectory(out_t, out_y, out_e, out_c)
+
     def _observation_interval(self, nsteps):
         """Steps between looks for a SIGINT during step(), or 0 for none: the
         call is short, the library has no observer, this is not the main
@@ -648,6 +766,45 @@ class System:
         self._finalizer = weakref.finalize(self, _destroy, handle, self._keep)
         return self
 
+    # copies and pickles go through a checkpoint
+    def __reduce__(self):
+        """Pickle support: the system as its checkpoint bytes (lpi_save_buffer).
+
+        Returns
+        -------
+        tuple
+            ``(_from_checkpoint, (bytes, method, split, threads))``; unpickling
+            restores an independent system that continues the trajectory bit
+            for bit (observers are not kept).
+        """
+        return (_from_checkpoint, (self.save_bytes(), self._method, self._split, self._threads))
+
+    def __copy__(self):
+        """An independent system in the same state (through a checkpoint).
+
+        Returns
+        -------
+        System
+            A new handle of the same kind; stepping one leaves the other as it is.
+        """
+        restore, args = self.__reduce__()
+        return restore(*args)
+
+    def __deepcopy__(self, memo):
+        """The same as ``copy.copy``: a system shares nothing with its copy.
+
+        Parameters
+        ----------
+        memo : dict
+            The ``copy.deepcopy`` memo (unused).
+
+        Returns
+        -------
+        System
+            A new, independent handle.
+        """
+        return self.__copy__()
+
     def __repr__(self):
         if self.closed:
             return "<%s (closed)>" % type(self).__name__
@@ -743,6 +900,18 @@ class Generic(System):
         self._call("lpi_add_casimir", fn, None)
         self._keep.append(fn)
 
+    def __reduce__(self):
+        """Refuses: a checkpoint cannot hold Python callables.
+
+        Raises
+        ------
+        TypeError
+            Always, for pickle, ``copy.copy`` and ``copy.deepcopy`` alike.
+        """
+        raise TypeError("a %s system cannot be copied or pickled: its pieces and Casimirs are Python "
+                        "callables, which a checkpoint does not hold; build a new one and set its state"
+                        % type(self).__name__)
+
     def poisson_rank(self, x=None):
         """Numerical rank of the Poisson matrix at x (default: the current state)."""
         if x is None:
@@ -801,14 +970,30 @@ class SineEuler(System):
         return [[complex(buf[2 * (a * N + b)], buf[2 * (a * N + b) + 1]) for b in range(N)]
                 for a in range(N)]
 
+    def _check_square(self, shape, what):
+        """SizeError unless shape is (N, N): the library checks only the count,
+        which a (1, N*N) array or ragged rows would pass."""
+        N = self.N
+        if tuple(shape) != (N, N):
+            _raise(STATUS["LPI_ERR_SIZE"], "%s must be %d x %d, not of shape %s" % (what, N, N, tuple(shape)))
+
+    @staticmethod
+    def _rows_shape(rows):
+        rows = list(rows)
+        lengths = {len(r) for r in rows}
+        return (len(rows), lengths.pop()) if len(lengths) == 1 else (len(rows), "ragged")
+
     def set_modes(self, modes):
         """Sets the modes (checked Hermitian, then symmetrised); time reset to 0."""
         if np is not None:
             a = modes
             if not (isinstance(a, np.ndarray) and a.dtype == np.complex128 and a.flags.c_contiguous):
                 a = np.ascontiguousarray(_real_array(modes, "modes", "iufc"), dtype=np.complex128)
+            self._check_square(a.shape, "modes")
             self._call("lpi_sine_euler_set_modes", a.ctypes.data_as(_lib.c_double_p), 2 * a.size)
             return
+        modes = [list(row) for row in modes]
+        self._check_square(self._rows_shape(modes), "modes")
         flat = []
         for row in modes:
             for z in row:
@@ -834,8 +1019,12 @@ class SineEuler(System):
     def set_grid(self, w):
         """Sets the vorticity from its N x N grid values; time reset to 0."""
         if np is not None:
-            ptr, n, _keep = _doubles_in(_real_array(w, "grid").astype(np.float64).reshape(-1), "grid")
+            a = _real_array(w, "grid")
+            self._check_square(a.shape, "grid")
+            ptr, n, _keep = _doubles_in(a.astype(np.float64).reshape(-1), "grid")
         else:
+            w = [list(row) for row in w]
+            self._check_square(self._rows_shape(w), "grid")
             ptr, n, _keep = _doubles_in([v for row in w for v in row], "grid")
         self._call("lpi_sine_euler_set_grid", ptr, n)
 
@@ -871,6 +1060,16 @@ def load(path):
     handle = ctypes.c_void_p()
     _check_free(lib.lpi_load(byref(handle), _c_path(path)))
     return System._adopt(handle)
+
+
+def _from_checkpoint(data, method, split, threads):
+    """A system from checkpoint bytes with the Python-side settings of the
+    system it was saved from (the library restores method and split itself)."""
+    system = load_bytes(data)
+    system._method, system._split = method, split
+    if threads != 1:
+        system.threads = threads
+    return system
 
 
 def load_bytes(data):
