@@ -70,8 +70,8 @@ clean:
 # suite's run time reasonable while reports still carry lines. The tests that
 # load the library into an uninstrumented host (the Python interpreter, a
 # gfortran program, outside programs built against an install, the Python
-# and Fortran examples) cannot run
-# with the ASan runtime and are left out here; they run in `make check`.
+# and Fortran examples) cannot run with the ASan runtime and are left out
+# here; they run in `make check`.
 ASAN_EXCLUDE = ^test_python_|^test_fortran$$|^test_install$$|^example_python$$|^example_fortran$$
 check-asan: deps
 	@cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLPI_SANITIZE=ON $(OUTPUT_ARGS) $(CMAKE_ARGS) $(STATUS_OUT)
