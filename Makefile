@@ -53,8 +53,11 @@ bench: build
 	@cmake --build $(BUILD) -j $(JOBS) $(BUILD_ARGS) --target benchmarks
 	@for b in $(BUILD)/tests/bench/bench_*; do [ -x "$$b" ] && "$$b"; done
 
+# Quiet, but says where the Python package went (and whether python3 finds it).
 install: build
-	@DESTDIR="$(DESTDIR)" cmake --install $(BUILD) --prefix $(PREFIX) $(STATUS_OUT)
+	@DESTDIR="$(DESTDIR)" cmake --install $(BUILD) --prefix $(PREFIX) >$(BUILD)/install.log || \
+	    { cat $(BUILD)/install.log; exit 1; }
+	@if [ "$(V)" = 0 ]; then sed -n 's/^-- liepoisson: //p' $(BUILD)/install.log; else cat $(BUILD)/install.log; fi
 	@echo "liepoisson $(VERSION) installed in $(DESTDIR)$(PREFIX)"
 
 abi-baseline: build
@@ -66,9 +69,10 @@ clean:
 # Sanitized builds live in their own directories. RelWithDebInfo keeps the
 # suite's run time reasonable while reports still carry lines. The tests that
 # load the library into an uninstrumented host (the Python interpreter, a
-# gfortran program, outside programs built against an install) cannot run
-# with the ASan runtime and are left out here; they run in `make check`.
-ASAN_EXCLUDE = ^test_python_|^test_fortran$$|^test_install$$
+# gfortran program, outside programs built against an install, the Python
+# and Fortran examples) cannot run with the ASan runtime and are left out
+# here; they run in `make check`.
+ASAN_EXCLUDE = ^test_python_|^test_fortran$$|^test_install$$|^example_python$$|^example_fortran$$
 check-asan: deps
 	@cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLPI_SANITIZE=ON $(OUTPUT_ARGS) $(CMAKE_ARGS) $(STATUS_OUT)
 	@cmake --build build-asan -j $(JOBS) $(BUILD_ARGS)

@@ -10,17 +10,32 @@ off) and plain lists otherwise; inputs may be any sequence.
         body.state = [1.0, 0.5, -0.3]
         body.step(0.01, 1000)
         print(body.time, body.energy(), body.casimirs())
+
+Attributes
+----------
+version : str
+    The loaded library's version, "MAJOR.MINOR.PATCH" (also ``__version__``).
+HAVE_NUMPY : bool
+    True when arrays are numpy arrays.
+STATUS : dict
+    The status codes by name, read from the library; each is also a module
+    attribute (``LPI_OK``, ``LPI_ERR_SIZE``, ..., ``LPI_STOPPED``).
 """
+from __future__ import annotations
+
 import collections
 import ctypes
+import math
 import numbers
 import operator
 import os
 import signal
+import sys
 import threading
 import time
 import weakref
 from ctypes import byref, c_double, c_int32, c_size_t
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 from . import _lib
 from ._lib import lib
@@ -35,9 +50,19 @@ if not os.environ.get("LIEPOISSON_NO_NUMPY"):
 #: True when arrays are numpy arrays (numpy importable and not turned off).
 HAVE_NUMPY = np is not None
 
+# Type aliases: numpy is optional, so arrays are typed loosely.
+#: An array argument: a sequence of real numbers, or a numpy array.
+ArrayIn = Any
+#: An array result: a numpy array with numpy, else a list.
+ArrayOut = Any
+#: A file name.
+PathLike = Union[str, bytes, os.PathLike]
+#: ``observer(system, step, t)`` of `System.step`; a truthy return stops the run.
+Observer = Callable[["System", int, float], Any]
+
 __all__ = [
     "version", "methods", "Method", "status_name", "status_message", "HAVE_NUMPY",
-    "System", "RigidBody", "Pendulum", "Generic", "Moments", "SineEuler",
+    "System", "Trajectory", "RigidBody", "Pendulum", "Generic", "Moments", "SineEuler",
     "load", "load_bytes", "fftw_wisdom_import_file", "fftw_wisdom_export_file",
     "fftw_wisdom_import_string", "fftw_wisdom_export_string",
     "LiePoissonError",
@@ -106,8 +131,20 @@ version = _text(lib.lpi_version_string())
 __version__ = version
 
 
-def status_name(status):
-    """"LPI_ERR_SIZE" for -3, "LPI_UNKNOWN_STATUS" for a value that is no status."""
+def status_name(status: int) -> str:
+    """The name of a status code.
+
+    Parameters
+    ----------
+    status : int
+        A status returned by the library.
+
+    Returns
+    -------
+    str
+        ``"LPI_ERR_SIZE"`` for -3; ``"LPI_UNKNOWN_STATUS"`` for a value that is
+        no status.
+    """
     status = _integer(status, "status", "int")
     name = _text(lib.lpi_status_name(status))
     if name == "LPI_UNKNOWN_STATUS" and status in _KNOWN_AHEAD:
@@ -115,8 +152,19 @@ def status_name(status):
     return name
 
 
-def status_message(status):
-    """The one-line description of a status code."""
+def status_message(status: int) -> str:
+    """The one-line description of a status code.
+
+    Parameters
+    ----------
+    status : int
+        A status returned by the library.
+
+    Returns
+    -------
+    str
+        The library's description of `status`.
+    """
     status = _integer(status, "status", "int")
     if status in _KNOWN_AHEAD and _text(lib.lpi_status_name(status)) == "LPI_UNKNOWN_STATUS":
         return _KNOWN_AHEAD[status][1]
@@ -126,11 +174,30 @@ def status_message(status):
 # ---- exceptions: one class per status, built from the library's own list ----
 
 class LiePoissonError(Exception):
-    """A liepoisson call failed. .status is the code (negative), .status_name
-    its name ("LPI_ERR_SIZE") and .message the library's detailed message."""
+    """A liepoisson call failed.
+
+    Each failing status raises its own subclass (`SizeError`, `FileError`,
+    ...); a status this binding does not know raises this class itself.
+
+    Parameters
+    ----------
+    status : int
+        The status code (negative).
+    message : str
+        The library's detailed message.
+
+    Attributes
+    ----------
+    status : int
+        The status code.
+    status_name : str
+        Its name, such as ``"LPI_ERR_SIZE"``.
+    message : str
+        The library's detailed message (what was wrong, where).
+    """
     status = None
 
-    def __init__(self, status, message):
+    def __init__(self, status: int, message: str) -> None:
         self.status = status
         self.status_name = status_name(status)
         self.message = message
@@ -221,13 +288,49 @@ _HAVE_OBSERVER = "lpi_set_observer" not in _lib.MISSING
 _OBSERVE_SECONDS = 0.05
 
 
+def _dividing_cadence(every, wanted):
+    """The library observer's cadence when a caller's observer (every) and the
+    SIGINT watch (about wanted steps) share it: a divisor of every, so that the
+    caller's steps are all observed, near wanted, else every itself (then
+    Ctrl-C is looked for at the caller's observations only)."""
+    if every <= wanted:
+        return every
+    parts = -(-every // wanted)  # the fewest parts of at most wanted steps
+    # cadences from wanted down to about wanted / 2, trying at most 64
+    for n in range(parts, min(2 * parts, parts + 63) + 1):
+        if every % n == 0:
+            return every // n
+    return every
+
+
 # ---- methods ----------------------------------------------------------------
 
 Method = collections.namedtuple("Method", "name order stages reference is_poisson")
+Method.__doc__ = """A registered method, as `methods` lists it.
+
+Attributes
+----------
+name : str
+    What `System.set_method` takes.
+order : int
+    The order of accuracy.
+stages : int
+    Leapfrog stages per step (1 for the sequences and rk4).
+reference : str
+    The publication it comes from.
+is_poisson : bool
+    True for a Poisson integrator (keeps the Casimirs to round-off).
+"""
 
 
-def methods():
-    """The registered methods, in the library's order."""
+def methods() -> List[Method]:
+    """The registered methods, in the library's order.
+
+    Returns
+    -------
+    list of Method
+        Named tuples ``(name, order, stages, reference, is_poisson)``.
+    """
     out = []
     for i in range(lib.lpi_method_count()):
         out.append(Method(_text(lib.lpi_method_name(i)), lib.lpi_method_order(i),
@@ -295,6 +398,40 @@ def _callback_view(ptr, n):
 
 # ---- systems ------------------------------------------------------------------
 
+class Trajectory:
+    """States recorded by `System.integrate` at the requested times.
+
+    Parameters
+    ----------
+    t, y, energy, casimirs : array_like or None
+        The attributes below.
+
+    Attributes
+    ----------
+    t : numpy.ndarray or list of float
+        The times reached, shape ``(m,)``.
+    y : numpy.ndarray or list of list of float
+        The states, one row per time: shape ``(m, dim)``.
+    energy : numpy.ndarray or list of float or None
+        The energy at each time, when asked for.
+    casimirs : numpy.ndarray or list of list of float or None
+        The Casimirs at each time (shape ``(m, casimir_count)``), when asked for.
+    """
+
+    __slots__ = ("t", "y", "energy", "casimirs")
+
+    def __init__(self, t: ArrayOut, y: ArrayOut, energy: Optional[ArrayOut] = None,
+                 casimirs: Optional[ArrayOut] = None) -> None:
+        self.t, self.y, self.energy, self.casimirs = t, y, energy, casimirs
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def __repr__(self):
+        return "<Trajectory of %d times%s%s>" % (len(self.t), ", energy" if self.energy is not None else "",
+                                                 ", casimirs" if self.casimirs is not None else "")
+
+
 def _destroy(handle, keep):
     # keep holds the ctypes callbacks until the handle that calls them is gone.
     status = lib.lpi_destroy(handle)
@@ -304,10 +441,22 @@ def _destroy(handle, keep):
 
 
 class System:
-    """A handle to one integrated system. Use a subclass to create one; close()
-    (or a with block, or garbage collection) releases it."""
+    """A handle to one integrated system.
 
-    def __init__(self, create, *args):
+    Create one through a subclass (`RigidBody`, `Pendulum`, `Generic`,
+    `Moments`, `SineEuler`) or `load`; ``close()``, a ``with`` block or garbage
+    collection releases it. ``copy.copy``, ``copy.deepcopy`` and pickle give
+    independent systems through a checkpoint.
+
+    Parameters
+    ----------
+    create : str
+        The library's ``lpi_*_create`` function (for subclasses).
+    args : tuple
+        Its arguments after the handle.
+    """
+
+    def __init__(self, create: str, *args: Any) -> None:
         handle = ctypes.c_void_p()
         _check_free(getattr(lib, create)(byref(handle), *args))
         self._handle = handle
@@ -320,8 +469,8 @@ class System:
         self._finalizer = weakref.finalize(self, _destroy, handle, self._keep)
 
     # lifetime
-    def close(self):
-        """Releases the handle now (idempotent).
+    def close(self) -> None:
+        """Release the handle now (idempotent).
 
         Raises
         ------
@@ -338,7 +487,14 @@ class System:
             _raise(status, _text(lib.lpi_last_error(self._handle)))
 
     @property
-    def closed(self):
+    def closed(self) -> bool:
+        """Whether the handle has been released.
+
+        Returns
+        -------
+        bool
+            True after `close`.
+        """
         return not self._finalizer.alive
 
     def __enter__(self):
@@ -367,106 +523,356 @@ class System:
         return status
 
     @property
-    def last_error(self):
-        """The message of the most recent failed call on this system ("" if none)."""
+    def last_error(self) -> str:
+        """The message of the most recent failed call on this system.
+
+        Returns
+        -------
+        str
+            The message, ``""`` if no call failed.
+        """
         return _text(lib.lpi_last_error(self._h()))
 
     # method and split
     @property
-    def method(self):
-        """The method's name ("leapfrog" until set; "custom" after set_composition)."""
+    def method(self) -> Optional[str]:
+        """The method's name.
+
+        Returns
+        -------
+        str or None
+            ``"leapfrog"`` until set, ``"custom"`` after `set_composition`,
+            None for a system from `load` (which still steps with the saved
+            method).
+        """
         return self._method
 
     @method.setter
-    def method(self, name):
+    def method(self, name: str) -> None:
         self.set_method(name)
 
-    def set_method(self, name):
+    def set_method(self, name: str) -> None:
+        """Choose the integration method.
+
+        Parameters
+        ----------
+        name : str
+            A name from `methods`, or ``"triple-jump-<p>"`` / ``"suzuki-<p>"``
+            for even p from 2 to 16.
+
+        Raises
+        ------
+        InvalidArgumentError
+            An unknown name; the method is unchanged.
+        """
         self._call("lpi_set_method", _c_string(name, "method"))
         self._method = name
 
     @property
-    def split(self):
-        """The split's name, or None for the system's default."""
+    def split(self) -> Optional[str]:
+        """The split's name.
+
+        Returns
+        -------
+        str or None
+            The name set, or None for the system's default split.
+        """
         return self._split
 
     @split.setter
-    def split(self, name):
+    def split(self, name: str) -> None:
         self.set_split(name)
 
-    def set_split(self, name):
+    def set_split(self, name: str) -> None:
+        """Choose how the Hamiltonian is split into pieces.
+
+        Parameters
+        ----------
+        name : str
+            A split of this system (the rigid body: ``"casimir-shift"``,
+            ``"axes"``).
+
+        Raises
+        ------
+        InvalidArgumentError
+            A split this system does not have; the split is unchanged.
+        """
         self._call("lpi_set_split", _c_string(name, "split"))
         self._split = name
 
-    def set_composition(self, gammas):
-        """A symmetric composition of leapfrog with weights gammas (method "custom")."""
+    def set_composition(self, gammas: ArrayIn) -> None:
+        """Use a symmetric composition of leapfrog (method ``"custom"``).
+
+        Parameters
+        ----------
+        gammas : sequence of float
+            The weights of the leapfrog stages, symmetric, summing to 1.
+        """
         ptr, n, _keep = _doubles_in(gammas, "gammas")
         self._call("lpi_set_composition", n, ptr)
         self._method = "custom"
 
-    def flows_per_step(self):
+    def flows_per_step(self) -> int:
+        """The number of piece flows one step computes.
+
+        Returns
+        -------
+        int
+            Flows per step with the current method and split.
+        """
         out = c_size_t()
         self._call("lpi_flows_per_step", byref(out))
         return out.value
 
-    def set_implicit_options(self, tolerance=1e-13, max_iterations=100):
+    def set_implicit_options(self, tolerance: float = 1e-13, max_iterations: int = 100) -> None:
+        """Set the fixed-point iteration of the implicit baselines.
+
+        Parameters
+        ----------
+        tolerance : float, optional
+            The iteration stops when a correction is below this (default 1e-13).
+        max_iterations : int, optional
+            Iterations before `NoConvergenceError` (default 100).
+        """
         self._call("lpi_set_implicit_options", _real(tolerance, "tolerance"),
                    _integer(max_iterations, "max_iterations", "int32"))
 
     @property
-    def threads(self):
+    def threads(self) -> int:
+        """The number of threads a step may use (sine-Euler).
+
+        Returns
+        -------
+        int
+            The count set (default 1).
+        """
         return self._threads
 
     @threads.setter
-    def threads(self, n):
+    def threads(self, n: int) -> None:
         n = _integer(n, "threads", "int32")
         self._call("lpi_set_threads", n)
         self._threads = n
 
     # state
     @property
-    def dim(self):
+    def dim(self) -> int:
+        """The dimension of the state vector.
+
+        Returns
+        -------
+        int
+            The number of state entries.
+        """
         return lib.lpi_dim(self._h())
 
     def __len__(self):
         return self.dim
 
-    def get_state(self, out=None):
+    def get_state(self, out: Optional[ArrayOut] = None) -> ArrayOut:
+        """The current state.
+
+        Parameters
+        ----------
+        out : numpy.ndarray, optional
+            A writeable C-contiguous float64 array of `dim` entries to fill.
+
+        Returns
+        -------
+        numpy.ndarray or list of float
+            The state (`out` when given).
+        """
         n = self.dim
         ptr, result = _doubles_out(n, out)
         self._call("lpi_get_state", ptr, n)
         return result()
 
-    def set_state(self, x):
-        """Sets the state (length dim) and resets the time to 0."""
+    def set_state(self, x: ArrayIn) -> None:
+        """Set the state and reset the time to 0.
+
+        Parameters
+        ----------
+        x : sequence of float
+            `dim` real numbers.
+
+        Raises
+        ------
+        SizeError
+            Not `dim` numbers; the state is unchanged.
+        TypeError
+            Not real numbers (strings, complex numbers, booleans).
+        """
         ptr, n, _keep = _doubles_in(x, "state")
         self._call("lpi_set_state", ptr, n)
 
     state = property(get_state, set_state)
 
     @property
-    def time(self):
+    def time(self) -> float:
+        """The current time.
+
+        Returns
+        -------
+        float
+            The time reached; `set_state` resets it to 0.
+        """
         return lib.lpi_time(self._h())
 
-    def step(self, dt, nsteps=1):
-        """Advances nsteps steps of size dt. On failure the state is unchanged.
+    def step(self, dt: float, nsteps: int = 1, *, observer: Optional[Observer] = None,
+             every: int = 1) -> int:
+        """Advance the system by `nsteps` steps of size `dt`.
 
-        Ctrl-C (SIGINT) during a long step: with a library that has
-        lpi_set_observer, the step stops within about _OBSERVE_SECONDS and the
-        SIGINT handler runs there (KeyboardInterrupt by default), the system
-        holding exactly the state of a call of the steps done (see .time);
-        otherwise the handler runs when the whole call returns. Either way the
-        bits of a step that is not interrupted do not depend on timing."""
+        Parameters
+        ----------
+        dt : float
+            The step size: finite and nonzero; negative integrates backwards.
+        nsteps : int, optional
+            The number of steps, >= 0 (default 1).
+        observer : callable, optional
+            ``observer(system, step, t)``, called after every `every`-th step
+            with this system, the number of steps done so far in this call and
+            the time reached. The system then holds exactly the state a call of
+            `step` steps would leave, and observing changes no bit of the
+            trajectory. The observer may read the system (state, energy,
+            Casimirs, ``save``); changing it raises `BusyError`. A truthy return
+            stops the run after that step; an exception stops it there too and
+            then propagates from ``step``.
+        every : int, optional
+            Steps between two calls of `observer`, >= 1 (default 1).
+
+        Returns
+        -------
+        int
+            The number of steps done: `nsteps`, or fewer when the observer (or
+            Ctrl-C) stopped the run; ``time`` has then advanced by that many
+            steps.
+
+        Raises
+        ------
+        NonFiniteError, CallbackError
+            A step failed; the state and time are those before the call.
+        UnsupportedError
+            `observer` given, but the loaded library has no lpi_set_observer.
+
+        Notes
+        -----
+        Ctrl-C (SIGINT) during a long call: with a library that has
+        lpi_set_observer, the run stops within about a twentieth of a second
+        and the SIGINT handler runs there (``KeyboardInterrupt`` by default),
+        the system holding exactly the state of a call of the steps done;
+        otherwise the handler runs when the whole call returns. With an
+        observer, Ctrl-C is looked for at a cadence that divides `every` (at
+        the observer's own calls when no such cadence is near the wanted one).
+        """
         dt = _real(dt, "dt")
         nsteps = _integer(nsteps, "nsteps", "int64")
+        every = _integer(every, "every", "int64")
+        if every < 1:
+            raise ValueError("every must be >= 1, not %d" % every)
+        if observer is not None:
+            if not callable(observer):
+                raise TypeError("observer must be callable, not %s" % type(observer).__name__)
+            if not _HAVE_OBSERVER:
+                _raise(STATUS["LPI_ERR_UNSUPPORTED"], "the loaded library has no lpi_set_observer")
         started = time.perf_counter()
-        every = self._observation_interval(nsteps)
-        if every:
-            self._step_observing_sigint(dt, nsteps, every)
-        else:
+        sigint_every = self._observation_interval(nsteps)
+        if observer is None and not sigint_every:
             self._call("lpi_step", dt, nsteps)
-        if nsteps > 0:
-            self._seconds_per_step = (time.perf_counter() - started) / nsteps
+            done = nsteps
+        else:
+            done = self._step_observed(dt, nsteps, observer, every, sigint_every)
+        if done > 0:
+            self._seconds_per_step = (time.perf_counter() - started) / done
+        return done
+
+    def integrate(self, t_eval: ArrayIn, dt: float, *, energy: bool = False,
+                  casimirs: bool = False) -> Trajectory:
+        """Integrate with fixed steps through the times `t_eval`, keeping the states there.
+
+        Like ``scipy.integrate.solve_ivp(..., t_eval=...)`` with a fixed step:
+        the system starts from its current state and time and ends at the last
+        requested time.
+
+        Parameters
+        ----------
+        t_eval : sequence of float
+            The times at which to record the state, in the direction of `dt`
+            (non-decreasing for dt > 0, non-increasing for dt < 0), none before
+            the current time. Each must be a whole number of steps from the
+            current time (to a millionth of a step, or the rounding of a long
+            run): the step is not stretched to meet a time.
+        dt : float
+            The step size, finite and nonzero.
+        energy : bool, optional
+            Also record the energy at each time (default False).
+        casimirs : bool, optional
+            Also record the Casimirs at each time (default False).
+
+        Returns
+        -------
+        Trajectory
+            ``.t`` the times reached (``t_eval`` up to the rounding of the
+            library's time), ``.y`` the states, one row per time (shape
+            ``(len(t), dim)``; note: scipy's ``.y`` is the transpose),
+            ``.energy`` and ``.casimirs`` when asked for (else None).
+
+        Raises
+        ------
+        ValueError
+            A time is not a whole number of steps from the current time, or
+            lies behind the previous one; nothing has been stepped then.
+        NonFiniteError, CallbackError
+            A step failed: the system holds the state of the last requested
+            time reached.
+
+        Examples
+        --------
+        >>> body = RigidBody(1.0, 2.0, 3.0)
+        >>> body.state = [1.0, 0.5, -0.3]
+        >>> sol = body.integrate([0.0, 0.5, 1.0], 0.01, casimirs=True)
+        >>> len(sol.t), len(sol.y[0])
+        (3, 3)
+        """
+        dt = _real(dt, "dt")
+        if not math.isfinite(dt) or dt == 0.0:
+            raise ValueError("dt must be finite and nonzero, not %r" % dt)
+        times = [_real(t, "t_eval entry") for t in (t_eval.tolist() if np is not None
+                                                   and isinstance(t_eval, np.ndarray) else t_eval)]
+        start = self.time
+        counts, previous = [], 0
+        for t in times:
+            exact = (t - start) / dt
+            n = round(exact) if math.isfinite(exact) else -1
+            if abs(exact - n) > max(1e-6, 8 * sys.float_info.epsilon * abs(exact)):
+                raise ValueError("t_eval entry %r is %.6g steps of %r from the time %r: not a whole number"
+                                 % (t, exact, dt, start))
+            if n < previous:
+                raise ValueError("t_eval entry %r lies behind %s (steps of %r from the time %r)"
+                                 % (t, "the previous one" if counts else "the current time", dt, start))
+            counts.append(n)
+            previous = n
+        dim, ncas = self.dim, self.casimir_count
+        out_t = [0.0] * len(times)
+        out_e = [0.0] * len(times) if energy else None
+        if np is not None:
+            out_y = np.empty((len(times), dim))
+            out_c = np.empty((len(times), ncas)) if casimirs else None
+        else:
+            out_y, out_c = [None] * len(times), ([None] * len(times) if casimirs else None)
+        done = 0
+        for i, n in enumerate(counts):
+            if n > done:
+                done += self.step(dt, n - done)
+            out_t[i] = self.time
+            out_y[i] = self.get_state(out_y[i] if np is not None else None)
+            if energy:
+                out_e[i] = self.energy()
+            if casimirs:
+                out_c[i] = self.casimirs(out_c[i] if np is not None else None)
+        if np is not None:
+            out_t = np.array(out_t)
+            out_e = np.array(out_e) if energy else None
+        return Trajectory(out_t, out_y, out_e, out_c)
 
     def _observation_interval(self, nsteps):
         """Steps between looks for a SIGINT during step(), or 0 for none: the
@@ -488,63 +894,123 @@ class System:
             return 0
         return max(1, min(nsteps, int(_OBSERVE_SECONDS / max(seconds, 1e-12))))
 
-    def _step_observing_sigint(self, dt, nsteps, every):
+    def _step_observed(self, dt, nsteps, observer, every, sigint_every):
+        """lpi_step under one library observer that serves both the caller's
+        observer (at the multiples of every) and the SIGINT watch (about every
+        sigint_every steps; 0: none). Returns the steps done."""
+        if observer is None:
+            cadence = sigint_every
+        elif sigint_every:
+            cadence = _dividing_cadence(every, sigint_every)
+        else:
+            cadence = every
         # SIGINT only sets a flag during the call; the observer runs the
         # handler that was in place, and stops the step if that raised.
-        received, raised = [], []
-        previous = signal.getsignal(signal.SIGINT)
+        received, raised, stopped_at = [], [], []
+        previous = signal.getsignal(signal.SIGINT) if sigint_every else None
 
         def run_previous_handler():
             del received[:]
             previous(signal.SIGINT, None)
 
-        def observe(sys, step, t, user):
-            if not received:
-                return 0
+        def observe(handle, step, t, user):
             try:
-                run_previous_handler()
+                if received:
+                    run_previous_handler()
+                if observer is not None and step % every == 0 and observer(self, step, t):
+                    stopped_at.append(step)
+                    return 1
             except BaseException as e:  # noqa: B902 - must not cross into C
                 raised.append(e)
+                stopped_at.append(step)
                 return 1
             return 0
 
-        observer = _lib.OBSERVER_FN(observe)
-        signal.signal(signal.SIGINT, lambda signum, frame: received.append(signum))
+        c_observer = _lib.OBSERVER_FN(observe)
+        if sigint_every:
+            signal.signal(signal.SIGINT, lambda signum, frame: received.append(signum))
         try:
-            self._call("lpi_set_observer", every, observer, None)
+            self._call("lpi_set_observer", cadence, c_observer, None)
             try:
                 self._call("lpi_step", dt, nsteps)
             finally:
                 lib.lpi_set_observer(self._handle, 0, _lib.OBSERVER_FN(), None)  # NULL: removed
         finally:
-            signal.signal(signal.SIGINT, previous)
+            if sigint_every:
+                signal.signal(signal.SIGINT, previous)
         if raised:
             raise raised[0]
         if received:  # arrived after the last observation
             run_previous_handler()
+        return stopped_at[0] if stopped_at else nsteps
 
-    def energy(self):
+    def energy(self) -> float:
+        """The energy of the current state.
+
+        Returns
+        -------
+        float
+            The Hamiltonian's value.
+        """
         out = c_double()
         self._call("lpi_energy", byref(out))
         return out.value
 
     @property
-    def casimir_count(self):
+    def casimir_count(self) -> int:
+        """The number of Casimirs `casimirs` reports.
+
+        Returns
+        -------
+        int
+            The count.
+        """
         return lib.lpi_casimir_count(self._h())
 
-    def casimirs(self, out=None):
+    def casimirs(self, out: Optional[ArrayOut] = None) -> ArrayOut:
+        """The Casimirs of the current state.
+
+        Parameters
+        ----------
+        out : numpy.ndarray, optional
+            A writeable C-contiguous float64 array of `casimir_count` entries.
+
+        Returns
+        -------
+        numpy.ndarray or list of float
+            The Casimirs (`out` when given).
+        """
         n = self.casimir_count
         ptr, result = _doubles_out(n, out)
         self._call("lpi_casimirs", ptr, n)
         return result()
 
     # checkpoints
-    def save(self, path):
-        """Writes a checkpoint to path atomically (lpi_save)."""
+    def save(self, path: PathLike) -> None:
+        """Write a checkpoint to a file, atomically (lpi_save).
+
+        Parameters
+        ----------
+        path : str, bytes or os.PathLike
+            The file to write.
+
+        Raises
+        ------
+        FileError
+            The file cannot be written (an `OSError`).
+        UnsupportedError
+            A system with Python callbacks (`Generic`, `Moments`).
+        """
         self._call("lpi_save", _c_path(path))
 
-    def save_bytes(self):
-        """The checkpoint as bytes (lpi_save_buffer)."""
+    def save_bytes(self) -> bytes:
+        """The checkpoint as bytes (lpi_save_buffer).
+
+        Returns
+        -------
+        bytes
+            What `load_bytes` restores.
+        """
         size = c_size_t()
         del self._pending[:]
         status = lib.lpi_save_buffer(self._h(), None, 0, byref(size))
@@ -572,6 +1038,45 @@ class System:
         self._finalizer = weakref.finalize(self, _destroy, handle, self._keep)
         return self
 
+    # copies and pickles go through a checkpoint
+    def __reduce__(self) -> Tuple[Any, ...]:
+        """Pickle support: the system as its checkpoint bytes (lpi_save_buffer).
+
+        Returns
+        -------
+        tuple
+            ``(_from_checkpoint, (bytes, method, split, threads))``; unpickling
+            restores an independent system that continues the trajectory bit
+            for bit (observers are not kept).
+        """
+        return (_from_checkpoint, (self.save_bytes(), self._method, self._split, self._threads))
+
+    def __copy__(self) -> "System":
+        """An independent system in the same state (through a checkpoint).
+
+        Returns
+        -------
+        System
+            A new handle of the same kind; stepping one leaves the other as it is.
+        """
+        restore, args = self.__reduce__()
+        return restore(*args)
+
+    def __deepcopy__(self, memo: Dict[int, Any]) -> "System":
+        """The same as ``copy.copy``: a system shares nothing with its copy.
+
+        Parameters
+        ----------
+        memo : dict
+            The ``copy.deepcopy`` memo (unused).
+
+        Returns
+        -------
+        System
+            A new, independent handle.
+        """
+        return self.__copy__()
+
     def __repr__(self):
         if self.closed:
             return "<%s (closed)>" % type(self).__name__
@@ -579,38 +1084,68 @@ class System:
 
 
 class RigidBody(System):
-    """Free rigid body on so(3)*: H = sum m_k^2 / (2 I_k), Casimir |m|^2.
-    Splits "casimir-shift" (default) and "axes"."""
+    """The free rigid body on so(3)*: H = sum m_k^2 / (2 I_k), Casimir |m|^2.
 
-    def __init__(self, I1, I2, I3):
+    Splits ``"casimir-shift"`` (default) and ``"axes"``.
+
+    Parameters
+    ----------
+    I1, I2, I3 : float
+        The principal moments of inertia, positive.
+    """
+
+    def __init__(self, I1: float, I2: float, I3: float) -> None:
         super().__init__("lpi_rigid_body_create", _real(I1, "I1"), _real(I2, "I2"), _real(I3, "I3"))
 
-    def exact(self, t):
-        """The exact solution at time self.time + t from the current state (unchanged)."""
+    def exact(self, t: float) -> ArrayOut:
+        """The exact solution (Jacobi elliptic functions) from the current state.
+
+        Parameters
+        ----------
+        t : float
+            The time to advance, from `time`.
+
+        Returns
+        -------
+        numpy.ndarray or list of float
+            The state at ``time + t``; the system is unchanged.
+        """
         ptr, result = _doubles_out(3)
         self._call("lpi_rigid_body_exact", _real(t, "t"), ptr)
         return result()
 
 
 class Pendulum(System):
-    """Planar pendulum on e(2)*: H = x3^2/2 + x2, Casimir x1^2 + x2^2."""
+    """The planar pendulum on e(2)*: H = x3^2/2 + x2, Casimir x1^2 + x2^2."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         super().__init__("lpi_pendulum_create")
 
 
 class Generic(System):
-    """A user-defined Lie-Poisson system: {x_i, x_j} = sum c x_k over the
-    brackets (i, j, k, c) (0-based). Pieces and Casimirs are Python callables.
+    """A user-defined Lie-Poisson system with Python callables as pieces.
 
-        g = Generic(3, [(0, 1, 2, -1.0), (0, 2, 1, 1.0), (1, 2, 0, -1.0)])
-        g.add_piece([0], lambda x: [x[0] / I1], lambda x: 0.5 * x[0] ** 2 / I1)
-        g.add_casimir(lambda x: x[0] ** 2 + x[1] ** 2 + x[2] ** 2)
+    The bracket is {x_i, x_j} = sum c x_k over the rows (i, j, k, c), 0-based.
+    A callback that raises makes the calling method raise `CallbackError`
+    (with the callback's exception as ``__cause__``) and leaves the state
+    unchanged. Cannot be copied, pickled or saved.
 
-    A callback that raises makes the calling method raise CallbackError (with
-    the callback's exception as __cause__) and leaves the state unchanged."""
+    Parameters
+    ----------
+    dim : int
+        The dimension of the state.
+    brackets : sequence of (int, int, int, float)
+        The structure constants (i, j, k, c).
 
-    def __init__(self, dim, brackets=(), _create=None):
+    Examples
+    --------
+    >>> g = Generic(3, [(0, 1, 2, -1.0), (0, 2, 1, 1.0), (1, 2, 0, -1.0)])
+    >>> g.add_piece([0], lambda x: [x[0] / 2.0], lambda x: 0.25 * x[0] ** 2)
+    >>> g.add_casimir(lambda x: x[0] ** 2 + x[1] ** 2 + x[2] ** 2)
+    """
+
+    def __init__(self, dim: int, brackets: Sequence[Tuple[int, int, int, float]] = (),
+                 _create: Optional[str] = None) -> None:
         if _create is not None:
             super().__init__(_create)
             return
@@ -638,9 +1173,24 @@ class Generic(System):
                 return 1
         return run
 
-    def add_piece(self, indices, gradient, energy):
-        """Appends the piece H(x_sigma), sigma = indices (abelian). gradient(x_sigma)
-        returns the n partial derivatives, energy(x_sigma) the value."""
+    def add_piece(self, indices: Sequence[int], gradient: Callable[[Any], Sequence[float]],
+                  energy: Callable[[Any], float]) -> None:
+        """Append the piece H(x_sigma) of the Hamiltonian.
+
+        Parameters
+        ----------
+        indices : sequence of int
+            sigma, an abelian set of state indices.
+        gradient : callable
+            ``gradient(x_sigma)`` returns the len(sigma) partial derivatives.
+        energy : callable
+            ``energy(x_sigma)`` returns the piece's value.
+
+        Raises
+        ------
+        NotAbelianError
+            The indices do not commute under the bracket.
+        """
         idx, n = _int32s(indices, "piece index")
 
         def grad_body(m, x, out, user):
@@ -658,8 +1208,14 @@ class Generic(System):
         self._call("lpi_add_piece", n, idx, g_fn, e_fn, None)
         self._keep.extend((g_fn, e_fn))
 
-    def add_casimir(self, casimir):
-        """Declares a Casimir: casimir(x) of the full state returns a float."""
+    def add_casimir(self, casimir: Callable[[Any], float]) -> None:
+        """Declare a Casimir, which `casimirs` then reports.
+
+        Parameters
+        ----------
+        casimir : callable
+            ``casimir(x)`` of the full state returns a float.
+        """
         def body(dim, x, out, user):
             out[0] = float(casimir(_callback_view(x, dim)))
 
@@ -667,8 +1223,31 @@ class Generic(System):
         self._call("lpi_add_casimir", fn, None)
         self._keep.append(fn)
 
-    def poisson_rank(self, x=None):
-        """Numerical rank of the Poisson matrix at x (default: the current state)."""
+    def __reduce__(self) -> Tuple[Any, ...]:
+        """Refuses: a checkpoint cannot hold Python callables.
+
+        Raises
+        ------
+        TypeError
+            Always, for pickle, ``copy.copy`` and ``copy.deepcopy`` alike.
+        """
+        raise TypeError("a %s system cannot be copied or pickled: its pieces and Casimirs are Python "
+                        "callables, which a checkpoint does not hold; build a new one and set its state"
+                        % type(self).__name__)
+
+    def poisson_rank(self, x: Optional[ArrayIn] = None) -> int:
+        """The numerical rank of the Poisson matrix.
+
+        Parameters
+        ----------
+        x : sequence of float, optional
+            The point (default: the current state).
+
+        Returns
+        -------
+        int
+            The rank.
+        """
         if x is None:
             x = self.get_state()
         ptr, n, _keep = _doubles_in(x, "x")
@@ -678,15 +1257,25 @@ class Generic(System):
 
 
 class Moments(Generic):
-    """The 8-dimensional algebra of second and fourth moments (McLachlan 1993),
-    with Casimirs I and K built in. Add pieces with add_piece on the abelian sets
-    {0,3}, {1,5}, {2,7}, {3,4,5,6,7} and add_product_piece for H(x1 x3)."""
+    """The 8-dimensional algebra of second and fourth moments (McLachlan 1993).
 
-    def __init__(self):
+    Casimirs I and K are built in. Add pieces with `add_piece` on the abelian
+    sets {0,3}, {1,5}, {2,7}, {3,4,5,6,7} and `add_product_piece` for H(x1 x3).
+    """
+
+    def __init__(self) -> None:
         super().__init__(8, _create="lpi_moments_create")
 
-    def add_product_piece(self, h, dh):
-        """Appends H(x1 x3) with its closed-form flow; h(u) and dh(u) = H'(u)."""
+    def add_product_piece(self, h: Callable[[float], float], dh: Callable[[float], float]) -> None:
+        """Append H(x1 x3), integrated by its closed-form flow.
+
+        Parameters
+        ----------
+        h : callable
+            ``h(u)``, the piece as a function of u = x1 x3.
+        dh : callable
+            ``dh(u)``, its derivative H'(u).
+        """
         def scalar_body(f):
             def body(u, out, user):
                 out[0] = float(f(u))
@@ -699,21 +1288,46 @@ class Moments(Generic):
 
 
 class SineEuler(System):
-    """Zeitlin's sine-Euler truncation of 2D Euler on the torus, N odd >= 3.
-    modes: complex N x N (entry [a][b] is mode (a, b) mod N, FFT order);
-    grid: real vorticity N x N at (2 pi a / N, 2 pi b / N). Needs FFTW in the
-    library (UnsupportedError otherwise)."""
+    """Zeitlin's sine-Euler truncation of 2D Euler on the torus.
 
-    def __init__(self, N):
+    ``modes``: complex N x N (entry [a][b] is mode (a, b) mod N, FFT order);
+    ``grid``: real vorticity N x N at (2 pi a / N, 2 pi b / N).
+
+    Parameters
+    ----------
+    N : int
+        The truncation, odd, >= 3.
+
+    Raises
+    ------
+    UnsupportedError
+        The library was built without FFTW.
+    """
+
+    def __init__(self, N: int) -> None:
         super().__init__("lpi_sine_euler_create", _integer(N, "N", "int32"))
 
     @property
-    def N(self):
+    def N(self) -> int:
+        """The truncation N.
+
+        Returns
+        -------
+        int
+            N, odd.
+        """
         out = c_int32()
         self._call("lpi_sine_euler_size", byref(out))
         return out.value
 
-    def get_modes(self):
+    def get_modes(self) -> Any:
+        """The Fourier modes of the vorticity.
+
+        Returns
+        -------
+        numpy.ndarray or list of list of complex
+            N x N, Hermitian.
+        """
         N = self.N
         n = 2 * N * N
         if np is not None:
@@ -725,14 +1339,43 @@ class SineEuler(System):
         return [[complex(buf[2 * (a * N + b)], buf[2 * (a * N + b) + 1]) for b in range(N)]
                 for a in range(N)]
 
-    def set_modes(self, modes):
-        """Sets the modes (checked Hermitian, then symmetrised); time reset to 0."""
+    def _check_square(self, shape: Tuple[Any, ...], what: str) -> None:
+        """SizeError unless shape is (N, N): the library checks only the count,
+        which a (1, N*N) array or ragged rows would pass."""
+        N = self.N
+        if tuple(shape) != (N, N):
+            _raise(STATUS["LPI_ERR_SIZE"], "%s must be %d x %d, not of shape %s" % (what, N, N, tuple(shape)))
+
+    @staticmethod
+    def _rows_shape(rows: Any) -> Tuple[Any, ...]:
+        rows = list(rows)
+        lengths = {len(r) for r in rows}
+        return (len(rows), lengths.pop()) if len(lengths) == 1 else (len(rows), "ragged")
+
+    def set_modes(self, modes: Any) -> None:
+        """Set the modes (checked Hermitian, then symmetrised); the time becomes 0.
+
+        Parameters
+        ----------
+        modes : array_like of complex
+            N x N.
+
+        Raises
+        ------
+        SizeError
+            Not N x N.
+        InvalidArgumentError
+            Not Hermitian; the state is unchanged.
+        """
         if np is not None:
             a = modes
             if not (isinstance(a, np.ndarray) and a.dtype == np.complex128 and a.flags.c_contiguous):
                 a = np.ascontiguousarray(_real_array(modes, "modes", "iufc"), dtype=np.complex128)
+            self._check_square(a.shape, "modes")
             self._call("lpi_sine_euler_set_modes", a.ctypes.data_as(_lib.c_double_p), 2 * a.size)
             return
+        modes = [list(row) for row in modes]
+        self._check_square(self._rows_shape(modes), "modes")
         flat = []
         for row in modes:
             for z in row:
@@ -745,7 +1388,14 @@ class SineEuler(System):
 
     modes = property(get_modes, set_modes)
 
-    def get_grid(self):
+    def get_grid(self) -> Any:
+        """The vorticity on the grid.
+
+        Returns
+        -------
+        numpy.ndarray or list of list of float
+            N x N real values.
+        """
         N = self.N
         if np is not None:
             out = np.empty((N, N), dtype=np.float64)
@@ -755,23 +1405,57 @@ class SineEuler(System):
         self._call("lpi_sine_euler_get_grid", buf, N * N)
         return [list(buf[a * N:(a + 1) * N]) for a in range(N)]
 
-    def set_grid(self, w):
-        """Sets the vorticity from its N x N grid values; time reset to 0."""
+    def set_grid(self, w: Any) -> None:
+        """Set the vorticity from its grid values; the time becomes 0.
+
+        Parameters
+        ----------
+        w : array_like of float
+            N x N real values. A complex array is refused (`TypeError`), not
+            cast.
+
+        Raises
+        ------
+        SizeError
+            Not N x N.
+        """
         if np is not None:
-            ptr, n, _keep = _doubles_in(_real_array(w, "grid").astype(np.float64).reshape(-1), "grid")
+            a = _real_array(w, "grid")
+            self._check_square(a.shape, "grid")
+            ptr, n, _keep = _doubles_in(a.astype(np.float64).reshape(-1), "grid")
         else:
+            w = [list(row) for row in w]
+            self._check_square(self._rows_shape(w), "grid")
             ptr, n, _keep = _doubles_in([v for row in w for v in row], "grid")
         self._call("lpi_sine_euler_set_grid", ptr, n)
 
     grid = property(get_grid, set_grid)
 
-    def enstrophy(self):
+    def enstrophy(self) -> float:
+        """The enstrophy of the current state.
+
+        Returns
+        -------
+        float
+            The enstrophy (a Casimir).
+        """
         out = c_double()
         self._call("lpi_sine_euler_enstrophy", byref(out))
         return out.value
 
-    def casimir_traces(self, kmax):
-        """[(1/N) tr W^k for k = 1 .. kmax]."""
+    def casimir_traces(self, kmax: int) -> ArrayOut:
+        """The Casimirs (1/N) tr W^k of the vorticity matrix.
+
+        Parameters
+        ----------
+        kmax : int
+            The highest power, >= 1.
+
+        Returns
+        -------
+        numpy.ndarray or list of float
+            The traces for k = 1 .. kmax.
+        """
         kmax = _integer(kmax, "kmax", "int32")
         ptr, result = _doubles_out(max(kmax, 0))
         if kmax < 1:  # let the library name the error
@@ -779,8 +1463,19 @@ class SineEuler(System):
         self._call("lpi_sine_euler_casimir_traces", kmax, ptr)
         return result()
 
-    def fft_floor(self, nsteps):
-        """(seconds per step, transforms per step) of FFTW alone for nsteps steps."""
+    def fft_floor(self, nsteps: int) -> Tuple[float, float]:
+        """The cost of FFTW alone over nsteps steps, for comparison with `step`.
+
+        Parameters
+        ----------
+        nsteps : int
+            Steps to time.
+
+        Returns
+        -------
+        tuple of float
+            (seconds per step, transforms per step).
+        """
         sec, count = c_double(), c_double()
         self._call("lpi_sine_euler_fft_floor", _integer(nsteps, "nsteps", "int64"), byref(sec), byref(count))
         return sec.value, count.value
@@ -788,17 +1483,62 @@ class SineEuler(System):
 
 # ---- checkpoints ----------------------------------------------------------------
 
-def load(path):
-    """A system restored from a checkpoint file (lpi_load); it continues the
-    saved trajectory bit for bit. The method's name is not stored in the object
-    (its .method is None) but the library uses the saved one."""
+def load(path: PathLike) -> System:
+    """A system restored from a checkpoint file (lpi_load).
+
+    It continues the saved trajectory bit for bit, with the saved method (its
+    ``method`` reads None: the name is not kept on the Python side).
+
+    Parameters
+    ----------
+    path : str, bytes or os.PathLike
+        The checkpoint file.
+
+    Returns
+    -------
+    System
+        A `RigidBody`, `Pendulum` or `SineEuler`.
+
+    Raises
+    ------
+    FileError
+        The file cannot be read (an `OSError`).
+    FormatError
+        Not a valid checkpoint (a `ValueError`).
+    """
     handle = ctypes.c_void_p()
     _check_free(lib.lpi_load(byref(handle), _c_path(path)))
     return System._adopt(handle)
 
 
-def load_bytes(data):
-    """A system restored from checkpoint bytes (lpi_load_buffer)."""
+def _from_checkpoint(data: bytes, method: Optional[str], split: Optional[str], threads: int) -> System:
+    """A system from checkpoint bytes with the Python-side settings of the
+    system it was saved from (the library restores method and split itself)."""
+    system = load_bytes(data)
+    system._method, system._split = method, split
+    if threads != 1:
+        system.threads = threads
+    return system
+
+
+def load_bytes(data: bytes) -> System:
+    """A system restored from checkpoint bytes (lpi_load_buffer).
+
+    Parameters
+    ----------
+    data : bytes-like
+        What `System.save_bytes` returned.
+
+    Returns
+    -------
+    System
+        A `RigidBody`, `Pendulum` or `SineEuler`.
+
+    Raises
+    ------
+    FormatError
+        Not a valid checkpoint (a `ValueError`).
+    """
     data = bytes(memoryview(data))  # bytes-like only: bytes(5) would be five zeros
     handle = ctypes.c_void_p()
     _check_free(lib.lpi_load_buffer(byref(handle), data, len(data)))
@@ -807,19 +1547,47 @@ def load_bytes(data):
 
 # ---- FFTW wisdom (process-wide) -----------------------------------------------
 
-def fftw_wisdom_import_file(path):
+def fftw_wisdom_import_file(path: PathLike) -> None:
+    """Import FFTW wisdom from a file (process-wide).
+
+    Parameters
+    ----------
+    path : str, bytes or os.PathLike
+        A file written by `fftw_wisdom_export_file`.
+    """
     _check_free(lib.lpi_fftw_wisdom_import_file(_c_path(path)))
 
 
-def fftw_wisdom_export_file(path):
+def fftw_wisdom_export_file(path: PathLike) -> None:
+    """Export the process's FFTW wisdom to a file.
+
+    Parameters
+    ----------
+    path : str, bytes or os.PathLike
+        The file to write.
+    """
     _check_free(lib.lpi_fftw_wisdom_export_file(_c_path(path)))
 
 
-def fftw_wisdom_import_string(wisdom):
+def fftw_wisdom_import_string(wisdom: str) -> None:
+    """Import FFTW wisdom from a string (process-wide).
+
+    Parameters
+    ----------
+    wisdom : str
+        What `fftw_wisdom_export_string` returned.
+    """
     _check_free(lib.lpi_fftw_wisdom_import_string(_c_string(wisdom, "wisdom")))
 
 
-def fftw_wisdom_export_string():
+def fftw_wisdom_export_string() -> str:
+    """The process's FFTW wisdom.
+
+    Returns
+    -------
+    str
+        The wisdom, for `fftw_wisdom_import_string`.
+    """
     length = c_size_t()
     status = lib.lpi_fftw_wisdom_export_string(None, 0, byref(length))
     if status != STATUS["LPI_ERR_SIZE"]:

@@ -1,9 +1,12 @@
 """Finding libliepoisson and declaring its C functions for ctypes.
 
 The library is searched for in this order:
-  1. the path in the environment variable LIEPOISSON_LIBRARY;
-  2. a build tree beside the sources (bindings/python/../../build);
-  3. the system's library path (ctypes.util.find_library).
+  1. the path in the environment variable LIEPOISSON_LIBRARY (final: a wrong
+     path is an error, not a reason to look elsewhere);
+  2. for a package installed by `make install`, the library installed with it
+     (recorded in _install.py: relative to the package, then absolute);
+  3. a build tree beside the sources (bindings/python/../../build);
+  4. the system's library path (ctypes.util.find_library).
 """
 import ctypes
 import ctypes.util
@@ -98,6 +101,13 @@ def _candidates():
         yield env
         return
     here = os.path.dirname(os.path.abspath(__file__))
+    try:
+        from . import _install
+    except ImportError:  # not installed by make install
+        pass
+    else:
+        yield os.path.normpath(os.path.join(here, _install.LIBRARY_RELATIVE))
+        yield _install.LIBRARY
     for build in (os.path.join(here, "..", "..", "..", "build"),):
         yield os.path.normpath(os.path.join(build, "libliepoisson.so.%d" % SONAME_MAJOR))
     found = ctypes.util.find_library("liepoisson")
