@@ -10,7 +10,7 @@ source_dir=$1 python=$2 library=$3
 work=$(mktemp -d "${TMPDIR:-/tmp}/lpi-pip.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 fail() { echo "check_pip: $*"; exit 1; }
-for module in pip setuptools wheel venv; do
+for module in setuptools wheel venv pip; do
     "$python" -c "import $module" 2>/dev/null || { echo "check_pip: $python has no $module: skipped"; exit 77; }
 done
 # A copy: setuptools builds in the source directory (build/, *.egg-info).
