@@ -72,5 +72,5 @@ int main(void) {
         cmocka_unit_test(test_long_time_and_backwards),
         cmocka_unit_test(test_bad_input),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return lpi_run_tests(tests);
 }
