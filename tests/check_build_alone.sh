@@ -33,8 +33,10 @@ cmake --build "$build" -j "${JOBS:-2}" >"$dir/build.log" 2>&1 || { cat "$dir/bui
 for f in lpi libliepoisson.so libliepoisson.a; do
     [ -e "$build/$f" ] || fail "no $f"
 done
-if grep -q '^CMAKE_Fortran_COMPILER:FILEPATH=/' "$build/CMakeCache.txt"; then
-    [ -e "$build/libliepoisson_fortran.so" ] || fail "a Fortran compiler was found but no Fortran binding built"
+if grep -q '^CMAKE_Fortran_COMPILER:[A-Z]*=/' "$build/CMakeCache.txt"; then
+    for f in libliepoisson_fortran.so fortran/liepoisson.mod; do
+        [ -e "$build/$f" ] || fail "a Fortran compiler was found but no $f was built"
+    done
     fortran=", the Fortran binding"
 else
     fortran=" (no Fortran compiler: no Fortran binding)"
