@@ -1,5 +1,6 @@
-/* Helpers shared by the cmocka tests: status checks with message and
- * unchanged-state assertions, an independent RK4 reference, order fitting. */
+/* Helpers shared by the cmocka tests: skips and the exit status ctest reads,
+ * status checks with message and unchanged-state assertions, an independent
+ * RK4 reference, order fitting. */
 #ifndef LPI_TEST_H
 #define LPI_TEST_H
 
@@ -12,7 +13,56 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __cplusplus /* cmocka.h declares its functions without C linkage */
+extern "C" {
+#endif
 #include <cmocka.h>
+#ifdef __cplusplus
+}
+#endif
+
+/* ---- skips and the exit status ------------------------------------------
+ * A test that cannot run here (this build lacks an optional part, or a tool
+ * it runs under cannot host it) calls LPI_SKIP with the reason: the reason is
+ * printed and cmocka lists the test as SKIPPED, never as passed. A program
+ * ends with `return lpi_run_tests(tests);`, whose status ctest reads: 1 when
+ * a test failed, 77 (the SKIP_RETURN_CODE every test is registered with) when
+ * every test was skipped, 0 otherwise. */
+static inline int *lpi_test_skip_count(void) {
+    static int count;
+    return &count;
+}
+
+#define LPI_SKIP(...)                      \
+    do {                                   \
+        printf("skipped: ");               \
+        printf(__VA_ARGS__);               \
+        printf("\n");                      \
+        fflush(stdout);                    \
+        ++*lpi_test_skip_count();          \
+        skip();                            \
+    } while (0)
+
+static inline int lpi_test_exit_status(int failed, size_t count) {
+    if (failed) return 1;
+    if (count > 0 && (size_t)*lpi_test_skip_count() == count) {
+        printf("every test was skipped\n");
+        return 77;
+    }
+    return 0;
+}
+
+#define lpi_run_tests(tests)                                              \
+    lpi_test_exit_status(cmocka_run_group_tests(tests, NULL, NULL),       \
+                         sizeof(tests) / sizeof((tests)[0]))
+
+/* What this build has, asked of the library as a program would. */
+static inline int lpi_test_have_sine_euler(void) {
+    lpi_system *probe = NULL;
+    const int have = lpi_sine_euler_create(&probe, 3) == LPI_OK;
+    lpi_destroy(probe);
+    return have;
+}
 
 /* State and time of a handle, to compare bit for bit. */
 typedef struct {

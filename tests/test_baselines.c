@@ -99,5 +99,5 @@ int main(void) {
         cmocka_unit_test(test_midpoint_keeps_quadratic_invariants),
         cmocka_unit_test(test_implicit_options_bad_input),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return lpi_run_tests(tests);
 }

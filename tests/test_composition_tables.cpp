@@ -12,12 +12,7 @@
 #include <string>
 #include <vector>
 
-extern "C" {
-#include <setjmp.h>
-#include <stdarg.h>
-#include <stddef.h>
-#include <cmocka.h>
-}
+#include "lpi_test.h"
 
 #include "core/methods.hpp"
 
@@ -211,5 +206,5 @@ int main() {
         cmocka_unit_test(test_check_detects_bad_tables),
         cmocka_unit_test(test_flow_program_merging),
     };
-    return cmocka_run_group_tests(tests, nullptr, nullptr);
+    return lpi_run_tests(tests);
 }

@@ -476,5 +476,5 @@ int main(void) {
         cmocka_unit_test(test_casimirs_every_method),
         cmocka_unit_test(test_energy_bounded),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return lpi_run_tests(tests);
 }

@@ -78,5 +78,5 @@ int main(void) {
         cmocka_unit_test(test_pendulum_orders),
         cmocka_unit_test(test_rk4_baseline_matches_reference),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return lpi_run_tests(tests);
 }

@@ -8,12 +8,7 @@
 #include <random>
 #include <vector>
 
-extern "C" {
-#include <setjmp.h>
-#include <stdarg.h>
-#include <stddef.h>
-#include <cmocka.h>
-}
+#include "lpi_test.h"
 
 #include "models/expm.hpp"
 
@@ -269,5 +264,5 @@ int main() {
         cmocka_unit_test(test_nilpotent_matrices),
         cmocka_unit_test(test_sparse_nilpotent_scales_with_nonzeros),
     };
-    return cmocka_run_group_tests(tests, nullptr, nullptr);
+    return lpi_run_tests(tests);
 }

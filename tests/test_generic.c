@@ -385,5 +385,5 @@ int main(void) {
         cmocka_unit_test(test_callback_failures_roll_back),
         cmocka_unit_test(test_no_pieces),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return lpi_run_tests(tests);
 }

@@ -94,5 +94,5 @@ int main(void) {
         cmocka_unit_test(test_pendulum_long_runs),
         cmocka_unit_test(test_rk4_drifts),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return lpi_run_tests(tests);
 }

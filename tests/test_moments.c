@@ -366,5 +366,5 @@ int main(void) {
         cmocka_unit_test(test_separable_case),
         cmocka_unit_test(test_product_piece_errors),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return lpi_run_tests(tests);
 }

@@ -274,5 +274,5 @@ int main(void) {
         cmocka_unit_test(test_failing_step_names_step_and_time),
         cmocka_unit_test(test_observer_arguments),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return lpi_run_tests(tests);
 }

@@ -174,5 +174,5 @@ int main(void) {
         cmocka_unit_test(test_moment_product_piece_callbacks),
         cmocka_unit_test(test_callbacks_inside_an_observer),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return lpi_run_tests(tests);
 }

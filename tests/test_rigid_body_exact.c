@@ -403,5 +403,5 @@ int main(void) {
         cmocka_unit_test(test_every_family_matches_its_reference),
         cmocka_unit_test(test_bad_input),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return lpi_run_tests(tests);
 }

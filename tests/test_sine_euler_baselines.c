@@ -7,6 +7,18 @@
  * systems refuse these methods. */
 #include "lpi_test.h"
 
+/* What this build has (set in main): sine-Euler needs FFTW; isomp and
+ * rk4-matrix need BLAS/LAPACK, direct-eq5 does not. */
+static int have_fftw, have_blas;
+
+static void require_fftw(void) {
+    if (!have_fftw) LPI_SKIP("built without FFTW: no sine-Euler system");
+}
+static void require_blas(void) {
+    require_fftw();
+    if (!have_blas) LPI_SKIP("built without BLAS/LAPACK: no isomp, no rk4-matrix");
+}
+
 /* A reproducible Hermitian field, w_0 = 0.3, amplitude ~ 2/(1 + |m|^2). */
 static void random_field(int N, unsigned seed, double *w) {
     lpi_test_random_field(N, 0xD1B54A32D192ED03ull ^ seed, 2.0, w);
@@ -94,6 +106,7 @@ static void test_unsupported_elsewhere(void **state) {
 /* direct-eq5 is O(N^4): refused beyond N = 31, with the reason. */
 static void test_direct_eq5_size_limit(void **state) {
     (void)state;
+    require_fftw();
     lpi_system *sys = NULL;
     assert_int_equal(lpi_sine_euler_create(&sys, 31), LPI_OK);
     assert_int_equal(lpi_set_method(sys, "direct-eq5"), LPI_OK);
@@ -113,6 +126,7 @@ static void test_direct_eq5_size_limit(void **state) {
  * eq. 5 summed term by term) are one map up to round-off. N = 9 is composite. */
 static void test_rk4_forms_agree(void **state) {
     (void)state;
+    require_blas();
     const int sizes[] = {7, 9, 11};
     for (size_t s = 0; s < sizeof sizes / sizeof sizes[0]; ++s) {
         const int N = sizes[s];
@@ -166,6 +180,7 @@ static void check_order(int N, const char *method, int order, const int64_t step
 
 static void test_orders(void **state) {
     (void)state;
+    require_blas();
     const int64_t isomp_steps[4] = {16, 24, 32, 48};
     const int64_t rk4_steps[4] = {16, 24, 32, 48};
     check_order(11, "isomp", 2, isomp_steps);
@@ -191,6 +206,7 @@ static double spectrum_drift(int N, const double *w0, const char *method, double
 
 static void test_isomp_isospectral(void **state) {
     (void)state;
+    require_blas();
     const int N = 13;
     double w0[2 * 13 * 13];
     random_field(N, 17, w0);
@@ -212,6 +228,7 @@ static void test_isomp_isospectral(void **state) {
 
 static void test_isomp_non_convergence_rolls_back(void **state) {
     (void)state;
+    require_blas();
     const int N = 7;
     double w0[2 * 7 * 7];
     random_field(N, 23, w0);
@@ -245,6 +262,7 @@ static void test_isomp_non_convergence_rolls_back(void **state) {
  * back and forth keeps working (plans are made and released per method). */
 static void test_switching(void **state) {
     (void)state;
+    require_blas();
     const int N = 11;
     const size_t n = 2 * (size_t)N * N;
     double w0[2 * 11 * 11], a[2 * 11 * 11], b[2 * 11 * 11];
@@ -268,6 +286,8 @@ static void test_switching(void **state) {
  * direct-eq5 (plain loops) still runs. */
 static void test_without_blas(void **state) {
     (void)state;
+    require_fftw();
+    if (have_blas) LPI_SKIP("built with BLAS/LAPACK: the refusals without it cannot be seen");
     double w0[2 * 7 * 7], a[2 * 7 * 7], b[2 * 7 * 7];
     random_field(7, 3, w0);
     lpi_system *sys = sine_euler(7, w0);
@@ -283,25 +303,9 @@ static void test_without_blas(void **state) {
 
 int main(void) {
     lpi_system *probe = NULL;
-    const int have_fftw = lpi_sine_euler_create(&probe, 3) == LPI_OK;
-    const int have_blas = have_fftw && lpi_set_method(probe, "rk4-matrix") == LPI_OK;
+    have_fftw = lpi_sine_euler_create(&probe, 3) == LPI_OK;
+    have_blas = have_fftw && lpi_set_method(probe, "rk4-matrix") == LPI_OK;
     lpi_destroy(probe);
-    if (!have_fftw) { /* no sine-Euler system: only the refusals elsewhere */
-        const struct CMUnitTest partial[] = {
-            cmocka_unit_test(test_registry_rows),
-            cmocka_unit_test(test_unsupported_elsewhere),
-        };
-        return cmocka_run_group_tests(partial, NULL, NULL);
-    }
-    if (!have_blas) {
-        const struct CMUnitTest partial[] = {
-            cmocka_unit_test(test_registry_rows),
-            cmocka_unit_test(test_unsupported_elsewhere),
-            cmocka_unit_test(test_direct_eq5_size_limit),
-            cmocka_unit_test(test_without_blas),
-        };
-        return cmocka_run_group_tests(partial, NULL, NULL);
-    }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_registry_rows),
         cmocka_unit_test(test_unsupported_elsewhere),
@@ -311,6 +315,7 @@ int main(void) {
         cmocka_unit_test(test_isomp_isospectral),
         cmocka_unit_test(test_isomp_non_convergence_rolls_back),
         cmocka_unit_test(test_switching),
+        cmocka_unit_test(test_without_blas),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return lpi_run_tests(tests);
 }

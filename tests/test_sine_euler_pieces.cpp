@@ -3,22 +3,18 @@
 // energies sum to H; their number is N prod_{p | N} (1 + 1/p).
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <vector>
 
 #include "lpi_config.h"
+#include "lpi_test.h"
 #include "models/sine_euler.hpp"
 
-static int failures = 0;
-#define CHECK(cond)                                                         \
-    do {                                                                    \
-        if (!(cond)) {                                                      \
-            std::printf("%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond); \
-            ++failures;                                                     \
-        }                                                                   \
-    } while (0)
+namespace {
 
-static std::size_t projective_line_size(int N) {
+const int kSizes[] = {3, 7, 9, 15, 25, 27, 45, 49};
+
+#if LPI_HAVE_FFTW
+std::size_t projective_line_size(int N) {
     double count = N;
     int n = N;
     for (int p = 2; p <= n; ++p)
@@ -28,17 +24,27 @@ static std::size_t projective_line_size(int N) {
         }
     return static_cast<std::size_t>(std::lround(count));
 }
+#endif
 
-int main() {
+void test_piece_count(void **) {
 #if !LPI_HAVE_FFTW
-    std::puts("built without FFTW: sine-Euler is left out");
-    return 0;
+    LPI_SKIP("built without FFTW: no sine-Euler model");
 #else
-    for (int N : {3, 7, 9, 15, 25, 27, 45, 49}) {
+    for (int N : kSizes) {
+        auto model = lpi::make_sine_euler(N);
+        assert_int_equal(model->piece_count(), projective_line_size(N));
+    }
+#endif
+}
+
+// Every nonzero mode alone: exactly one piece carries its energy.
+void test_each_mode_has_one_owner(void **) {
+#if !LPI_HAVE_FFTW
+    LPI_SKIP("built without FFTW: no sine-Euler model");
+#else
+    for (int N : kSizes) {
         auto model = lpi::make_sine_euler(N);
         auto &se = dynamic_cast<lpi::SineEulerModel &>(*model);
-        CHECK(model->piece_count() == projective_line_size(N));
-        // Every nonzero mode alone: exactly one piece carries its energy.
         std::vector<double> state(2 * N * N, 0.0);
         for (int i = 1; i < N * N; ++i) {
             const int a = i / N, b = i % N;
@@ -49,9 +55,21 @@ int main() {
             int owners = 0;
             for (std::size_t k = 0; k < model->piece_count(); ++k)
                 owners += se.piece_energy(k, state.data()) != 0.0;
-            CHECK(owners == 1);
+            if (owners != 1) fail_msg("N = %d, mode %d: %d pieces own it", N, i, owners);
         }
-        // A full field: the pieces' energies sum to H.
+    }
+#endif
+}
+
+// A full field: the pieces' energies sum to H.
+void test_piece_energies_sum_to_h(void **) {
+#if !LPI_HAVE_FFTW
+    LPI_SKIP("built without FFTW: no sine-Euler model");
+#else
+    for (int N : kSizes) {
+        auto model = lpi::make_sine_euler(N);
+        auto &se = dynamic_cast<lpi::SineEulerModel &>(*model);
+        std::vector<double> state(2 * N * N);
         unsigned seed = 1;
         for (int i = 0; i < 2 * N * N; ++i) {
             seed = seed * 1103515245u + 12345u;
@@ -63,10 +81,20 @@ int main() {
         double sum = 0.0;
         for (std::size_t k = 0; k < model->piece_count(); ++k) sum += se.piece_energy(k, state.data());
         const double H = model->energy(state.data());
-        CHECK(std::fabs(sum - H) <= 1e-13 * H);
         std::printf("N = %2d: %3zu pieces, sum of piece energies - H = %.1e\n", N,
                     model->piece_count(), sum - H);
+        assert_true(std::fabs(sum - H) <= 1e-13 * H);
     }
-    return failures ? EXIT_FAILURE : EXIT_SUCCESS;
 #endif
+}
+
+}  // namespace
+
+int main() {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_piece_count),
+        cmocka_unit_test(test_each_mode_has_one_owner),
+        cmocka_unit_test(test_piece_energies_sum_to_h),
+    };
+    return lpi_run_tests(tests);
 }

@@ -228,14 +228,11 @@ static void test_refused_threads_give_a_status(void **state) {
     /* An address-space limit does not mix with ASan's shadow memory or with
      * valgrind's own mappings. */
 #if defined(__SANITIZE_ADDRESS__)
-    printf("thread limits under a low RLIMIT_AS: skipped under AddressSanitizer\n");
-    return;
+    LPI_SKIP("thread limits under a low RLIMIT_AS: not under AddressSanitizer");
 #endif
     const char *preload = getenv("LD_PRELOAD");
-    if (preload && strstr(preload, "vgpreload")) {
-        printf("thread limits under a low RLIMIT_AS: skipped under valgrind\n");
-        return;
-    }
+    if (preload && strstr(preload, "vgpreload"))
+        LPI_SKIP("thread limits under a low RLIMIT_AS: not under valgrind");
     fflush(stdout);
     const pid_t child = fork();
     assert_true(child >= 0);
@@ -244,10 +241,8 @@ static void test_refused_threads_give_a_status(void **state) {
     }
     int status = 0;
     assert_int_equal(waitpid(child, &status, 0), child);
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 100) {
-        printf("thread limits: skipped (no FFTW or no OpenMP in this build)\n");
-        return;
-    }
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 100)
+        LPI_SKIP("thread limits: built without FFTW or without OpenMP");
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
         fail_msg("under a low RLIMIT_AS the child %s %d", WIFEXITED(status) ? "failed check" :
                  "was killed by signal", WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
@@ -257,9 +252,8 @@ static void test_thread_count_bound(void **state) {
     (void)state;
     lpi_system *sys = sine_euler_15();
     if (!sys || lpi_set_threads(sys, 2) == LPI_ERR_UNSUPPORTED) {
-        printf("thread count bound: skipped (no FFTW or no OpenMP in this build)\n");
         lpi_destroy(sys);
-        return;
+        LPI_SKIP("thread count bound: built without FFTW or without OpenMP");
     }
     cpu_set_t set;
     assert_int_equal(sched_getaffinity(0, sizeof set, &set), 0);
@@ -278,5 +272,5 @@ int main(void) {
         cmocka_unit_test(test_handles_on_threads),
         cmocka_unit_test(test_thread_count_bound),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return lpi_run_tests(tests);
 }
