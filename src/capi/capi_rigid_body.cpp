@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "../models/models.hpp"
-#include "../reference/rigid_body_exact.hpp"
+#include "../baselines/rigid_body_exact.hpp"
 #include "handle.hpp"
 
 using lpi::capi::guarded;
