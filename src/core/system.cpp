@@ -46,7 +46,8 @@ void require_length(const char *what, std::size_t given, std::size_t expected) {
 
 System::System(std::unique_ptr<Model> model)
     : model_(std::move(model)), method_(find_method("leapfrog")),
-      state_(model_->state_size(), 0.0), saved_(model_->state_size(), 0.0) {
+      state_(model_->state_size(), 0.0), saved_(model_->state_size(), 0.0),
+      split_(model_->split()) {
     rebuild_integrator();
 }
 
@@ -70,7 +71,9 @@ void System::set_split(const std::string &name) {
     const std::string previous = model_->split();
     model_->set_split(name);  // throws, unchanged, if unknown
     try {
+        std::string current = model_->split();
         rebuild_integrator();
+        split_.swap(current);
     } catch (...) {
         model_->set_split(previous);
         throw;

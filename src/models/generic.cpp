@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "../core/error.hpp"
+#include "../core/system.hpp"
 
 namespace lpi {
 
@@ -447,6 +448,36 @@ std::size_t GenericModel::poisson_rank(const double *x) const {
     for (double s : sigma)
         if (s > tolerance) ++rank;
     return rank;
+}
+
+GenericModel &generic_model_of(System &system) {
+    return const_cast<GenericModel &>(generic_model_of(static_cast<const System &>(system)));
+}
+
+const GenericModel &generic_model_of(const System &system) {
+    const auto *model = dynamic_cast<const GenericModel *>(&system.model());
+    if (!model)
+        fail(LPI_ERR_UNSUPPORTED, std::string("a ") + system.model().kind() +
+                                      " system has no user pieces or structure constants "
+                                      "(create it with lpi_generic_create or "
+                                      "lpi_moments_create)");
+    return *model;
+}
+
+void commit_new_piece(System &system, GenericModel &model) {
+    try {
+        system.rebuild_integrator();
+    } catch (...) {
+        model.remove_last_piece();
+        throw;
+    }
+}
+
+void add_piece(System &system, std::size_t n, const std::int32_t *indices, lpi_gradient_fn grad,
+               lpi_energy_fn energy, void *user) {
+    GenericModel &model = generic_model_of(system);
+    model.add_piece(n, indices, grad, energy, user);
+    commit_new_piece(system, model);
 }
 
 std::unique_ptr<GenericModel> make_generic(std::size_t dim, std::size_t nnz, const std::int32_t *i,

@@ -104,6 +104,8 @@ def _c_path(path):
 #: The library's version, "MAJOR.MINOR.PATCH".
 version = _text(lib.lpi_version_string())
 __version__ = version
+#: The same as one number, MAJOR * 10000 + MINOR * 100 + PATCH: compare this.
+version_number = lib.lpi_version_number()
 
 
 def status_name(status):
@@ -313,8 +315,6 @@ class System:
         self._handle = handle
         self._keep = []        # ctypes callbacks the library holds
         self._pending = []     # exception raised inside a callback during the current call
-        self._method = "leapfrog"
-        self._split = None
         self._threads = 1
         self._seconds_per_step = None  # measured by step(), for the SIGINT observer
         self._finalizer = weakref.finalize(self, _destroy, handle, self._keep)
@@ -371,11 +371,17 @@ class System:
         """The message of the most recent failed call on this system ("" if none)."""
         return _text(lib.lpi_last_error(self._h()))
 
+    @property
+    def kind(self):
+        """The system's kind: "rigid-body", "pendulum", "generic", "moments", "sine-euler"."""
+        return _text(lib.lpi_kind(self._h()))
+
     # method and split
     @property
     def method(self):
-        """The method's name ("leapfrog" until set; "custom" after set_composition)."""
-        return self._method
+        """The method's name ("leapfrog" until set; "custom" after set_composition;
+        an alias set is reported by its name)."""
+        return _text(lib.lpi_get_method(self._h()))
 
     @method.setter
     def method(self, name):
@@ -383,12 +389,11 @@ class System:
 
     def set_method(self, name):
         self._call("lpi_set_method", _c_string(name, "method"))
-        self._method = name
 
     @property
     def split(self):
-        """The split's name, or None for the system's default."""
-        return self._split
+        """The split's name (the system's default until set)."""
+        return _text(lib.lpi_get_split(self._h()))
 
     @split.setter
     def split(self, name):
@@ -396,13 +401,11 @@ class System:
 
     def set_split(self, name):
         self._call("lpi_set_split", _c_string(name, "split"))
-        self._split = name
 
     def set_composition(self, gammas):
         """A symmetric composition of leapfrog with weights gammas (method "custom")."""
         ptr, n, _keep = _doubles_in(gammas, "gammas")
         self._call("lpi_set_composition", n, ptr)
-        self._method = "custom"
 
     def flows_per_step(self):
         out = c_size_t()
@@ -555,19 +558,15 @@ class System:
         return buf.raw[:size.value]
 
     @classmethod
-    def _adopt(cls, handle, method=None):
+    def _adopt(cls, handle):
         """Wraps a handle made by lpi_load*, as the subclass of its kind."""
-        N = c_int32()
-        if lib.lpi_sine_euler_size(handle, byref(N)) == 0:
-            kind = SineEuler
-        elif lib.lpi_rigid_body_exact(handle, 0.0, (c_double * 3)()) == 0:
-            kind = RigidBody
-        else:
-            kind = Pendulum  # generic and moment systems cannot be saved
+        # Generic and moment systems cannot be saved.
+        classes = {"sine-euler": SineEuler, "rigid-body": RigidBody, "pendulum": Pendulum}
+        kind = classes[_text(lib.lpi_kind(handle))]
         self = kind.__new__(kind)
         self._handle = handle
         self._keep, self._pending = [], []
-        self._method, self._split, self._threads = method, None, 1
+        self._threads = 1
         self._seconds_per_step = None
         self._finalizer = weakref.finalize(self, _destroy, handle, self._keep)
         return self
@@ -575,7 +574,7 @@ class System:
     def __repr__(self):
         if self.closed:
             return "<%s (closed)>" % type(self).__name__
-        return "<%s dim=%d method=%r t=%g>" % (type(self).__name__, self.dim, self._method, self.time)
+        return "<%s dim=%d method=%r t=%g>" % (type(self).__name__, self.dim, self.method, self.time)
 
 
 class RigidBody(System):
@@ -790,8 +789,7 @@ class SineEuler(System):
 
 def load(path):
     """A system restored from a checkpoint file (lpi_load); it continues the
-    saved trajectory bit for bit. The method's name is not stored in the object
-    (its .method is None) but the library uses the saved one."""
+    saved trajectory bit for bit, with the saved method and split."""
     handle = ctypes.c_void_p()
     _check_free(lib.lpi_load(byref(handle), _c_path(path)))
     return System._adopt(handle)
