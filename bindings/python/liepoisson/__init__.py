@@ -36,7 +36,7 @@ if not os.environ.get("LIEPOISSON_NO_NUMPY"):
 HAVE_NUMPY = np is not None
 
 __all__ = [
-    "version", "methods", "Method", "status_name", "status_message", "HAVE_NUMPY",
+    "version", "version_number", "methods", "Method", "status_name", "status_message", "HAVE_NUMPY",
     "System", "RigidBody", "Pendulum", "Generic", "Moments", "SineEuler",
     "load", "load_bytes", "fftw_wisdom_import_file", "fftw_wisdom_export_file",
     "fftw_wisdom_import_string", "fftw_wisdom_export_string",
