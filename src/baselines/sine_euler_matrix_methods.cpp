@@ -65,17 +65,17 @@ public:
 private:
     // dw_m/dt = sum_{n != 0} sin(eps m x n) / (eps |n|^2) w_{m+n} w_{-n}  (eq. 5)
     void rate(const double *modes, double *out) const {
-        const int N = N_;
+        const std::size_t N = static_cast<std::size_t>(N_);
         const cplx *w = reinterpret_cast<const cplx *>(modes);
         cplx *r = reinterpret_cast<cplx *>(out);
-        for (int m1 = 0; m1 < N; ++m1)
-            for (int m2 = 0; m2 < N; ++m2) {
+        for (std::size_t m1 = 0; m1 < N; ++m1)
+            for (std::size_t m2 = 0; m2 < N; ++m2) {
                 cplx sum = 0.0;
-                for (int n1 = 0; n1 < N; ++n1) {
-                    const int row = (m1 + n1) % N, minus1 = (N - n1) % N;
+                for (std::size_t n1 = 0; n1 < N; ++n1) {
+                    const std::size_t row = (m1 + n1) % N, minus1 = (N - n1) % N;
                     // cross = m1 n2 - m2 n1 (mod N), advanced by m1 with n2.
-                    int cross = (N - (m2 * n1) % N) % N;
-                    for (int n2 = 0; n2 < N; ++n2) {
+                    std::size_t cross = (N - (m2 * n1) % N) % N;
+                    for (std::size_t n2 = 0; n2 < N; ++n2) {
                         const double c = sine_[cross] * weight_[n1 * N + n2];
                         sum += c * w[row * N + (m2 + n2) % N] * w[minus1 * N + (N - n2) % N];
                         cross += m1;
@@ -102,11 +102,12 @@ extern "C" void zgemm_(const char *transa, const char *transb, const int *m, con
 // Keeps the mode array Hermitian (w_-m = conj(w_m)) after a matrix-form step,
 // where round-off of the transforms breaks it slightly, and restores the
 // inert mode w_0 exactly.
-void symmetrise_modes(int N, const double *w0, double *modes) {
+void symmetrise_modes(int order, const double *w0, double *modes) {
+    const std::size_t N = static_cast<std::size_t>(order);
     cplx *w = reinterpret_cast<cplx *>(modes);
-    for (int a = 0; a < N; ++a)
-        for (int b = 0; b < N; ++b) {
-            const int m = a * N + b, minus = ((N - a) % N) * N + (N - b) % N;
+    for (std::size_t a = 0; a < N; ++a)
+        for (std::size_t b = 0; b < N; ++b) {
+            const std::size_t m = a * N + b, minus = ((N - a) % N) * N + (N - b) % N;
             if (minus <= m) continue;
             const cplx mean = 0.5 * (w[m] + std::conj(w[minus]));
             w[m] = mean;
@@ -128,17 +129,19 @@ class MatrixForm {
 public:
     explicit MatrixForm(int N)
         : N_(N), index_(static_cast<std::size_t>(N) * N), inverse_laplacian_(index_.size()) {
-        const int half = (N + 1) / 2;  // the inverse of 2 mod N (N odd)
-        for (int m2 = 0; m2 < N; ++m2)
-            for (int k = 0; k < N; ++k) {
-                const int a = static_cast<int>((static_cast<long>(k - m2 + N) * half) % N);
-                const int b = (a + m2) % N;
-                index_[m2 * N + k] = a + b * N;
+        const std::size_t n = static_cast<std::size_t>(N);
+        const std::size_t half = (n + 1) / 2;  // the inverse of 2 mod N (N odd)
+        for (std::size_t m2 = 0; m2 < n; ++m2)
+            for (std::size_t k = 0; k < n; ++k) {
+                const std::size_t a = (k + n - m2) * half % n, b = (a + m2) % n;
+                index_[m2 * n + k] = a + b * n;
             }
-        for (int m2 = 0; m2 < N; ++m2)
-            for (int m1 = 0; m1 < N; ++m1) {
-                const int r1 = rep(m1, N), r2 = rep(m2, N), norm2 = r1 * r1 + r2 * r2;
-                inverse_laplacian_[m2 * N + m1] = norm2 ? 1.0 / (static_cast<double>(N) * norm2) : 0.0;
+        for (std::size_t m2 = 0; m2 < n; ++m2)
+            for (std::size_t m1 = 0; m1 < n; ++m1) {
+                const long r1 = rep(static_cast<int>(m1), N), r2 = rep(static_cast<int>(m2), N);
+                const long norm2 = r1 * r1 + r2 * r2;
+                inverse_laplacian_[m2 * n + m1] =
+                    norm2 ? 1.0 / (static_cast<double>(N) * static_cast<double>(norm2)) : 0.0;
             }
         std::lock_guard<std::mutex> lock(fftw_planner_mutex());
         buffer_ = fftw_alloc_complex(index_.size());
@@ -161,24 +164,24 @@ public:
     MatrixForm &operator=(const MatrixForm &) = delete;
 
     void to_matrix(const double *modes, cplx *W) {
-        const int N = N_;
+        const std::size_t N = static_cast<std::size_t>(N_);
         const cplx *w = reinterpret_cast<const cplx *>(modes);
         cplx *x = reinterpret_cast<cplx *>(buffer_);
-        for (int m1 = 0; m1 < N; ++m1)
-            for (int m2 = 0; m2 < N; ++m2) x[m2 * N + m1] = w[m1 * N + m2];
+        for (std::size_t m1 = 0; m1 < N; ++m1)
+            for (std::size_t m2 = 0; m2 < N; ++m2) x[m2 * N + m1] = w[m1 * N + m2];
         fftw_execute(backward_);
         scatter(W);
     }
 
     void to_modes(const cplx *W, double *modes) {
-        const int N = N_;
+        const std::size_t N = static_cast<std::size_t>(N_);
         gather(W);
         fftw_execute(forward_);
         const cplx *x = reinterpret_cast<const cplx *>(buffer_);
         cplx *w = reinterpret_cast<cplx *>(modes);
-        const double scale = 1.0 / N;
-        for (int m1 = 0; m1 < N; ++m1)
-            for (int m2 = 0; m2 < N; ++m2) w[m1 * N + m2] = scale * x[m2 * N + m1];
+        const double scale = 1.0 / N_;
+        for (std::size_t m1 = 0; m1 < N; ++m1)
+            for (std::size_t m2 = 0; m2 < N; ++m2) w[m1 * N + m2] = scale * x[m2 * N + m1];
     }
 
     // P = sum_{n != 0} w_n / |n|^2 J_n for W = sum_n w_n J_n.
@@ -209,7 +212,7 @@ private:
     }
 
     int N_;
-    std::vector<int> index_;                // [m2 * N + k] -> entry (a, a + m2) of W
+    std::vector<std::size_t> index_;        // [m2 * N + k] -> entry (a, a + m2) of W
     std::vector<double> inverse_laplacian_;  // [m2 * N + m1] = 1 / (N |m|^2), 0 at m = 0
     fftw_complex *buffer_ = nullptr;
     fftw_plan forward_ = nullptr, backward_ = nullptr;
@@ -245,10 +248,10 @@ protected:
     // Out = i f (X - X^dagger): the Hermitian [B, W] when X = P W, since
     // W P = (P W)^dagger for Hermitian P and W.
     void commutator(const cplx *X, cplx *out) const {
-        const int N = N_;
+        const std::size_t N = static_cast<std::size_t>(N_);
         const cplx factor(0.0, f_);
-        for (int j = 0; j < N; ++j)
-            for (int i = 0; i < N; ++i)
+        for (std::size_t j = 0; j < N; ++j)
+            for (std::size_t i = 0; i < N; ++i)
                 out[i + j * N] = factor * (X[i + j * N] - std::conj(X[j + i * N]));
     }
 

@@ -173,7 +173,7 @@ void StructureConstants::check_jacobi() const {
 }
 
 void StructureConstants::poisson_matrix(const double *x, double *J) const {
-    std::fill(J, J + dim_ * dim_, 0.0);
+    std::fill(J, J + square_entries(dim_, "Poisson matrix"), 0.0);
     for (const auto &[key, outputs] : brackets_) {
         double s = 0.0;
         for (const Output &o : outputs) s += o.c * x[o.l];
@@ -202,11 +202,12 @@ public:
         // A_il = sum_p c_{i sigma_p}^l g_p: one matrix entry per distinct
         // (i, l), fed by the contributions (p, c) that land on it.
         struct Raw {
-            std::uint32_t row, col, p;
+            std::uint32_t row, col;
+            std::size_t p;
             double c;
         };
         std::vector<Raw> raw;
-        for (std::uint32_t p = 0; p < sigma_.size(); ++p)
+        for (std::size_t p = 0; p < sigma_.size(); ++p)
             for (const StructureConstants::Term &t : constants_.column(sigma_[p]))
                 raw.push_back({t.i, t.l, p, t.c});
         std::sort(raw.begin(), raw.end(), [](const Raw &a, const Raw &b) {
@@ -250,7 +251,7 @@ public:
 private:
     struct Contribution {
         std::size_t entry;
-        std::uint32_t p;
+        std::size_t p;
         double c;
     };
 
@@ -382,7 +383,7 @@ void GenericModel::add_builtin_casimir(lpi_casimir_fn fn, const std::string &nam
 std::vector<double> singular_values(std::size_t n, std::vector<double> M) {
     // One-sided Jacobi (Hestenes 1958): rotate pairs of columns until they are
     // mutually orthogonal; the column norms are then the singular values.
-    std::vector<double> col(n * n);  // column-major copy
+    std::vector<double> col(square_entries(n, "matrix"));  // column-major copy
     for (std::size_t r = 0; r < n; ++r)
         for (std::size_t c = 0; c < n; ++c) col[c * n + r] = M[r * n + c];
     for (int sweep = 0; sweep < 100; ++sweep) {
@@ -428,7 +429,7 @@ std::size_t GenericModel::poisson_rank(const double *x) const {
     if (x_max == 0.0) return 0;
     std::vector<double> scaled(x, x + n);
     for (double &v : scaled) v /= x_max;
-    std::vector<double> J(n * n);
+    std::vector<double> J(square_entries(n, "Poisson matrix J(x)"));
     constants_->poisson_matrix(scaled.data(), J.data());
     double J_max = 0.0;
     for (std::size_t e = 0; e < J.size(); ++e) {
