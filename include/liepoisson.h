@@ -41,7 +41,8 @@
 #define LPI_VERSION_PATCH 0
 /* The version as one number that grows with every release:
  * MAJOR * 10000 + MINOR * 100 + PATCH (0.1.0 is 100). */
-#define LPI_VERSION_NUMBER (LPI_VERSION_MAJOR * 10000 + LPI_VERSION_MINOR * 100 + LPI_VERSION_PATCH)
+#define LPI_VERSION_NUMBER \
+    (LPI_VERSION_MAJOR * 10000 + LPI_VERSION_MINOR * 100 + LPI_VERSION_PATCH)
 
 #if defined(LPI_BUILDING_LIBRARY) && defined(__GNUC__)
 #define LPI_API __attribute__((visibility("default")))

@@ -344,8 +344,9 @@ private:
                     const std::size_t e = i + j * n;
                     const cplx sym = 0.5 * (Y_[e] + std::conj(Y_[j + i * n]));
                     next[e] = W[e] + 0.5 * h * C_[e] + quad * sym;
-                    change = max_change(change, std::max(std::fabs(next[e].real() - mid[e].real()),
-                                                         std::fabs(next[e].imag() - mid[e].imag())));
+                    const double d = std::max(std::fabs(next[e].real() - mid[e].real()),
+                                              std::fabs(next[e].imag() - mid[e].imag()));
+                    change = max_change(change, d);
                 }
             converged = fixed_point_converged(change, largest, settings_, "isomp", s);
             std::swap(mid_, next_);

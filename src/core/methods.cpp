@@ -1,11 +1,11 @@
 #include "methods.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
 #include "error.hpp"
 #include "integrator.hpp"
+#include "text.hpp"
 
 namespace lpi {
 
@@ -196,12 +196,6 @@ int recursive_order(const std::string &name, const std::string &prefix) {
     return p;
 }
 
-std::string format_double(double x) {
-    char buffer[40];
-    std::snprintf(buffer, sizeof buffer, "%.17g", x);
-    return buffer;
-}
-
 }  // namespace
 
 const std::vector<Method> &method_table() {
@@ -255,7 +249,7 @@ Method custom_composition(const double *gammas, std::size_t n) {
     for (std::size_t i = 0; i < n; ++i)
         if (!std::isfinite(gammas[i]))
             fail(LPI_ERR_NONFINITE, "gammas[" + std::to_string(i) + "] = " +
-                                        format_double(gammas[i]) + " is not finite");
+                                        number_text(gammas[i]) + " is not finite");
     // The sum of |gammas| bounds every difference, partial sum, merged flow
     // weight and mean below: when it is finite, none of them overflows.
     double magnitude = 0.0;
@@ -268,8 +262,8 @@ Method custom_composition(const double *gammas, std::size_t n) {
         const double a = gammas[i], b = gammas[j];
         if (std::fabs(a - b) > kTolerance * std::fmax(std::fabs(a), std::fabs(b)))
             fail(LPI_ERR_INVALID, "the weights are not symmetric: gammas[" + std::to_string(i) +
-                                      "] = " + format_double(a) + " but gammas[" +
-                                      std::to_string(j) + "] = " + format_double(b) +
+                                      "] = " + number_text(a) + " but gammas[" +
+                                      std::to_string(j) + "] = " + number_text(b) +
                                       " (they must agree to a relative 1e-14)");
     }
     // Neumaier's compensated sum, so the test is not blurred by its own round-off.
@@ -281,7 +275,7 @@ Method custom_composition(const double *gammas, std::size_t n) {
     }
     sum += compensation;
     if (!(std::fabs(sum - 1.0) <= kTolerance * magnitude))
-        fail(LPI_ERR_INVALID, "the weights sum to " + format_double(sum) +
+        fail(LPI_ERR_INVALID, "the weights sum to " + number_text(sum) +
                                   ", not 1 (they must, to 1e-14 times the sum of their "
                                   "absolute values)");
     std::vector<double> symmetric(gammas, gammas + n);

@@ -3,28 +3,16 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <tuple>
 
 #include "../core/error.hpp"
 #include "../core/system.hpp"
+#include "../core/text.hpp"
 
 namespace lpi {
 
 namespace {
-
-std::string number(double v) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.17g", v);
-    return buffer;
-}
-
-std::string short_number(double v) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.3g", v);
-    return buffer;
-}
 
 std::string x_name(std::uint32_t i) { return "x_" + std::to_string(i); }
 
@@ -32,7 +20,7 @@ std::string bracket_text(std::uint32_t i, std::uint32_t j,
                          const std::vector<StructureConstants::Output> &terms) {
     std::string s = "{" + x_name(i) + ", " + x_name(j) + "} = ";
     for (std::size_t t = 0; t < terms.size(); ++t)
-        s += (t ? " + " : "") + number(terms[t].c) + " " + x_name(terms[t].l);
+        s += (t ? " + " : "") + number_text(terms[t].c) + " " + x_name(terms[t].l);
     return s;
 }
 
@@ -67,13 +55,13 @@ StructureConstants::StructureConstants(std::size_t dim, std::size_t nnz, const s
             if (idx[q] < 0 || static_cast<std::size_t>(idx[q]) >= dim)
                 fail(LPI_ERR_INVALID, entry + names[q] + " = " + std::to_string(idx[q]) + range);
         if (!std::isfinite(c[e]))
-            fail(LPI_ERR_NONFINITE, entry + "c = " + number(c[e]) + " is not finite");
+            fail(LPI_ERR_NONFINITE, entry + "c = " + number_text(c[e]) + " is not finite");
         const auto a = static_cast<std::uint32_t>(idx[0]), b = static_cast<std::uint32_t>(idx[1]),
                    l = static_cast<std::uint32_t>(idx[2]);
         if (a == b) {
             if (c[e] != 0.0)
                 fail(LPI_ERR_INVALID, entry + "{" + x_name(a) + ", " + x_name(a) + "} must be 0 "
-                                      "(antisymmetry), got coefficient " + number(c[e]) +
+                                      "(antisymmetry), got coefficient " + number_text(c[e]) +
                                       " on " + x_name(l));
             continue;
         }
@@ -84,8 +72,8 @@ StructureConstants::StructureConstants(std::size_t dim, std::size_t nnz, const s
             const double implied = a < b ? it->second.first : -it->second.first;
             fail(LPI_ERR_INVALID,
                  entry + "gives {" + x_name(a) + ", " + x_name(b) + "} the coefficient " +
-                     number(c[e]) + " on " + x_name(l) + ", but entry " +
-                     std::to_string(it->second.second) + " implies " + number(implied) +
+                     number_text(c[e]) + " on " + x_name(l) + ", but entry " +
+                     std::to_string(it->second.second) + " implies " + number_text(implied) +
                      " (entries must agree, with {x_j, x_i} = -{x_i, x_j})");
         }
     }
@@ -163,7 +151,7 @@ void StructureConstants::check_jacobi() const {
                          "the structure constants violate the Jacobi identity at (i, j, k) = (" +
                              std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " +
                              std::to_string(t[2]) + "): {{x_i, x_j}, x_k} + {{x_j, x_k}, x_i} + "
-                             "{{x_k, x_i}, x_j} has coefficient " + short_number(value[m]) +
+                             "{{x_k, x_i}, x_j} has coefficient " + number_text(value[m], 3) +
                              " on " + x_name(m) + " (must be 0)");
             }
             for (std::uint32_t m : touched) value[m] = size[m] = 0.0;

@@ -1,9 +1,9 @@
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 #include "../core/error.hpp"
+#include "../core/text.hpp"
 #include "models.hpp"
 
 namespace lpi {
@@ -63,12 +63,6 @@ namespace {
 // component, with a margin of 2^21 over what the flows leave: 2^-32 of it.
 constexpr double kMaxRelativeCarry = 0x1p-32;
 
-std::string format_double(double x) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.17g", x);
-    return text;
-}
-
 }  // namespace
 
 void check_compensated_state(const Model &model, const double *state) {
@@ -84,9 +78,9 @@ void check_compensated_state(const Model &model, const double *state) {
     for (std::size_t i = 0; i < n; ++i)
         if (std::fabs(state[n + i]) > kMaxRelativeCarry * largest)
             fail(LPI_ERR_INVALID, "the compensation carry of state entry " + std::to_string(i) +
-                                      " is " + format_double(state[n + i]) +
+                                      " is " + number_text(state[n + i]) +
                                       ", no rounding remainder of a state whose largest entry "
-                                      "is " + format_double(largest));
+                                      "is " + number_text(largest));
 }
 
 }  // namespace lpi
