@@ -2,6 +2,7 @@
 // (implicit-midpoint, isomp), written once.
 #pragma once
 
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 
@@ -15,17 +16,37 @@ inline double max_change(double change, double d) {
     return d > change || std::isnan(d) ? d : change;
 }
 
-// Whether an iteration whose largest change is `change` has converged for a
-// state whose largest |component| is `largest`: change <= tolerance *
-// max(1, largest) (lpi_set_implicit_options). Compared as a quotient: the
-// product of a large tolerance and a large state would overflow to +inf and
-// pass any change at once. Throws LPI_ERR_NO_CONVERGENCE naming `method` and
-// `step` when the iteration diverged (a change that is not finite).
-bool fixed_point_converged(double change, double largest, const ImplicitSettings &settings,
-                           const char *method, std::int64_t step);
+// One step's test: the iteration has converged when its largest change is at
+// most tolerance * max(1, max|x|) (lpi_set_implicit_options), x the state
+// the step starts from. The bound is formed once per step; where the product
+// overflows, the true bound exceeds every double and DBL_MAX stands for it,
+// so that the test never compares against +inf.
+class FixedPointTest {
+public:
+    FixedPointTest(const ImplicitSettings &settings, double largest, const char *method,
+                   std::int64_t step)
+        : settings_(settings), method_(method), step_(step) {
+        const double bound = settings.tolerance * std::fmax(1.0, largest);
+        bound_ = std::isfinite(bound) ? bound : DBL_MAX;
+    }
 
-// Throws LPI_ERR_NO_CONVERGENCE: no convergence in settings.max_iterations.
-[[noreturn]] void fixed_point_failed(const ImplicitSettings &settings, const char *method,
-                                     std::int64_t step);
+    // Whether an iteration whose largest change is `change` has converged;
+    // LPI_ERR_NO_CONVERGENCE when it diverged (a change that is not finite).
+    bool converged(double change) const {
+        if (!std::isfinite(change)) diverged();
+        return change <= bound_;
+    }
+
+    // LPI_ERR_NO_CONVERGENCE: no convergence in settings.max_iterations.
+    [[noreturn]] void failed() const;
+
+private:
+    [[noreturn]] void diverged() const;
+
+    const ImplicitSettings &settings_;
+    const char *method_;
+    std::int64_t step_;
+    double bound_;
+};
 
 }  // namespace lpi

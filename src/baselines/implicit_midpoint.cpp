@@ -41,6 +41,7 @@ private:
         for (std::size_t i = 0; i < size; ++i) midpoint_[i] = x[i] + 0.5 * dt * rate_[i];
         double largest = 0.0;
         for (std::size_t i = 0; i < size; ++i) largest = std::max(largest, std::fabs(x[i]));
+        const FixedPointTest test(settings_, largest, "implicit midpoint", step);
         for (int k = 0; k < settings_.max_iterations; ++k) {
             model.vector_field(midpoint_.data(), rate_.data());
             double change = 0.0;
@@ -49,12 +50,12 @@ private:
                 change = max_change(change, std::fabs(y - midpoint_[i]));
                 midpoint_[i] = y;
             }
-            if (fixed_point_converged(change, largest, settings_, "implicit midpoint", step)) {
+            if (test.converged(change)) {
                 for (std::size_t i = 0; i < size; ++i) x[i] = 2.0 * midpoint_[i] - x[i];
                 return k + 1;
             }
         }
-        fixed_point_failed(settings_, "implicit midpoint", step);
+        test.failed();
     }
 
     ImplicitSettings settings_;

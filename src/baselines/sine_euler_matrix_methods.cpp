@@ -331,6 +331,7 @@ private:
         // B Wt B = -f^2 P Wt P, symmetrised so Wt stays exactly Hermitian.
         const double quad = -0.25 * h * h * f_ * f_;
         const std::size_t n = static_cast<std::size_t>(N);
+        const FixedPointTest test(settings_, largest, "isomp", s);
         bool converged = false;
         for (int k = 0; k < settings_.max_iterations && !converged; ++k) {
             form_.stream(mid, P_.data());
@@ -348,12 +349,12 @@ private:
                                               std::fabs(next[e].imag() - mid[e].imag()));
                     change = max_change(change, d);
                 }
-            converged = fixed_point_converged(change, largest, settings_, "isomp", s);
+            converged = test.converged(change);
             std::swap(mid_, next_);
             mid = mid_.data();
             next = next_.data();
         }
-        if (!converged) fixed_point_failed(settings_, "isomp", s);
+        if (!converged) test.failed();
         // W_{n+1} = W_n + h [B(Wt), Wt] with the last iterate's commutator.
         for (std::size_t i = 0; i < size_; ++i) W[i] += h * C_[i];
     }
