@@ -65,17 +65,19 @@ public:
 private:
     // dw_m/dt = sum_{n != 0} sin(eps m x n) / (eps |n|^2) w_{m+n} w_{-n}  (eq. 5)
     void rate(const double *modes, double *out) const {
-        const std::size_t N = static_cast<std::size_t>(N_);
+        // int indices: N <= kDirectEq5MaxN, so none exceeds N^2 = 961, and
+        // the remainders of this O(N^4) loop are cheaper in 32 bits.
+        const int N = N_;
         const cplx *w = reinterpret_cast<const cplx *>(modes);
         cplx *r = reinterpret_cast<cplx *>(out);
-        for (std::size_t m1 = 0; m1 < N; ++m1)
-            for (std::size_t m2 = 0; m2 < N; ++m2) {
+        for (int m1 = 0; m1 < N; ++m1)
+            for (int m2 = 0; m2 < N; ++m2) {
                 cplx sum = 0.0;
-                for (std::size_t n1 = 0; n1 < N; ++n1) {
-                    const std::size_t row = (m1 + n1) % N, minus1 = (N - n1) % N;
+                for (int n1 = 0; n1 < N; ++n1) {
+                    const int row = (m1 + n1) % N, minus1 = (N - n1) % N;
                     // cross = m1 n2 - m2 n1 (mod N), advanced by m1 with n2.
-                    std::size_t cross = (N - (m2 * n1) % N) % N;
-                    for (std::size_t n2 = 0; n2 < N; ++n2) {
+                    int cross = (N - (m2 * n1) % N) % N;
+                    for (int n2 = 0; n2 < N; ++n2) {
                         const double c = sine_[cross] * weight_[n1 * N + n2];
                         sum += c * w[row * N + (m2 + n2) % N] * w[minus1 * N + (N - n2) % N];
                         cross += m1;
