@@ -1,4 +1,4 @@
-// The C ABI of the rigid body's exact solution (a reference, beside the
+// The C ABI of the rigid body's exact solution (a baseline, beside the
 // integrators, never inside them).
 #include <cmath>
 
