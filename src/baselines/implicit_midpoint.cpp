@@ -42,7 +42,9 @@ private:
         double largest = 0.0;
         for (std::size_t i = 0; i < size; ++i) largest = std::max(largest, std::fabs(x[i]));
         const FixedPointTest test(settings_, largest, "implicit midpoint", step);
-        for (int k = 0; k < settings_.max_iterations; ++k) {
+        bool converged = false;
+        int iterations = 0;
+        while (iterations < settings_.max_iterations && !converged) {
             model.vector_field(midpoint_.data(), rate_.data());
             double change = 0.0;
             for (std::size_t i = 0; i < size; ++i) {
@@ -50,12 +52,12 @@ private:
                 change = max_change(change, std::fabs(y - midpoint_[i]));
                 midpoint_[i] = y;
             }
-            if (test.converged(change)) {
-                for (std::size_t i = 0; i < size; ++i) x[i] = 2.0 * midpoint_[i] - x[i];
-                return k + 1;
-            }
+            ++iterations;
+            converged = test.converged(change);
         }
-        test.failed();
+        if (!converged) test.failed();
+        for (std::size_t i = 0; i < size; ++i) x[i] = 2.0 * midpoint_[i] - x[i];
+        return iterations;
     }
 
     ImplicitSettings settings_;
