@@ -18,8 +18,16 @@
  * (lpi_set_observer) the read-only functions - those taking a const
  * lpi_system * (lpi_get_state, lpi_energy, lpi_casimirs, the sine-Euler
  * getters, lpi_save, ...) - are allowed; and lpi_dim, lpi_time,
- * lpi_casimir_count and lpi_last_error, which return no status, always
- * answer. Calls on other handles are not affected.
+ * lpi_casimir_count, lpi_kind, lpi_get_method, lpi_get_split and
+ * lpi_last_error, which return no status, always answer. Calls on other
+ * handles are not affected.
+ *
+ * Kinds: a function defined for some kinds of system only (lpi_rigid_body_exact,
+ * lpi_add_piece, lpi_add_casimir, lpi_poisson_rank,
+ * lpi_moments_add_product_piece, the lpi_sine_euler_* functions, the
+ * sine-Euler matrix methods) returns LPI_ERR_UNSUPPORTED, "not defined for
+ * this system", for a handle of another kind (lpi_kind names it), and
+ * changes nothing.
  */
 #ifndef LIEPOISSON_H
 #define LIEPOISSON_H
@@ -31,6 +39,10 @@
 #define LPI_VERSION_MAJOR 0
 #define LPI_VERSION_MINOR 1
 #define LPI_VERSION_PATCH 0
+/* The version as one number that grows with every release:
+ * MAJOR * 10000 + MINOR * 100 + PATCH (0.1.0 is 100). */
+#define LPI_VERSION_NUMBER \
+    (LPI_VERSION_MAJOR * 10000 + LPI_VERSION_MINOR * 100 + LPI_VERSION_PATCH)
 
 #if defined(LPI_BUILDING_LIBRARY) && defined(__GNUC__)
 #define LPI_API __attribute__((visibility("default")))
@@ -77,6 +89,9 @@ typedef struct lpi_system lpi_system;
 /* ---- Version, status codes, methods (no handle needed) ------------------- */
 
 LPI_API const char *lpi_version_string(void);        /* "MAJOR.MINOR.PATCH" */
+/* LPI_VERSION_NUMBER of the library that runs: compare it with the macro (the
+ * header a program was built against), or a binding's minimum, as numbers. */
+LPI_API int lpi_version_number(void);
 LPI_API const char *lpi_status_name(int status);     /* "LPI_ERR_SIZE"; "LPI_UNKNOWN_STATUS" otherwise */
 LPI_API const char *lpi_status_message(int status);  /* one-line description */
 
@@ -114,6 +129,19 @@ LPI_API int lpi_destroy(lpi_system *sys);
 
 LPI_API int lpi_set_method(lpi_system *sys, const char *name);
 LPI_API int lpi_set_split(lpi_system *sys, const char *name);
+
+/* What a system is and how it is integrated, as names; NULL for a NULL
+ * handle. lpi_kind: "rigid-body", "pendulum", "generic", "moments" or
+ * "sine-euler", valid as long as the handle. lpi_get_method: the method's
+ * name as lpi_set_method takes it ("leapfrog" for a new system; "custom" after
+ * lpi_set_composition; an alias is resolved: "strang" gives "leapfrog").
+ * lpi_get_split: the split in use (the default for a new system). The string
+ * belongs to the handle, like lpi_last_error's: valid until the next
+ * lpi_set_method, lpi_set_composition or lpi_set_split on it (for
+ * lpi_get_split: lpi_set_split) or lpi_destroy; copy it to keep it. */
+LPI_API const char *lpi_kind(const lpi_system *sys);
+LPI_API const char *lpi_get_method(const lpi_system *sys);
+LPI_API const char *lpi_get_split(const lpi_system *sys);
 
 /* Dimension of the state vector; 0 for NULL. */
 LPI_API size_t lpi_dim(const lpi_system *sys);
@@ -254,7 +282,7 @@ LPI_API int lpi_moments_add_product_piece(lpi_system *sys, lpi_scalar_fn h, lpi_
 
 /* Built without FFTW3: LPI_ERR_UNSUPPORTED. N even or < 3: LPI_ERR_INVALID. */
 LPI_API int lpi_sine_euler_create(lpi_system **out, int32_t N);
-/* N of a sine-Euler system (LPI_ERR_INVALID for another kind of system). */
+/* N of a sine-Euler system (LPI_ERR_UNSUPPORTED for another kind of system). */
 LPI_API int lpi_sine_euler_size(const lpi_system *sys, int32_t *N);
 
 /* Modes, n = 2*N*N doubles: entry [a*N + b] is mode (a, b) mod N (FFT order)

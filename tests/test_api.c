@@ -17,6 +17,13 @@ static void test_version_and_status_names(void **state) {
     snprintf(expected, sizeof expected, "%d.%d.%d", LPI_VERSION_MAJOR, LPI_VERSION_MINOR,
              LPI_VERSION_PATCH);
     assert_string_equal(lpi_version_string(), expected);
+    /* One number for comparisons: the header's and the library's agree. */
+    assert_int_equal(LPI_VERSION_NUMBER,
+                     LPI_VERSION_MAJOR * 10000 + LPI_VERSION_MINOR * 100 + LPI_VERSION_PATCH);
+    assert_int_equal(lpi_version_number(), LPI_VERSION_NUMBER);
+    snprintf(expected, sizeof expected, "%d.%d.%d", lpi_version_number() / 10000,
+             lpi_version_number() / 100 % 100, lpi_version_number() % 100);
+    assert_string_equal(lpi_version_string(), expected);
     assert_string_equal(lpi_status_name(LPI_OK), "LPI_OK");
     assert_string_equal(lpi_status_name(LPI_ERR_NULL), "LPI_ERR_NULL");
     assert_string_equal(lpi_status_name(LPI_ERR_SIZE), "LPI_ERR_SIZE");
@@ -193,6 +200,148 @@ static void test_successful_calls(void **state) {
     lpi_destroy(sys);
 }
 
+/* Every setter has a getter: the kind, method and split read back what was
+ * set, a failed setter leaves them, and a checkpoint brings them back. */
+static void test_getters(void **state) {
+    (void)state;
+    assert_null(lpi_kind(NULL));
+    assert_null(lpi_get_method(NULL));
+    assert_null(lpi_get_split(NULL));
+    lpi_system *sys = rigid_body();
+    assert_string_equal(lpi_kind(sys), "rigid-body");
+    assert_string_equal(lpi_get_method(sys), "leapfrog");
+    assert_string_equal(lpi_get_split(sys), "casimir-shift");
+    assert_int_equal(lpi_set_method(sys, "strang"), LPI_OK);
+    assert_string_equal(lpi_get_method(sys), "leapfrog"); /* the alias's name */
+    assert_int_equal(lpi_set_method(sys, "suzuki-6"), LPI_OK);
+    assert_string_equal(lpi_get_method(sys), "suzuki-6");
+    assert_int_equal(lpi_set_split(sys, "axes"), LPI_OK);
+    assert_string_equal(lpi_get_split(sys), "axes");
+    LPI_ASSERT_FAILS(sys, lpi_set_method(sys, "no-such-method"), LPI_ERR_INVALID, "lpi_set_method");
+    LPI_ASSERT_FAILS(sys, lpi_set_split(sys, "standard-map"), LPI_ERR_INVALID, "lpi_set_split");
+    assert_string_equal(lpi_get_method(sys), "suzuki-6");
+    assert_string_equal(lpi_get_split(sys), "axes");
+
+    unsigned char buf[4096];
+    size_t size = 0;
+    assert_int_equal(lpi_save_buffer(sys, buf, sizeof buf, &size), LPI_OK);
+    lpi_system *copy = NULL;
+    assert_int_equal(lpi_load_buffer(&copy, buf, size), LPI_OK);
+    assert_string_equal(lpi_kind(copy), "rigid-body");
+    assert_string_equal(lpi_get_method(copy), "suzuki-6");
+    assert_string_equal(lpi_get_split(copy), "axes");
+    lpi_destroy(copy);
+
+    const double gammas[3] = {0.25, 0.5, 0.25};
+    assert_int_equal(lpi_set_composition(sys, 3, gammas), LPI_OK);
+    assert_string_equal(lpi_get_method(sys), "custom");
+    lpi_destroy(sys);
+
+    lpi_system *other = NULL;
+    assert_int_equal(lpi_pendulum_create(&other), LPI_OK);
+    assert_string_equal(lpi_kind(other), "pendulum");
+    assert_string_equal(lpi_get_split(other), "standard-map");
+    lpi_destroy(other);
+    assert_int_equal(lpi_moments_create(&other), LPI_OK);
+    assert_string_equal(lpi_kind(other), "moments");
+    assert_string_equal(lpi_get_split(other), "pieces");
+    lpi_destroy(other);
+    assert_int_equal(lpi_generic_create(&other, 1, 0, NULL, NULL, NULL, NULL), LPI_OK);
+    assert_string_equal(lpi_kind(other), "generic");
+    lpi_destroy(other);
+    if (lpi_sine_euler_create(&other, 5) == LPI_OK) {
+        assert_string_equal(lpi_kind(other), "sine-euler");
+        lpi_destroy(other);
+    }
+}
+
+static int zero_gradient(size_t n, const double *x, double *g, void *user) {
+    (void)x, (void)user;
+    for (size_t i = 0; i < n; ++i) g[i] = 0.0;
+    return 0;
+}
+static int zero_energy(size_t n, const double *x, double *h, void *user) {
+    (void)n, (void)x, (void)user;
+    *h = 0.0;
+    return 0;
+}
+static int zero_casimir(size_t dim, const double *x, double *out, void *user) {
+    (void)dim, (void)x, (void)user;
+    *out = 0.0;
+    return 0;
+}
+static int scalar_zero(double u, double *out, void *user) {
+    (void)u, (void)user;
+    *out = 0.0;
+    return 0;
+}
+
+/* The wrong-kind rule: every function defined for some kinds of system only
+ * returns LPI_ERR_UNSUPPORTED, and changes nothing, on every other kind. */
+static void test_wrong_kind_is_unsupported(void **state) {
+    (void)state;
+    lpi_system *systems[5] = {NULL};
+    assert_int_equal(lpi_rigid_body_create(&systems[0], 1.0, 2.0, 3.0), LPI_OK);
+    assert_int_equal(lpi_pendulum_create(&systems[1]), LPI_OK);
+    const int32_t i[1] = {0}, j[1] = {1}, k[1] = {2};
+    const double c[1] = {1.0};
+    assert_int_equal(lpi_generic_create(&systems[2], 3, 1, i, j, k, c), LPI_OK);
+    assert_int_equal(lpi_moments_create(&systems[3]), LPI_OK);
+    const int count = lpi_sine_euler_create(&systems[4], 5) == LPI_OK ? 5 : 4;
+    for (int s = 0; s < count; ++s) {
+        lpi_system *sys = systems[s];
+        const char *kind = lpi_kind(sys);
+        const int rigid = strcmp(kind, "rigid-body") == 0;
+        const int generic = strcmp(kind, "generic") == 0 || strcmp(kind, "moments") == 0;
+        const int moments = strcmp(kind, "moments") == 0;
+        const int sine_euler = strcmp(kind, "sine-euler") == 0;
+        double out[64] = {0}, x[64] = {0}, seconds, transforms;
+        int32_t N;
+        size_t rank;
+        const int32_t index[1] = {0};
+        if (!rigid)
+            LPI_ASSERT_FAILS(sys, lpi_rigid_body_exact(sys, 0.5, out), LPI_ERR_UNSUPPORTED,
+                             "lpi_rigid_body_exact");
+        if (!generic) {
+            LPI_ASSERT_FAILS(sys, lpi_add_piece(sys, 1, index, zero_gradient, zero_energy, NULL),
+                             LPI_ERR_UNSUPPORTED, "lpi_add_piece");
+            LPI_ASSERT_FAILS(sys, lpi_add_casimir(sys, zero_casimir, NULL), LPI_ERR_UNSUPPORTED,
+                             "lpi_add_casimir");
+            LPI_ASSERT_FAILS(sys, lpi_poisson_rank(sys, x, lpi_dim(sys), &rank),
+                             LPI_ERR_UNSUPPORTED, "lpi_poisson_rank");
+        }
+        if (!moments)
+            LPI_ASSERT_FAILS(sys, lpi_moments_add_product_piece(sys, scalar_zero, scalar_zero, NULL),
+                             LPI_ERR_UNSUPPORTED, "lpi_moments_add_product_piece");
+        if (!sine_euler) {
+            LPI_ASSERT_FAILS(sys, lpi_sine_euler_size(sys, &N), LPI_ERR_UNSUPPORTED,
+                             "lpi_sine_euler_size");
+            LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_modes(sys, x, 50), LPI_ERR_UNSUPPORTED,
+                             "lpi_sine_euler_set_modes");
+            LPI_ASSERT_FAILS(sys, lpi_sine_euler_get_modes(sys, out, 50), LPI_ERR_UNSUPPORTED,
+                             "lpi_sine_euler_get_modes");
+            LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_grid(sys, x, 25), LPI_ERR_UNSUPPORTED,
+                             "lpi_sine_euler_set_grid");
+            LPI_ASSERT_FAILS(sys, lpi_sine_euler_get_grid(sys, out, 25), LPI_ERR_UNSUPPORTED,
+                             "lpi_sine_euler_get_grid");
+            LPI_ASSERT_FAILS(sys, lpi_sine_euler_enstrophy(sys, out), LPI_ERR_UNSUPPORTED,
+                             "lpi_sine_euler_enstrophy");
+            LPI_ASSERT_FAILS(sys, lpi_sine_euler_casimir_traces(sys, 2, out), LPI_ERR_UNSUPPORTED,
+                             "lpi_sine_euler_casimir_traces");
+            LPI_ASSERT_FAILS(sys, lpi_sine_euler_fft_floor(sys, 1, &seconds, &transforms),
+                             LPI_ERR_UNSUPPORTED, "lpi_sine_euler_fft_floor");
+            const char *matrix_methods[] = {"isomp", "rk4-matrix", "direct-eq5"};
+            for (int m = 0; m < 3; ++m) {
+                LPI_ASSERT_FAILS(sys, lpi_set_method(sys, matrix_methods[m]), LPI_ERR_UNSUPPORTED,
+                                 "lpi_set_method");
+                assert_non_null(strstr(lpi_last_error(sys), kind));
+                assert_string_equal(lpi_get_method(sys), "leapfrog");
+            }
+        }
+        lpi_destroy(sys);
+    }
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_version_and_status_names),
@@ -202,6 +351,8 @@ int main(void) {
         cmocka_unit_test(test_bad_arguments_leave_state_unchanged),
         cmocka_unit_test(test_nonfinite_step_is_rolled_back),
         cmocka_unit_test(test_successful_calls),
+        cmocka_unit_test(test_getters),
+        cmocka_unit_test(test_wrong_kind_is_unsupported),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

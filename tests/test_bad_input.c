@@ -173,6 +173,10 @@ static int call_lpi_version_string(lpi_system *s, const args *a, lpi_system **o)
     (void)s, (void)a, (void)o;
     return lpi_version_string() != NULL && strlen(lpi_version_string()) >= 5;
 }
+static int call_lpi_version_number(lpi_system *s, const args *a, lpi_system **o) {
+    (void)s, (void)a, (void)o;
+    return lpi_version_number() == LPI_VERSION_NUMBER;
+}
 static int call_lpi_status_name(lpi_system *s, const args *a, lpi_system **o) {
     (void)s, (void)o;
     return strcmp(lpi_status_name((int)a->k), "LPI_UNKNOWN_STATUS") == 0;
@@ -216,6 +220,18 @@ static int call_lpi_dim(lpi_system *s, const args *a, lpi_system **o) {
 static int call_lpi_time(lpi_system *s, const args *a, lpi_system **o) {
     (void)a, (void)o;
     return isnan(lpi_time(s));
+}
+static int call_lpi_kind(lpi_system *s, const args *a, lpi_system **o) {
+    (void)a, (void)o;
+    return lpi_kind(s) == NULL;
+}
+static int call_lpi_get_method(lpi_system *s, const args *a, lpi_system **o) {
+    (void)a, (void)o;
+    return lpi_get_method(s) == NULL;
+}
+static int call_lpi_get_split(lpi_system *s, const args *a, lpi_system **o) {
+    (void)a, (void)o;
+    return lpi_get_split(s) == NULL;
 }
 static int call_lpi_casimir_count(lpi_system *s, const args *a, lpi_system **o) {
     (void)a, (void)o;
@@ -414,6 +430,7 @@ static const unsigned char kNotCheckpoint[40] = "this is not a liepoisson checkp
 static const bad_case kCases[] = {
     /* functions that need no handle: documented sentinels */
     C(lpi_version_string, "no arguments: never NULL", SENTINEL, NONE),
+    C(lpi_version_number, "no arguments: the header's LPI_VERSION_NUMBER", SENTINEL, NONE),
     C(lpi_status_name, "unknown code 12345", SENTINEL, NONE, .k = 12345),
     C(lpi_status_name, "unknown code INT_MIN", SENTINEL, NONE, .k = INT_MIN),
     C(lpi_status_name, "unknown code 2", SENTINEL, NONE, .k = 2),
@@ -434,6 +451,9 @@ static const bad_case kCases[] = {
     C(lpi_dim, "NULL handle: 0", SENTINEL, NONE),
     C(lpi_time, "NULL handle: NaN", SENTINEL, NONE),
     C(lpi_casimir_count, "NULL handle: 0", SENTINEL, NONE),
+    C(lpi_kind, "NULL handle: NULL", SENTINEL, NONE),
+    C(lpi_get_method, "NULL handle: NULL", SENTINEL, NONE),
+    C(lpi_get_split, "NULL handle: NULL", SENTINEL, NONE),
     C(lpi_last_error, "NULL handle: never NULL", SENTINEL, NONE),
 
     /* creators */
@@ -586,10 +606,10 @@ static const bad_case kCases[] = {
 
     /* sine-Euler */
     C(lpi_sine_euler_size, "NULL handle", LPI_ERR_NULL, NONE),
-    C(lpi_sine_euler_size, "a rigid body (wrong kind)", LPI_ERR_INVALID, RB),
+    C(lpi_sine_euler_size, "a rigid body (wrong kind)", LPI_ERR_UNSUPPORTED, RB),
     C(lpi_sine_euler_size, "NULL N", LPI_ERR_NULL, SE, .nul = P1),
     C(lpi_sine_euler_set_modes, "NULL handle", LPI_ERR_NULL, NONE, .x = kModesNaN, .n = 162),
-    C(lpi_sine_euler_set_modes, "a pendulum (wrong kind)", LPI_ERR_INVALID, PEND, .x = kModesNaN, .n = 162),
+    C(lpi_sine_euler_set_modes, "a pendulum (wrong kind)", LPI_ERR_UNSUPPORTED, PEND, .x = kModesNaN, .n = 162),
     C(lpi_sine_euler_set_modes, "NULL modes", LPI_ERR_NULL, SE, .n = 162),
     C(lpi_sine_euler_set_modes, "n = 81", LPI_ERR_SIZE, SE, .x = kModesNaN, .n = 81),
     C(lpi_sine_euler_set_modes, "NaN mode", LPI_ERR_NONFINITE, SE, .x = kModesNaN, .n = 162),
@@ -597,32 +617,32 @@ static const bad_case kCases[] = {
     C(lpi_sine_euler_set_modes, "imaginary w_0", LPI_ERR_INVALID, SE, .x = kModesImaginaryW0, .n = 162),
     C(lpi_sine_euler_set_modes, "finite modes whose symmetrised field overflows", LPI_ERR_OVERFLOW, SE_HUGE, .x = kModesOverflow, .n = 50),
     C(lpi_sine_euler_get_modes, "NULL handle", LPI_ERR_NULL, NONE, .n = 162),
-    C(lpi_sine_euler_get_modes, "a generic system (wrong kind)", LPI_ERR_INVALID, GEN, .n = 162),
+    C(lpi_sine_euler_get_modes, "a generic system (wrong kind)", LPI_ERR_UNSUPPORTED, GEN, .n = 162),
     C(lpi_sine_euler_get_modes, "NULL buffer", LPI_ERR_NULL, SE, .nul = P1, .n = 162),
     C(lpi_sine_euler_get_modes, "n = 161", LPI_ERR_SIZE, SE, .n = 161),
     C(lpi_sine_euler_set_grid, "NULL handle", LPI_ERR_NULL, NONE, .x = kGrid, .n = 81),
-    C(lpi_sine_euler_set_grid, "a rigid body (wrong kind)", LPI_ERR_INVALID, RB, .x = kGrid, .n = 81),
+    C(lpi_sine_euler_set_grid, "a rigid body (wrong kind)", LPI_ERR_UNSUPPORTED, RB, .x = kGrid, .n = 81),
     C(lpi_sine_euler_set_grid, "NULL grid", LPI_ERR_NULL, SE, .n = 81),
     C(lpi_sine_euler_set_grid, "n = 162", LPI_ERR_SIZE, SE, .x = kGrid, .n = 162),
     C(lpi_sine_euler_set_grid, "NaN value", LPI_ERR_NONFINITE, SE, .x = kGridNaN, .n = 81),
     C(lpi_sine_euler_set_grid, "-Inf value", LPI_ERR_NONFINITE, SE, .x = kGridInf, .n = 81),
     C(lpi_sine_euler_get_grid, "NULL handle", LPI_ERR_NULL, NONE, .n = 81),
-    C(lpi_sine_euler_get_grid, "moments (wrong kind)", LPI_ERR_INVALID, MOM, .n = 81),
+    C(lpi_sine_euler_get_grid, "moments (wrong kind)", LPI_ERR_UNSUPPORTED, MOM, .n = 81),
     C(lpi_sine_euler_get_grid, "NULL buffer", LPI_ERR_NULL, SE, .nul = P1, .n = 81),
     C(lpi_sine_euler_get_grid, "n = 0", LPI_ERR_SIZE, SE, .n = 0),
     C(lpi_sine_euler_get_grid, "grid of modes ~ 1e308 overflows", LPI_ERR_OVERFLOW, SE_HUGE, .n = 25),
     C(lpi_sine_euler_enstrophy, "NULL handle", LPI_ERR_NULL, NONE),
-    C(lpi_sine_euler_enstrophy, "a pendulum (wrong kind)", LPI_ERR_INVALID, PEND),
+    C(lpi_sine_euler_enstrophy, "a pendulum (wrong kind)", LPI_ERR_UNSUPPORTED, PEND),
     C(lpi_sine_euler_enstrophy, "NULL out", LPI_ERR_NULL, SE, .nul = P1),
     C(lpi_sine_euler_enstrophy, "enstrophy of modes ~ 1e308 overflows", LPI_ERR_OVERFLOW, SE_HUGE),
     C(lpi_sine_euler_casimir_traces, "NULL handle", LPI_ERR_NULL, NONE, .k = 3),
-    C(lpi_sine_euler_casimir_traces, "a rigid body (wrong kind)", LPI_ERR_INVALID, RB, .k = 3),
+    C(lpi_sine_euler_casimir_traces, "a rigid body (wrong kind)", LPI_ERR_UNSUPPORTED, RB, .k = 3),
     C(lpi_sine_euler_casimir_traces, "NULL out", LPI_ERR_NULL, SE, .nul = P1, .k = 3),
     C(lpi_sine_euler_casimir_traces, "kmax = 0", LPI_ERR_INVALID, SE, .k = 0),
     C(lpi_sine_euler_casimir_traces, "kmax < 0", LPI_ERR_INVALID, SE, .k = -4),
     C(lpi_sine_euler_casimir_traces, "tr W^2 of modes ~ 1e308 overflows", LPI_ERR_OVERFLOW, SE_HUGE, .k = 3),
     C(lpi_sine_euler_fft_floor, "NULL handle", LPI_ERR_NULL, NONE, .k = 1),
-    C(lpi_sine_euler_fft_floor, "a rigid body (wrong kind)", LPI_ERR_INVALID, RB, .k = 1),
+    C(lpi_sine_euler_fft_floor, "a rigid body (wrong kind)", LPI_ERR_UNSUPPORTED, RB, .k = 1),
     C(lpi_sine_euler_fft_floor, "NULL seconds", LPI_ERR_NULL, SE, .nul = P1, .k = 1),
     C(lpi_sine_euler_fft_floor, "NULL transforms", LPI_ERR_NULL, SE, .nul = P2, .k = 1),
     C(lpi_sine_euler_fft_floor, "nsteps = 0", LPI_ERR_INVALID, SE, .k = 0),

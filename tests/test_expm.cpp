@@ -8,6 +8,8 @@
 #include <random>
 #include <vector>
 
+// Before cmocka.h (through lpi_test.h), whose fail() macro would rewrite lpi::fail.
+#include "core/error.hpp"
 #include "lpi_test.h"
 
 #include "models/expm.hpp"
@@ -255,6 +257,26 @@ void test_sparse_nilpotent_scales_with_nonzeros(void **) {
     assert_true(worst < 1e-14);
 }
 
+// The size of an n x n matrix is counted without wrapping: a dimension whose
+// bytes overflow a size_t is refused (LPI_ERR_NO_MEMORY), not allocated small.
+void test_square_entries_refuse_overflow(void **) {
+    assert_int_equal(lpi::square_entries(0, "matrix"), 0);
+    assert_int_equal(lpi::square_entries(3, "matrix"), 9);
+    const std::size_t largest = static_cast<std::size_t>(
+        std::sqrt(static_cast<double>(SIZE_MAX / sizeof(double))));  // rounded down or near
+    std::size_t fits = largest;
+    while (fits > SIZE_MAX / sizeof(double) / fits) --fits;
+    assert_int_equal(lpi::square_entries(fits, "matrix"), fits * fits);
+    for (std::size_t n : {fits + 1, std::size_t{1} << 32, SIZE_MAX / 2, SIZE_MAX}) {
+        try {
+            lpi::square_entries(n, "matrix");
+            fail_msg("square_entries(%zu) did not refuse", n);
+        } catch (const lpi::Error &e) {
+            assert_int_equal(e.status(), LPI_ERR_NO_MEMORY);
+        }
+    }
+}
+
 }  // namespace
 
 int main() {
@@ -263,6 +285,7 @@ int main() {
         cmocka_unit_test(test_skew_matrices),
         cmocka_unit_test(test_nilpotent_matrices),
         cmocka_unit_test(test_sparse_nilpotent_scales_with_nonzeros),
+        cmocka_unit_test(test_square_entries_refuse_overflow),
     };
     return lpi_run_tests(tests);
 }

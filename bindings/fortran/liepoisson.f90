@@ -75,6 +75,9 @@ module liepoisson
         type(c_ptr) function c_lpi_version_string() bind(C, name="lpi_version_string")
             import :: c_ptr
         end function
+        integer(c_int) function c_lpi_version_number() bind(C, name="lpi_version_number")
+            import :: c_int
+        end function
         type(c_ptr) function c_lpi_status_name(status) bind(C, name="lpi_status_name")
             import :: c_ptr, c_int
             integer(c_int), value :: status
@@ -136,6 +139,18 @@ module liepoisson
             import :: c_int, c_ptr, c_char
             type(c_ptr), value :: sys
             character(kind=c_char), intent(in) :: name(*)
+        end function
+        type(c_ptr) function c_lpi_kind(sys) bind(C, name="lpi_kind")
+            import :: c_ptr
+            type(c_ptr), value :: sys
+        end function
+        type(c_ptr) function c_lpi_get_method(sys) bind(C, name="lpi_get_method")
+            import :: c_ptr
+            type(c_ptr), value :: sys
+        end function
+        type(c_ptr) function c_lpi_get_split(sys) bind(C, name="lpi_get_split")
+            import :: c_ptr
+            type(c_ptr), value :: sys
         end function
         integer(c_size_t) function c_lpi_dim(sys) bind(C, name="lpi_dim")
             import :: c_size_t, c_ptr
@@ -361,7 +376,8 @@ module liepoisson
         end function
     end interface
 
-    public :: c_lpi_version_string, c_lpi_status_name, c_lpi_status_message, c_lpi_method_count, &
+    public :: c_lpi_version_string, c_lpi_version_number, c_lpi_kind, c_lpi_get_method, &
+        c_lpi_get_split, c_lpi_status_name, c_lpi_status_message, c_lpi_method_count, &
         c_lpi_method_name, c_lpi_method_order, c_lpi_method_is_poisson, c_lpi_method_stages, &
         c_lpi_method_reference, c_lpi_rigid_body_create, c_lpi_rigid_body_exact, &
         c_lpi_pendulum_create, c_lpi_destroy, c_lpi_set_method, c_lpi_set_split, c_lpi_dim, &
@@ -381,7 +397,8 @@ module liepoisson
         module procedure lpi_step_i4, lpi_step_i8
     end interface
 
-    public :: lpi_version_string, lpi_status_name, lpi_status_message, lpi_method_count, &
+    public :: lpi_version_string, lpi_version_number, lpi_kind, lpi_get_method, lpi_get_split, &
+        lpi_status_name, lpi_status_message, lpi_method_count, &
         lpi_method_name, lpi_method_order, lpi_method_is_poisson, lpi_method_stages, &
         lpi_method_reference, lpi_rigid_body_create, lpi_rigid_body_exact, lpi_pendulum_create, &
         lpi_destroy, lpi_set_method, lpi_set_split, lpi_dim, lpi_set_state, lpi_get_state, &
@@ -441,6 +458,11 @@ contains
     function lpi_version_string() result(s)
         character(len=:), allocatable :: s
         s = f_string(c_lpi_version_string())
+    end function
+
+    ! MAJOR * 10000 + MINOR * 100 + PATCH of the library that runs.
+    integer function lpi_version_number()
+        lpi_version_number = c_lpi_version_number()
     end function
 
     function lpi_status_name(status) result(s)
@@ -614,6 +636,26 @@ contains
 
     ! The message of the last failure on sys; c_null_ptr gives the calling
     ! thread's last failure of a call without a handle (a failed create).
+    ! The system's kind ("rigid-body", ..., "sine-euler"), method and split
+    ! names ("" for a null handle).
+    function lpi_kind(sys) result(s)
+        type(c_ptr), intent(in) :: sys
+        character(len=:), allocatable :: s
+        s = f_string(c_lpi_kind(sys))
+    end function
+
+    function lpi_get_method(sys) result(s)
+        type(c_ptr), intent(in) :: sys
+        character(len=:), allocatable :: s
+        s = f_string(c_lpi_get_method(sys))
+    end function
+
+    function lpi_get_split(sys) result(s)
+        type(c_ptr), intent(in) :: sys
+        character(len=:), allocatable :: s
+        s = f_string(c_lpi_get_split(sys))
+    end function
+
     function lpi_last_error(sys) result(s)
         type(c_ptr), intent(in) :: sys
         character(len=:), allocatable :: s

@@ -28,6 +28,8 @@ LPI_API const char *lpi_version_string(void) {
         LPI_VERSION_PATCH);
 }
 
+LPI_API int lpi_version_number(void) { return LPI_VERSION_NUMBER; }
+
 LPI_API const char *lpi_status_name(int status) {
     switch (status) {
 #define LPI_STATUS_NAME_CASE(name, value, message) \
@@ -83,6 +85,25 @@ LPI_API int lpi_set_split(lpi_system *sys, const char *name) {
         require(name, "split name");
         sys->system.set_split(name);
     });
+}
+
+LPI_API int lpi_set_threads(lpi_system *sys, int32_t n) {
+    return guarded(sys, "lpi_set_threads", [&] {
+        require(sys, "system");
+        sys->system.set_threads(n);  // bounded in the System, before the model sees n
+    });
+}
+
+LPI_API const char *lpi_kind(const lpi_system *sys) {
+    return sys ? sys->system.model().kind() : nullptr;
+}
+
+LPI_API const char *lpi_get_method(const lpi_system *sys) {
+    return sys ? sys->system.method().name.c_str() : nullptr;
+}
+
+LPI_API const char *lpi_get_split(const lpi_system *sys) {
+    return sys ? sys->system.split().c_str() : nullptr;
 }
 
 LPI_API size_t lpi_dim(const lpi_system *sys) { return sys ? sys->system.dim() : 0; }

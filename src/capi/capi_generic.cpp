@@ -1,6 +1,5 @@
 // The C ABI of generic Lie-Poisson systems and the moment algebra.
 #include <cmath>
-#include <string>
 
 #include "../models/generic.hpp"
 #include "handle.hpp"
@@ -8,31 +7,6 @@
 using lpi::capi::create;
 using lpi::capi::guarded;
 using lpi::capi::require;
-
-namespace {
-
-// The generic model behind sys, or LPI_ERR_UNSUPPORTED naming what it is.
-lpi::GenericModel &generic_model(const lpi_system *sys) {
-    auto *model = dynamic_cast<lpi::GenericModel *>(const_cast<lpi::Model *>(&sys->system.model()));
-    if (!model)
-        lpi::fail(LPI_ERR_UNSUPPORTED, std::string("a ") + sys->system.model().kind() +
-                                           " system has no user pieces or structure constants "
-                                           "(create it with lpi_generic_create or "
-                                           "lpi_moments_create)");
-    return *model;
-}
-
-// Rebuilds the integrator for the new piece count; on failure the piece goes.
-void commit_piece(lpi_system *sys, lpi::GenericModel &model) {
-    try {
-        sys->system.rebuild_integrator();
-    } catch (...) {
-        model.remove_last_piece();
-        throw;
-    }
-}
-
-}  // namespace
 
 extern "C" {
 
@@ -53,24 +27,23 @@ LPI_API int lpi_add_piece(lpi_system *sys, size_t n, const int32_t *indices,
                           lpi_gradient_fn grad, lpi_energy_fn energy, void *user) {
     return guarded(sys, "lpi_add_piece", [&] {
         require(sys, "system");
-        lpi::GenericModel &model = generic_model(sys);
+        lpi::generic_model_of(sys->system);  // the kind first: a rigid body has no pieces to add
         require(indices, "indices");
-        model.add_piece(n, indices, grad, energy, user);
-        commit_piece(sys, model);
+        lpi::add_piece(sys->system, n, indices, grad, energy, user);
     });
 }
 
 LPI_API int lpi_add_casimir(lpi_system *sys, lpi_casimir_fn fn, void *user) {
     return guarded(sys, "lpi_add_casimir", [&] {
         require(sys, "system");
-        generic_model(sys).add_casimir(fn, user);
+        lpi::generic_model_of(sys->system).add_casimir(fn, user);
     });
 }
 
 LPI_API int lpi_poisson_rank(const lpi_system *sys, const double *x, size_t n, size_t *rank) {
     return guarded(sys, "lpi_poisson_rank", [&] {
         require(sys, "system");
-        const lpi::GenericModel &model = generic_model(sys);
+        const lpi::GenericModel &model = lpi::generic_model_of(sys->system);
         require(x, "x");
         require(rank, "rank");
         lpi::require_length("x", n, model.dim());
@@ -89,9 +62,7 @@ LPI_API int lpi_moments_add_product_piece(lpi_system *sys, lpi_scalar_fn h, lpi_
                                           void *user) {
     return guarded(sys, "lpi_moments_add_product_piece", [&] {
         require(sys, "system");
-        lpi::GenericModel &model = generic_model(sys);
-        lpi::add_moments_product_piece(model, h, dh, user);
-        commit_piece(sys, model);
+        lpi::add_moments_product_piece(sys->system, h, dh, user);
     });
 }
 

@@ -39,7 +39,7 @@ LPI_API int lpi_method_stages(int i) {
 
 LPI_API const char *lpi_method_reference(int i) {
     const lpi::Method *m = row(i);
-    return m ? m->reference.c_str() : nullptr;
+    return m ? m->source.c_str() : nullptr;
 }
 
 LPI_API int lpi_method_is_poisson(int i) {

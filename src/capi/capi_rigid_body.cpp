@@ -1,9 +1,9 @@
-// The C ABI of the rigid body's exact solution (a reference, beside the
+// The C ABI of the rigid body's exact solution (a baseline, beside the
 // integrators, never inside them).
 #include <cmath>
 
 #include "../models/models.hpp"
-#include "../reference/rigid_body_exact.hpp"
+#include "../baselines/rigid_body_exact.hpp"
 #include "handle.hpp"
 
 using lpi::capi::guarded;

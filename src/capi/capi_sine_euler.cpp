@@ -1,4 +1,4 @@
-// The C ABI of sine-Euler, threads and FFTW wisdom.
+// The C ABI of sine-Euler and FFTW wisdom.
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -25,8 +25,8 @@ lpi::SineEulerModel &sine_euler(const lpi_system *sys) {
     require(sys, "system");
     auto *model = dynamic_cast<const lpi::SineEulerModel *>(&sys->system.model());
     if (!model)
-        lpi::fail(LPI_ERR_INVALID, std::string("system is a ") + sys->system.model().kind() +
-                                       " system, not sine-euler");
+        lpi::fail(LPI_ERR_UNSUPPORTED, std::string("system is a ") + sys->system.model().kind() +
+                                           " system, not sine-euler");
     return const_cast<lpi::SineEulerModel &>(*model);
 }
 
@@ -166,13 +166,6 @@ LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *se
         const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
         *seconds_per_step = elapsed.count() / static_cast<double>(nsteps);
         *transforms_per_step = transforms / static_cast<double>(nsteps);
-    });
-}
-
-LPI_API int lpi_set_threads(lpi_system *sys, int32_t n) {
-    return guarded(sys, "lpi_set_threads", [&] {
-        require(sys, "system");
-        sys->system.set_threads(n);  // bounded in the System, before the model sees n
     });
 }
 

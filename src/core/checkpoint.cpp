@@ -13,8 +13,6 @@
 #include <limits>
 #include <system_error>
 
-#include "../models/models.hpp"
-#include "../models/sine_euler.hpp"
 #include "error.hpp"
 
 namespace lpi {
@@ -111,12 +109,6 @@ std::uint64_t load_u64(const unsigned char *p) {
 
 std::string io_reason(int error) { return std::generic_category().message(error); }
 
-std::string format_double(double x) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.17g", x);
-    return text;
-}
-
 // Checks the header (the first head_size <= 24 bytes of a checkpoint of
 // `size` bytes): magic, byte order, version, and the announced total size
 // against the actual one.
@@ -148,96 +140,51 @@ void check_header(const unsigned char *head, std::size_t head_size, std::uint64_
                                  std::to_string(total) + "-byte checkpoint");
 }
 
-// The models a checkpoint can name, rebuilt from their parameters. The
-// state length is checked first: a crafted file must not make the library
+// The registered kind of that name, or nullptr.
+const CheckpointKind *find_checkpoint_kind(const std::string &kind) {
+    for (const CheckpointKind &k : checkpoint_kinds())
+        if (kind == k.kind) return &k;
+    return nullptr;
+}
+
+// The model a checkpoint names, rebuilt from its parameters. The state
+// length is checked first: a crafted file must not make the library
 // allocate a model far larger than the file.
 std::unique_ptr<Model> make_model_for_checkpoint(const std::string &kind,
                                                  const std::vector<double> &p,
                                                  std::size_t state_length) {
-    auto expect_state = [&](double expected) {
-        if (static_cast<double>(state_length) != expected)
+    const CheckpointKind *entry = find_checkpoint_kind(kind);
+    if (!entry) fail(LPI_ERR_FORMAT, "unknown system kind '" + kind + "'");
+    if (p.size() != entry->parameter_count)
+        fail(LPI_ERR_FORMAT, "a " + kind + " system has " + std::to_string(entry->parameter_count) +
+                                 " parameters, the checkpoint gives " + std::to_string(p.size()));
+    try {
+        const std::uint64_t expected = entry->state_size(p);
+        if (state_length != expected)
             fail(LPI_ERR_FORMAT, "the state has " + std::to_string(state_length) + " values, a " +
                                      kind + " system of these parameters has " +
-                                     std::to_string(static_cast<std::uint64_t>(expected)));
-    };
-    auto need = [&](std::size_t n) {
-        if (p.size() != n)
-            fail(LPI_ERR_FORMAT, "a " + kind + " system has " + std::to_string(n) +
-                                     " parameters, the checkpoint gives " + std::to_string(p.size()));
-    };
-    try {
-        if (kind == "rigid-body") {
-            need(3);
-            expect_state(6);
-            return make_rigid_body(p[0], p[1], p[2]);
-        }
-        if (kind == "pendulum") {
-            need(0);
-            expect_state(6);
-            return make_pendulum();
-        }
-        if (kind == "sine-euler") {
-            need(1);
-            if (!(p[0] >= 0 && p[0] <= std::numeric_limits<std::int32_t>::max()) ||
-                p[0] != std::floor(p[0]))
-                fail(LPI_ERR_FORMAT, "sine-euler N is not an integer");
-            expect_state(2.0 * p[0] * p[0]);
-            return make_sine_euler(static_cast<int>(p[0]));
-        }
+                                     std::to_string(expected));
+        return entry->build(p);
     } catch (const Error &e) {
         // A build without FFTW cannot load sine-Euler: that is not a bad file.
         if (e.status() == LPI_ERR_UNSUPPORTED || e.status() == LPI_ERR_FORMAT) throw;
         fail(LPI_ERR_FORMAT, std::string("invalid ") + kind + " parameters: " + e.what());
     }
-    fail(LPI_ERR_FORMAT, "unknown system kind '" + kind + "'");
-}
-
-// The carry of a compensated model ([x, carry]) is the rounding remainder
-// of x: at most half an ulp of its component when a flow writes it
-// (compensated_add). The non-splitting baselines (rk4, implicit-midpoint)
-// leave it as it is while x moves, so it is bounded against the largest
-// component, with a margin of 2^21 over what the flows leave: 2^-32 of it.
-constexpr double kMaxRelativeCarry = 0x1p-32;
-
-void check_carry(const CompensatedModel &model, const std::vector<double> &state) {
-    const std::size_t n = model.dim();
-    double largest = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-        const double value = state[i] + state[n + i];
-        if (!std::isfinite(value))
-            fail(LPI_ERR_FORMAT, "state entry " + std::to_string(i) +
-                                     " overflows when its compensation carry is added");
-        largest = std::fmax(largest, std::fabs(value));
-    }
-    for (std::size_t i = 0; i < n; ++i)
-        if (std::fabs(state[n + i]) > kMaxRelativeCarry * largest)
-            fail(LPI_ERR_FORMAT, "the compensation carry of state entry " + std::to_string(i) +
-                                     " is " + format_double(state[n + i]) +
-                                     ", no rounding remainder of a state whose largest entry is " +
-                                     format_double(largest));
 }
 
 // The working state must be one the model's own operations produce, checked
 // as strictly as the setters check what users give: the checksum proves
 // that the bytes are those written, not that this library wrote them.
-void check_working_state(const Model &model, const std::vector<double> &state) {
+void check_working_state(const CheckpointKind &kind, const Model &model,
+                         const std::vector<double> &state) {
     for (std::size_t i = 0; i < state.size(); ++i)
         if (!std::isfinite(state[i]))
             fail(LPI_ERR_FORMAT, "working state entry " + std::to_string(i) + " is not finite");
-    if (const auto *compensated = dynamic_cast<const CompensatedModel *>(&model)) {
-        check_carry(*compensated, state);
-    } else if (const auto *sine_euler = dynamic_cast<const SineEulerModel *>(&model)) {
-        // The modes must pass lpi_sine_euler_set_modes: Hermitian and w_0
-        // real, to its tolerance. The splitting flows keep them so to the
-        // bit (each mirror mode is written as the exact conjugate), but the
-        // rk4, implicit-midpoint and direct-eq5 baselines do not, so a
-        // checkpoint they leave cannot be held to bit-exact symmetry.
-        std::vector<double> x(model.dim());
-        try {
-            sine_euler->public_from_modes(state.data(), x.data());
-        } catch (const Error &e) {
-            fail(LPI_ERR_FORMAT, std::string("the stored state: ") + e.what());
-        }
+    if (!kind.check_state) return;
+    try {
+        kind.check_state(model, state.data());
+    } catch (const Error &e) {
+        fail(LPI_ERR_FORMAT, std::string("the stored state: ") + e.what());
     }
 }
 
@@ -261,6 +208,10 @@ std::uint32_t crc32(const unsigned char *data, std::size_t size) {
 std::vector<unsigned char> encode_checkpoint(const System &system) {
     const Model &model = system.model();
     const std::vector<double> parameters = model.checkpoint_parameters();  // may refuse
+    // What is saved must load: a kind without a restore is refused here.
+    if (!find_checkpoint_kind(model.kind()))
+        fail(LPI_ERR_UNSUPPORTED, std::string("a ") + model.kind() + " system cannot be "
+                                  "checkpointed: this library cannot rebuild its kind");
     Writer w;
     w.bytes().assign(kMagic, kMagic + sizeof kMagic);
     w.put(kByteOrder);
@@ -307,6 +258,7 @@ Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size) {
         fail(LPI_ERR_FORMAT, std::to_string(r.left()) + " unread bytes at the end of the payload");
 
     cp.model = make_model_for_checkpoint(kind, parameters, cp.state.size());
+    const CheckpointKind &entry = *find_checkpoint_kind(kind);
     try {
         cp.model->set_split(split);
     } catch (const Error &e) {
@@ -317,7 +269,7 @@ Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size) {
                                  kind + " system of these parameters has " +
                                  std::to_string(cp.model->state_size()));
     if (!std::isfinite(cp.time)) fail(LPI_ERR_FORMAT, "the time is not finite");
-    check_working_state(*cp.model, cp.state);
+    check_working_state(entry, *cp.model, cp.state);
     return cp;
 }
 

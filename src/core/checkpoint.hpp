@@ -9,7 +9,7 @@
 //          12  version      u32      1
 //          16  total size   u64      bytes in the whole checkpoint
 //          24  payload:
-//              kind         string   "rigid-body", "pendulum", "sine-euler"
+//              kind         string   Model::kind(), one of checkpoint_kinds()
 //              parameters   u32 n, n x f64   (Model::checkpoint_parameters)
 //              split        string
 //              method       string   registry name, or "custom"
@@ -36,12 +36,33 @@ namespace lpi {
 
 constexpr std::uint32_t kCheckpointVersion = 1;
 
+// How a checkpoint brings a model kind back. Each model kind that can be
+// saved (Model::checkpoint_parameters) has one, listed in checkpoint_kinds().
+struct CheckpointKind {
+    const char *kind;  // Model::kind()
+    std::size_t parameter_count;
+    // The working-state length of the model these parameters (of the right
+    // count) describe, without building it: a crafted file must not make the
+    // library allocate a model far larger than the file. Throws lpi::Error
+    // for parameters no setter would accept.
+    std::uint64_t (*state_size)(const std::vector<double> &parameters);
+    // Builds the model (throws lpi::Error for invalid parameters).
+    std::unique_ptr<Model> (*build)(const std::vector<double> &parameters);
+    // Throws lpi::Error unless the (finite) working state is one the model's
+    // own operations produce; nullptr when every finite state is.
+    void (*check_state)(const Model &model, const double *state);
+};
+
+// Every kind a checkpoint can name (defined in src/registry.cpp).
+const std::vector<CheckpointKind> &checkpoint_kinds();
+
 // CRC-32 (reflected polynomial 0xEDB88320, init and final xor 0xFFFFFFFF: the
 // checksum of zlib, PNG and IEEE 802.3; check value 0xCBF43926 for "123456789").
 std::uint32_t crc32(const unsigned char *data, std::size_t size);
 
 // The checkpoint of a system; LPI_ERR_UNSUPPORTED for models that cannot be
-// saved (generic systems: their pieces are user callbacks).
+// saved (generic systems: their pieces are user callbacks) or whose kind has
+// no CheckpointKind (it could not be loaded).
 std::vector<unsigned char> encode_checkpoint(const System &system);
 
 // A decoded, validated checkpoint: the model is built (split selected), the

@@ -4,9 +4,6 @@
 #include <cmath>
 #include <vector>
 
-#include "../reference/implicit_midpoint.hpp"
-#include "../reference/runge_kutta4.hpp"
-#include "../reference/sine_euler_matrix_methods.hpp"
 #include "error.hpp"
 
 namespace lpi {
@@ -108,24 +105,16 @@ private:
 
 }  // namespace
 
+std::unique_ptr<Integrator> make_splitting_integrator(const Method &method, const Model &model,
+                                                      const ImplicitSettings &) {
+    return std::make_unique<SplittingIntegrator>(build_flow_program(method, model.piece_count()));
+}
+
 std::unique_ptr<Integrator> make_integrator(const Method &method, const Model &model,
                                             const ImplicitSettings &implicit) {
-    switch (method.kind) {
-    case MethodKind::Sequence:
-    case MethodKind::SequenceAdjoint:
-    case MethodKind::SymmetricComposition:
-        return std::make_unique<SplittingIntegrator>(
-            build_flow_program(method, model.piece_count()));
-    case MethodKind::RungeKutta4:
-        return std::make_unique<RungeKutta4>(model.state_size());
-    case MethodKind::ImplicitMidpoint:
-        return std::make_unique<ImplicitMidpoint>(model.state_size(), implicit);
-    case MethodKind::IsospectralMidpoint:
-    case MethodKind::RungeKutta4Matrix:
-    case MethodKind::DirectEq5:
-        return make_sine_euler_matrix_integrator(method, model, implicit);
-    }
-    fail(LPI_ERR_INTERNAL, "unhandled method kind for '" + method.name + "'");
+    if (!method.make_integrator)
+        fail(LPI_ERR_INTERNAL, "method '" + method.name + "' has no integrator factory");
+    return method.make_integrator(method, model, implicit);
 }
 
 }  // namespace lpi

@@ -1,6 +1,6 @@
 // How a System advances its state: an Integrator is built from a Method for a
-// Model. Splitting methods compose the model's exact piece flows; reference
-// methods (src/reference) integrate the full vector field.
+// Model by the method's own factory. Splitting methods compose the model's
+// exact piece flows; the baselines (src/baselines) integrate otherwise.
 #pragma once
 
 #include <cstddef>
@@ -59,12 +59,30 @@ struct ImplicitSettings {
     int max_iterations = 100;
 };
 
+// The method's integrator for model (its row's factory).
 std::unique_ptr<Integrator> make_integrator(const Method &method, const Model &model,
                                             const ImplicitSettings &implicit = {});
+
+// The factory of every splitting row: composes the model's piece flows in
+// the method's flow program (build_flow_program).
+std::unique_ptr<Integrator> make_splitting_integrator(const Method &method, const Model &model,
+                                                      const ImplicitSettings &implicit);
 
 bool all_finite(const double *x, std::size_t n);
 
 // How often long runs look for a non-finite state, in steps.
 constexpr std::int64_t kFiniteCheckInterval = 256;
+
+// Runs step(s) for s = 0 .. n-1, asking finite() every kFiniteCheckInterval
+// steps and at the end: false as soon as it answers false (the loop of every
+// baseline's advance()).
+template <class Step, class Finite>
+bool run_checked_steps(std::int64_t n, Step &&step, Finite &&finite) {
+    for (std::int64_t s = 0; s < n; ++s) {
+        step(s);
+        if ((s + 1) % kFiniteCheckInterval == 0 && !finite()) return false;
+    }
+    return finite();
+}
 
 }  // namespace lpi

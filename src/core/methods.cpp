@@ -1,47 +1,36 @@
 #include "methods.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
 #include "error.hpp"
+#include "integrator.hpp"
+#include "text.hpp"
 
 namespace lpi {
 
 namespace {
 
-Method sequence(const char *name, MethodKind kind, const char *reference) {
+Method sequence(const char *name, MethodKind kind, const char *source) {
     Method m;
     m.name = name;
     m.order = 1;
     m.stages = 1;
-    m.reference = reference;
+    m.source = source;
     m.kind = kind;
+    m.make_integrator = make_splitting_integrator;
     return m;
 }
 
-Method composition(std::string name, int order, std::vector<double> gammas,
-                   std::string reference) {
+Method composition(std::string name, int order, std::vector<double> gammas, std::string source) {
     Method m;
     m.name = std::move(name);
     m.order = order;
     m.stages = static_cast<int>(gammas.size());
-    m.reference = std::move(reference);
+    m.source = std::move(source);
     m.kind = MethodKind::SymmetricComposition;
     m.gammas = std::move(gammas);
-    return m;
-}
-
-// A method that integrates the full vector field (or the matrix form): not a
-// Poisson map, one "stage" per step.
-Method baseline(const char *name, int order, MethodKind kind, const char *reference) {
-    Method m;
-    m.name = name;
-    m.order = order;
-    m.stages = 1;
-    m.reference = reference;
-    m.poisson = false;
-    m.kind = kind;
+    m.make_integrator = make_splitting_integrator;
     return m;
 }
 
@@ -162,31 +151,7 @@ std::vector<Method> make_table() {
         "M. Sofroniou and G. Spaletta, Optim. Methods Softw. 20 (2005) 597; Hairer, "
         "Lubich & Wanner (2006) sect. V.3.2"));
 
-    table.push_back(baseline("rk4", 4, MethodKind::RungeKutta4,
-                             "classical Runge-Kutta (Kutta 1901); not a Poisson map"));
-    table.push_back(baseline(
-        "implicit-midpoint", 2, MethodKind::ImplicitMidpoint,
-        "implicit midpoint rule, fixed-point iteration (Hairer, Lubich & Wanner, Geometric "
-        "Numerical Integration (2006) sect. IV.4.2, VI.3); symplectic for canonical systems, not "
-        "a Lie-Poisson map"));
-
-    // The sine-Euler matrix-form baselines (other systems refuse them).
-    // isomp is a Lie-Poisson integrator in exact arithmetic, but solved by
-    // fixed-point iteration it keeps the Casimirs only to the iteration's
-    // tolerance, not to round-off: a baseline here.
-    table.push_back(baseline(
-        "isomp", 2, MethodKind::IsospectralMidpoint,
-        "isospectral midpoint method on the matrix form of sine-Euler, fixed-point iteration, "
-        "BLAS-3 (K. Modin and M. Viviani, Found. Comput. Math. 20 (2020) 889; M. Viviani, BIT "
-        "Numer. Math. 60 (2020) 741); Casimirs kept to the iteration tolerance; sine-Euler only"));
-    table.push_back(baseline(
-        "rk4-matrix", 4, MethodKind::RungeKutta4Matrix,
-        "classical Runge-Kutta on the matrix form dW/dt = (i/(2 eps)) [P, W] of sine-Euler "
-        "(V. Zeitlin, Physica D 49 (1991) 353), BLAS-3; not a Poisson map; sine-Euler only"));
-    table.push_back(baseline(
-        "direct-eq5", 4, MethodKind::DirectEq5,
-        "classical Runge-Kutta on McLachlan 1993 eq. (5) summed term by term, O(N^4) per "
-        "evaluation: a correctness reference; sine-Euler with N <= 31 only"));
+    add_registered_methods(table);
     return table;
 }
 
@@ -231,17 +196,25 @@ int recursive_order(const std::string &name, const std::string &prefix) {
     return p;
 }
 
-std::string format_double(double x) {
-    char buffer[40];
-    std::snprintf(buffer, sizeof buffer, "%.17g", x);
-    return buffer;
-}
-
 }  // namespace
 
 const std::vector<Method> &method_table() {
     static const std::vector<Method> table = make_table();
     return table;
+}
+
+bool is_splitting(const Method &method) { return method.kind != MethodKind::Baseline; }
+
+Method baseline_method(std::string name, int order, std::string source, IntegratorFactory make) {
+    Method m;
+    m.name = std::move(name);
+    m.order = order;
+    m.stages = 1;
+    m.source = std::move(source);
+    m.poisson = false;
+    m.kind = MethodKind::Baseline;
+    m.make_integrator = make;
+    return m;
 }
 
 std::vector<double> triple_jump_gammas(int order) { return recursive_gammas(order, 3); }
@@ -276,7 +249,7 @@ Method custom_composition(const double *gammas, std::size_t n) {
     for (std::size_t i = 0; i < n; ++i)
         if (!std::isfinite(gammas[i]))
             fail(LPI_ERR_NONFINITE, "gammas[" + std::to_string(i) + "] = " +
-                                        format_double(gammas[i]) + " is not finite");
+                                        number_text(gammas[i]) + " is not finite");
     // The sum of |gammas| bounds every difference, partial sum, merged flow
     // weight and mean below: when it is finite, none of them overflows.
     double magnitude = 0.0;
@@ -289,8 +262,8 @@ Method custom_composition(const double *gammas, std::size_t n) {
         const double a = gammas[i], b = gammas[j];
         if (std::fabs(a - b) > kTolerance * std::fmax(std::fabs(a), std::fabs(b)))
             fail(LPI_ERR_INVALID, "the weights are not symmetric: gammas[" + std::to_string(i) +
-                                      "] = " + format_double(a) + " but gammas[" +
-                                      std::to_string(j) + "] = " + format_double(b) +
+                                      "] = " + number_text(a) + " but gammas[" +
+                                      std::to_string(j) + "] = " + number_text(b) +
                                       " (they must agree to a relative 1e-14)");
     }
     // Neumaier's compensated sum, so the test is not blurred by its own round-off.
@@ -302,7 +275,7 @@ Method custom_composition(const double *gammas, std::size_t n) {
     }
     sum += compensation;
     if (!(std::fabs(sum - 1.0) <= kTolerance * magnitude))
-        fail(LPI_ERR_INVALID, "the weights sum to " + format_double(sum) +
+        fail(LPI_ERR_INVALID, "the weights sum to " + number_text(sum) +
                                   ", not 1 (they must, to 1e-14 times the sum of their "
                                   "absolute values)");
     std::vector<double> symmetric(gammas, gammas + n);
@@ -330,11 +303,7 @@ std::vector<Flow> build_flow_program(const Method &method, std::size_t pieces) {
             for (std::size_t k = pieces - 1; k-- > 0;) raw.push_back({k, 0.5 * g});
         }
         break;
-    case MethodKind::RungeKutta4:
-    case MethodKind::ImplicitMidpoint:
-    case MethodKind::IsospectralMidpoint:
-    case MethodKind::RungeKutta4Matrix:
-    case MethodKind::DirectEq5:
+    case MethodKind::Baseline:
         fail(LPI_ERR_INTERNAL, "build_flow_program called for a non-splitting method");
     }
     std::vector<Flow> merged;

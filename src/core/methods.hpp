@@ -1,38 +1,60 @@
 // The method registry: every integration method the library offers, chosen by
-// name. Splitting methods are described as data (a sequence of piece flows or
-// a symmetric composition of leapfrog); adding a composition is adding a row.
+// name. Each row carries the factory of its integrator. The splitting methods
+// are rows of this file, described as data (a sequence of piece flows or a
+// symmetric composition of leapfrog): adding a composition is adding a row.
+// The baselines (src/baselines) bring their own rows and factories, listed
+// once in src/registry.cpp.
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace lpi {
 
+class Integrator;
+class Model;
+struct ImplicitSettings;
+struct Method;
+
+// Builds the integrator of `method` for `model`. A method defined for some
+// kinds of system only refuses the others with LPI_ERR_UNSUPPORTED.
+using IntegratorFactory = std::unique_ptr<Integrator> (*)(const Method &method,
+                                                          const Model &model,
+                                                          const ImplicitSettings &implicit);
+
 enum class MethodKind {
-    Sequence,            // each piece once per step, in order (Lie-Trotter)
-    SequenceAdjoint,     // each piece once per step, in reverse order
-    SymmetricComposition,// leapfrog stages with weights gammas (sum 1, symmetric)
-    RungeKutta4,         // classical RK4 on the full vector field (not Poisson)
-    ImplicitMidpoint,    // implicit midpoint rule on the full vector field (not Poisson)
-    // Sine-Euler only (src/reference/sine_euler_matrix_methods.hpp):
-    IsospectralMidpoint, // isomp on the matrix form dW/dt = [B(W), W]
-    RungeKutta4Matrix,   // classical RK4 on the matrix form
-    DirectEq5,           // classical RK4 on eq. 5 summed directly, O(N^4), small N
+    Sequence,             // each piece once per step, in order (Lie-Trotter)
+    SequenceAdjoint,      // each piece once per step, in reverse order
+    SymmetricComposition, // leapfrog stages with weights gammas (sum 1, symmetric)
+    Baseline,             // no piece flows: its factory integrates otherwise
 };
 
 struct Method {
     std::string name;
     int order = 0;
-    int stages = 0;  // leapfrog stages per step (1 for sequences and RK4)
-    std::string reference;
+    int stages = 0;  // leapfrog stages per step (1 for sequences and baselines)
+    std::string source;  // the publication the method comes from
     bool poisson = true;  // preserves the Poisson structure and every Casimir
     MethodKind kind = MethodKind::Sequence;
     std::vector<double> gammas;  // SymmetricComposition only
+    IntegratorFactory make_integrator = nullptr;
 };
 
-// The registered methods, in the order lpi_method_name(i) lists them.
+// True for the methods that compose exact piece flows.
+bool is_splitting(const Method &method);
+
+// A row of a method that is not a Poisson map and takes one stage per step.
+Method baseline_method(std::string name, int order, std::string source, IntegratorFactory make);
+
+// The registered methods, in the order lpi_method_name(i) lists them: the
+// splittings of this file, then the rows of add_registered_methods.
 const std::vector<Method> &method_table();
+
+// Appends the rows registered from outside the core (defined in
+// src/registry.cpp). Called once, when the table is first built.
+void add_registered_methods(std::vector<Method> &table);
 
 // Looks a method up by name or alias; also builds the recursive compositions
 // "triple-jump-<p>" and "suzuki-<p>" for even p in 2..kMaxRecursiveOrder.

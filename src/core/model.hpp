@@ -41,7 +41,7 @@ public:
     virtual void casimirs(const double *state, double *out) const = 0;
 
     // The full vector field J(x) grad H(x) in the working layout: what the
-    // non-splitting reference methods integrate.
+    // baselines (src/baselines) integrate.
     virtual void vector_field(const double *state, double *rate) const = 0;
 
     // Threads used inside one flow. The default integrates on one thread:
@@ -49,8 +49,9 @@ public:
     virtual void set_threads(int n);
 
     // What a checkpoint stores to rebuild this model: its parameters, which
-    // make_model_for_checkpoint (checkpoint.cpp) turns back into the model of
-    // the same kind. The default refuses with LPI_ERR_UNSUPPORTED.
+    // the CheckpointKind of its kind (checkpoint.hpp, listed in
+    // src/registry.cpp) turns back into the model. The default refuses with
+    // LPI_ERR_UNSUPPORTED.
     virtual std::vector<double> checkpoint_parameters() const;
 };
 

@@ -2,20 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "error.hpp"
+#include "text.hpp"
 #include "threads.hpp"
 
 namespace lpi {
 
 namespace {
-
-std::string short_number(double v) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.6g", v);
-    return text;
-}
 
 // "in step 7 of this call (t = 0.6 .. 0.7)" or "in steps 1 .. 256 ..."
 std::string steps_text(const StepsInProgress &p, double start, double dt) {
@@ -25,8 +19,8 @@ std::string steps_text(const StepsInProgress &p, double start, double dt) {
                                   ? "step " + std::to_string(p.first)
                                   : "steps " + std::to_string(p.first) + " .. " +
                                         std::to_string(p.last);
-    return "in " + steps + " of this call (t = " + short_number(from) + " .. " +
-           short_number(to) + ")";
+    return "in " + steps + " of this call (t = " + number_text(from, 6) + " .. " +
+           number_text(to, 6) + ")";
 }
 
 }  // namespace
@@ -46,7 +40,8 @@ void require_length(const char *what, std::size_t given, std::size_t expected) {
 
 System::System(std::unique_ptr<Model> model)
     : model_(std::move(model)), method_(find_method("leapfrog")),
-      state_(model_->state_size(), 0.0), saved_(model_->state_size(), 0.0) {
+      state_(model_->state_size(), 0.0), saved_(model_->state_size(), 0.0),
+      split_(model_->split()) {
     rebuild_integrator();
 }
 
@@ -70,7 +65,9 @@ void System::set_split(const std::string &name) {
     const std::string previous = model_->split();
     model_->set_split(name);  // throws, unchanged, if unknown
     try {
+        std::string current = model_->split();
         rebuild_integrator();
+        split_.swap(current);
     } catch (...) {
         model_->set_split(previous);
         throw;
@@ -145,13 +142,13 @@ bool System::step(double dt, std::int64_t nsteps) {
                                   "lpi_add_piece)");
     const double start = time_;
     if (!std::isfinite(start + dt * static_cast<double>(nsteps)))
-        fail(LPI_ERR_OVERFLOW, "the end time t + dt * nsteps = " + short_number(start) + " + " +
-                                   short_number(dt) + " * " + std::to_string(nsteps) +
+        fail(LPI_ERR_OVERFLOW, "the end time t + dt * nsteps = " + number_text(start, 6) + " + " +
+                                   number_text(dt, 6) + " * " + std::to_string(nsteps) +
                                    " overflows a double");
     const double fraction = integrator_->largest_step_fraction();
     if (!std::isfinite(dt * fraction))
-        fail(LPI_ERR_OVERFLOW, "dt = " + short_number(dt) + " times the largest flow weight " +
-                                   short_number(fraction) + " of method '" + method_.name +
+        fail(LPI_ERR_OVERFLOW, "dt = " + number_text(dt, 6) + " times the largest flow weight " +
+                                   number_text(fraction, 6) + " of method '" + method_.name +
                                    "' overflows a double");
     prepare_threads();
 
@@ -183,9 +180,9 @@ bool System::step(double dt, std::int64_t nsteps) {
         time_ = start;
         fail(LPI_ERR_NONFINITE,
              "method '" + method_.name + "' produced a non-finite state with dt = " +
-                 short_number(dt) + ", found after step " + std::to_string(outcome.steps) +
+                 number_text(dt, 6) + ", found after step " + std::to_string(outcome.steps) +
                  " of this call (t = " +
-                 short_number(start + dt * static_cast<double>(outcome.steps)) +
+                 number_text(start + dt * static_cast<double>(outcome.steps), 6) +
                  "; the state is checked every " + std::to_string(kFiniteCheckInterval) +
                  " steps, at each observation and at the end); state rolled back");
     }

@@ -31,6 +31,8 @@ public:
     // Piece flows (RK4: vector-field evaluations) per step in a long run.
     std::size_t flows_per_step() const { return integrator_->evaluations_per_step(); }
     void set_split(const std::string &name);
+    // The split in use, stored here so that its name outlives the call.
+    const std::string &split() const { return split_; }
     // Bounded by max_threads(); the model may refuse n > 1, and a count whose
     // threads the system refuses to start fails with LPI_ERR_NO_MEMORY.
     void set_threads(int n);
@@ -75,6 +77,7 @@ private:
     std::vector<double> saved_;  // the state before the step in progress
     double time_ = 0.0;
     ImplicitSettings implicit_;
+    std::string split_;  // the model's split(), as of the last change
     int threads_ = 1;
     std::int64_t observe_every_ = 0;
     Observer observer_;

@@ -201,6 +201,14 @@ void expm1_dense(std::size_t n, const double *A, double *W) {
     }
 }
 
+std::size_t square_entries(std::size_t n, const char *what) {
+    if (n != 0 && n > std::numeric_limits<std::size_t>::max() / sizeof(double) / n)
+        fail(LPI_ERR_NO_MEMORY, std::string("the ") + what + " of " + std::to_string(n) + " x " +
+                                    std::to_string(n) + " doubles is larger than memory can "
+                                    "address");
+    return n * n;
+}
+
 void ExpmWorkspace::check_finite(std::size_t m) const {
     // x is left untouched when the exact flow is not representable.
     for (std::size_t v = 0; v < m; ++v)
@@ -224,14 +232,14 @@ long ExpmWorkspace::topological_depth() {
     cursor_.assign(start_.begin(), start_.end() - 1);
     for (const SparseEntry &e : local_) adjacency_[cursor_[e.col]++] = e.row;
     queue_.clear();
-    for (std::uint32_t v = 0; v < m; ++v)
-        if (indegree_[v] == 0) queue_.push_back(v);
+    for (std::size_t v = 0; v < m; ++v)
+        if (indegree_[v] == 0) queue_.push_back(static_cast<std::uint32_t>(v));
     depth_.assign(m, 0);
     long deepest = 0;
     for (std::size_t head = 0; head < queue_.size(); ++head) {
         const std::uint32_t u = queue_[head];
         deepest = std::max(deepest, depth_[u]);
-        for (std::uint32_t a = start_[u]; a < start_[u + 1]; ++a) {
+        for (std::size_t a = start_[u]; a < start_[u + 1]; ++a) {
             const std::uint32_t v = adjacency_[a];
             depth_[v] = std::max(depth_[v], depth_[u] + 1);
             if (--indegree_[v] == 0) queue_.push_back(v);
@@ -283,7 +291,7 @@ ExpmPath ExpmWorkspace::apply(std::size_t n, const std::vector<SparseEntry> &ent
         return ExpmPath::Nilpotent;
     }
 
-    dense_.assign(m * m, 0.0);
+    dense_.assign(square_entries(m, "exponential's matrix"), 0.0);
     for (const SparseEntry &e : local_) dense_[e.row * m + e.col] += e.value;
     // Each squaring doubles the relative error of the computed exponential
     // (for a rotation: its departure from orthogonality, which the Casimirs
@@ -301,7 +309,7 @@ ExpmPath ExpmWorkspace::apply(std::size_t n, const std::vector<SparseEntry> &ent
                       norm, kMaxSquarings);
         fail(LPI_ERR_INVALID, text);
     }
-    exp_.resize(m * m);
+    exp_.resize(dense_.size());
     expm1_dense(m, dense_.data(), exp_.data());
     // x += (exp(tA) - I) x: the increment carries its own small rounding
     // errors, and x is rounded once (as in the nilpotent branch).

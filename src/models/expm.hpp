@@ -16,6 +16,11 @@
 
 namespace lpi {
 
+// The n * n entries of a dense n x n matrix of doubles; LPI_ERR_NO_MEMORY
+// naming `what` when their bytes cannot even be counted in a size_t (the
+// product would wrap around to a small, wrong allocation).
+std::size_t square_entries(std::size_t n, const char *what);
+
 // Dense exponential E = exp(A), both n x n row-major. Accurate to round-off
 // relative to the conditioning of exp at A (Higham 2005).
 void expm_dense(std::size_t n, const double *A, double *E);
@@ -57,7 +62,8 @@ private:
     std::vector<std::int64_t> local_of_;  // global index -> local, -1 if inactive
     std::vector<std::uint32_t> active_;   // local -> global
     std::vector<SparseEntry> local_;      // nonzero entries in local indices
-    std::vector<std::uint32_t> start_, cursor_, adjacency_, indegree_, queue_;
+    std::vector<std::size_t> start_, cursor_;  // offsets into adjacency_ (nnz)
+    std::vector<std::uint32_t> adjacency_, indegree_, queue_;
     std::vector<long> depth_;
     std::vector<double> term_, next_, increment_, dense_, exp_;
     long last_depth_ = -1;

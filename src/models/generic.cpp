@@ -3,27 +3,16 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <tuple>
 
 #include "../core/error.hpp"
+#include "../core/system.hpp"
+#include "../core/text.hpp"
 
 namespace lpi {
 
 namespace {
-
-std::string number(double v) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.17g", v);
-    return buffer;
-}
-
-std::string short_number(double v) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.3g", v);
-    return buffer;
-}
 
 std::string x_name(std::uint32_t i) { return "x_" + std::to_string(i); }
 
@@ -31,7 +20,7 @@ std::string bracket_text(std::uint32_t i, std::uint32_t j,
                          const std::vector<StructureConstants::Output> &terms) {
     std::string s = "{" + x_name(i) + ", " + x_name(j) + "} = ";
     for (std::size_t t = 0; t < terms.size(); ++t)
-        s += (t ? " + " : "") + number(terms[t].c) + " " + x_name(terms[t].l);
+        s += (t ? " + " : "") + number_text(terms[t].c) + " " + x_name(terms[t].l);
     return s;
 }
 
@@ -66,13 +55,13 @@ StructureConstants::StructureConstants(std::size_t dim, std::size_t nnz, const s
             if (idx[q] < 0 || static_cast<std::size_t>(idx[q]) >= dim)
                 fail(LPI_ERR_INVALID, entry + names[q] + " = " + std::to_string(idx[q]) + range);
         if (!std::isfinite(c[e]))
-            fail(LPI_ERR_NONFINITE, entry + "c = " + number(c[e]) + " is not finite");
+            fail(LPI_ERR_NONFINITE, entry + "c = " + number_text(c[e]) + " is not finite");
         const auto a = static_cast<std::uint32_t>(idx[0]), b = static_cast<std::uint32_t>(idx[1]),
                    l = static_cast<std::uint32_t>(idx[2]);
         if (a == b) {
             if (c[e] != 0.0)
                 fail(LPI_ERR_INVALID, entry + "{" + x_name(a) + ", " + x_name(a) + "} must be 0 "
-                                      "(antisymmetry), got coefficient " + number(c[e]) +
+                                      "(antisymmetry), got coefficient " + number_text(c[e]) +
                                       " on " + x_name(l));
             continue;
         }
@@ -83,8 +72,8 @@ StructureConstants::StructureConstants(std::size_t dim, std::size_t nnz, const s
             const double implied = a < b ? it->second.first : -it->second.first;
             fail(LPI_ERR_INVALID,
                  entry + "gives {" + x_name(a) + ", " + x_name(b) + "} the coefficient " +
-                     number(c[e]) + " on " + x_name(l) + ", but entry " +
-                     std::to_string(it->second.second) + " implies " + number(implied) +
+                     number_text(c[e]) + " on " + x_name(l) + ", but entry " +
+                     std::to_string(it->second.second) + " implies " + number_text(implied) +
                      " (entries must agree, with {x_j, x_i} = -{x_i, x_j})");
         }
     }
@@ -162,7 +151,7 @@ void StructureConstants::check_jacobi() const {
                          "the structure constants violate the Jacobi identity at (i, j, k) = (" +
                              std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " +
                              std::to_string(t[2]) + "): {{x_i, x_j}, x_k} + {{x_j, x_k}, x_i} + "
-                             "{{x_k, x_i}, x_j} has coefficient " + short_number(value[m]) +
+                             "{{x_k, x_i}, x_j} has coefficient " + number_text(value[m], 3) +
                              " on " + x_name(m) + " (must be 0)");
             }
             for (std::uint32_t m : touched) value[m] = size[m] = 0.0;
@@ -172,7 +161,7 @@ void StructureConstants::check_jacobi() const {
 }
 
 void StructureConstants::poisson_matrix(const double *x, double *J) const {
-    std::fill(J, J + dim_ * dim_, 0.0);
+    std::fill(J, J + square_entries(dim_, "Poisson matrix"), 0.0);
     for (const auto &[key, outputs] : brackets_) {
         double s = 0.0;
         for (const Output &o : outputs) s += o.c * x[o.l];
@@ -201,11 +190,12 @@ public:
         // A_il = sum_p c_{i sigma_p}^l g_p: one matrix entry per distinct
         // (i, l), fed by the contributions (p, c) that land on it.
         struct Raw {
-            std::uint32_t row, col, p;
+            std::uint32_t row, col;
+            std::size_t p;
             double c;
         };
         std::vector<Raw> raw;
-        for (std::uint32_t p = 0; p < sigma_.size(); ++p)
+        for (std::size_t p = 0; p < sigma_.size(); ++p)
             for (const StructureConstants::Term &t : constants_.column(sigma_[p]))
                 raw.push_back({t.i, t.l, p, t.c});
         std::sort(raw.begin(), raw.end(), [](const Raw &a, const Raw &b) {
@@ -249,7 +239,7 @@ public:
 private:
     struct Contribution {
         std::size_t entry;
-        std::uint32_t p;
+        std::size_t p;
         double c;
     };
 
@@ -381,7 +371,7 @@ void GenericModel::add_builtin_casimir(lpi_casimir_fn fn, const std::string &nam
 std::vector<double> singular_values(std::size_t n, std::vector<double> M) {
     // One-sided Jacobi (Hestenes 1958): rotate pairs of columns until they are
     // mutually orthogonal; the column norms are then the singular values.
-    std::vector<double> col(n * n);  // column-major copy
+    std::vector<double> col(square_entries(n, "matrix"));  // column-major copy
     for (std::size_t r = 0; r < n; ++r)
         for (std::size_t c = 0; c < n; ++c) col[c * n + r] = M[r * n + c];
     for (int sweep = 0; sweep < 100; ++sweep) {
@@ -427,7 +417,7 @@ std::size_t GenericModel::poisson_rank(const double *x) const {
     if (x_max == 0.0) return 0;
     std::vector<double> scaled(x, x + n);
     for (double &v : scaled) v /= x_max;
-    std::vector<double> J(n * n);
+    std::vector<double> J(square_entries(n, "Poisson matrix J(x)"));
     constants_->poisson_matrix(scaled.data(), J.data());
     double J_max = 0.0;
     for (std::size_t e = 0; e < J.size(); ++e) {
@@ -447,6 +437,36 @@ std::size_t GenericModel::poisson_rank(const double *x) const {
     for (double s : sigma)
         if (s > tolerance) ++rank;
     return rank;
+}
+
+GenericModel &generic_model_of(System &system) {
+    return const_cast<GenericModel &>(generic_model_of(static_cast<const System &>(system)));
+}
+
+const GenericModel &generic_model_of(const System &system) {
+    const auto *model = dynamic_cast<const GenericModel *>(&system.model());
+    if (!model)
+        fail(LPI_ERR_UNSUPPORTED, std::string("a ") + system.model().kind() +
+                                      " system has no user pieces or structure constants "
+                                      "(create it with lpi_generic_create or "
+                                      "lpi_moments_create)");
+    return *model;
+}
+
+void commit_new_piece(System &system, GenericModel &model) {
+    try {
+        system.rebuild_integrator();
+    } catch (...) {
+        model.remove_last_piece();
+        throw;
+    }
+}
+
+void add_piece(System &system, std::size_t n, const std::int32_t *indices, lpi_gradient_fn grad,
+               lpi_energy_fn energy, void *user) {
+    GenericModel &model = generic_model_of(system);
+    model.add_piece(n, indices, grad, energy, user);
+    commit_new_piece(system, model);
 }
 
 std::unique_ptr<GenericModel> make_generic(std::size_t dim, std::size_t nnz, const std::int32_t *i,

@@ -16,6 +16,8 @@
 
 namespace lpi {
 
+class System;
+
 // {x_i, x_j} = sum_l c_ij^l x_l, stored sparsely in both orders. Construction
 // validates ranges, antisymmetry and the Jacobi identity (throws lpi::Error).
 class StructureConstants {
@@ -130,13 +132,28 @@ std::vector<double> singular_values(std::size_t n, std::vector<double> M);
 void add_poisson_times(const StructureConstants &c, const std::uint32_t *sigma, std::size_t n,
                        const double *g, const double *x, double *rate);
 
+// The generic model of a system; LPI_ERR_UNSUPPORTED naming the system's
+// kind for every other kind.
+GenericModel &generic_model_of(System &system);
+const GenericModel &generic_model_of(const System &system);
+
+// Appends a piece to the system's generic model (validated as in
+// GenericModel::add_piece) and rebuilds the system's integrator for it. When
+// either fails, the system is left as it was.
+void add_piece(System &system, std::size_t n, const std::int32_t *indices, lpi_gradient_fn grad,
+               lpi_energy_fn energy, void *user);
+// Rebuilds the system's integrator after model (its own) gained a piece; on
+// failure the piece is removed again and the failure rethrown.
+void commit_new_piece(System &system, GenericModel &model);
+
 std::unique_ptr<GenericModel> make_generic(std::size_t dim, std::size_t nnz, const std::int32_t *i,
                                            const std::int32_t *j, const std::int32_t *k,
                                            const double *c);
 
 // The moment algebra of the paper (kind "moments"), Casimirs I and K declared.
 std::unique_ptr<GenericModel> make_moments();
-// Appends the product piece H(x1 x3); throws unless model is a moments system.
-void add_moments_product_piece(GenericModel &model, lpi_scalar_fn h, lpi_scalar_fn dh, void *user);
+// Appends the product piece H(x1 x3) as add_piece does; LPI_ERR_UNSUPPORTED
+// unless the system is a moments system.
+void add_moments_product_piece(System &system, lpi_scalar_fn h, lpi_scalar_fn dh, void *user);
 
 }  // namespace lpi

@@ -4,6 +4,7 @@
 
 #include <memory>
 
+#include "../core/checkpoint.hpp"
 #include "../core/model.hpp"
 
 namespace lpi {
@@ -17,7 +18,7 @@ bool rigid_body_inertia(const Model &model, double inertia[3]);
 // The small built-in models keep their state compensated: the working layout
 // is [x, carry], the value is x + carry, and every flow adds an increment with
 // Kahan summation. Round-off in the Casimirs then stays O(u) instead of
-// growing like u sqrt(steps) (see DESIGN notes and the invariant tests).
+// growing like u sqrt(steps) (tests/test_invariants.c measures it).
 void compensated_add(double &x, double &carry, double increment);
 
 // Rotates (x_i, x_j) by angle a: x_i <- cos a x_i + sin a x_j,
@@ -39,5 +40,14 @@ protected:
     void value(const double *state, double *x) const;
     virtual void public_vector_field(const double *x, double *rate) const = 0;
 };
+
+// Throws LPI_ERR_INVALID unless every carry of a CompensatedModel's working
+// state is a rounding remainder of its entry (what a checkpoint must hold).
+void check_compensated_state(const Model &model, const double *state);
+
+// How checkpoints restore each built-in kind (src/registry.cpp lists them).
+CheckpointKind rigid_body_checkpoint_kind();
+CheckpointKind pendulum_checkpoint_kind();
+CheckpointKind sine_euler_checkpoint_kind();  // sine_euler_checkpoint.cpp
 
 }  // namespace lpi

@@ -20,6 +20,7 @@
 #include <cmath>
 
 #include "../core/error.hpp"
+#include "../core/system.hpp"
 #include "generic.hpp"
 
 namespace lpi {
@@ -192,8 +193,8 @@ std::unique_ptr<GenericModel> make_moments() {
     return model;
 }
 
-void add_moments_product_piece(GenericModel &model, lpi_scalar_fn h, lpi_scalar_fn dh,
-                               void *user) {
+void add_moments_product_piece(System &system, lpi_scalar_fn h, lpi_scalar_fn dh, void *user) {
+    GenericModel &model = generic_model_of(system);
     if (std::string(model.kind()) != "moments")
         fail(LPI_ERR_UNSUPPORTED, std::string("the product piece H(x1 x3) belongs to the moment "
                                               "algebra; this is a ") + model.kind() + " system");
@@ -201,6 +202,7 @@ void add_moments_product_piece(GenericModel &model, lpi_scalar_fn h, lpi_scalar_
     if (!dh) fail(LPI_ERR_NULL, "the H' callback is NULL");
     model.add_piece(std::make_unique<ProductPiece>(model.next_piece_name() + " (product H(x1 x3))",
                                                    model.constants(), h, dh, user));
+    commit_new_piece(system, model);
 }
 
 }  // namespace lpi

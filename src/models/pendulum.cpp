@@ -52,4 +52,9 @@ private:
 
 std::unique_ptr<Model> make_pendulum() { return std::make_unique<Pendulum>(); }
 
+CheckpointKind pendulum_checkpoint_kind() {
+    return {"pendulum", 0, [](const std::vector<double> &) -> std::uint64_t { return 6; },
+            [](const std::vector<double> &) { return make_pendulum(); }, check_compensated_state};
+}
+
 }  // namespace lpi

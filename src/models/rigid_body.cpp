@@ -90,4 +90,10 @@ std::unique_ptr<Model> make_rigid_body(double I1, double I2, double I3) {
     return std::make_unique<RigidBody>(I1, I2, I3);
 }
 
+CheckpointKind rigid_body_checkpoint_kind() {
+    return {"rigid-body", 3, [](const std::vector<double> &) -> std::uint64_t { return 6; },
+            [](const std::vector<double> &p) { return make_rigid_body(p[0], p[1], p[2]); },
+            check_compensated_state};
+}
+
 }  // namespace lpi

@@ -1,6 +1,9 @@
 #include <algorithm>
 #include <cmath>
+#include <string>
 
+#include "../core/error.hpp"
+#include "../core/text.hpp"
 #include "models.hpp"
 
 namespace lpi {
@@ -45,6 +48,39 @@ void CompensatedModel::vector_field(const double *state, double *rate) const {
     value(state, x);
     public_vector_field(x, rate);
     std::fill(rate + dim(), rate + 2 * dim(), 0.0);
+}
+
+}  // namespace lpi
+
+namespace lpi {
+
+namespace {
+
+// The carry of a compensated model ([x, carry]) is the rounding remainder
+// of x: at most half an ulp of its component when a flow writes it
+// (compensated_add). The non-splitting baselines (rk4, implicit-midpoint)
+// leave it as it is while x moves, so it is bounded against the largest
+// component, with a margin of 2^21 over what the flows leave: 2^-32 of it.
+constexpr double kMaxRelativeCarry = 0x1p-32;
+
+}  // namespace
+
+void check_compensated_state(const Model &model, const double *state) {
+    const std::size_t n = model.dim();
+    double largest = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double value = state[i] + state[n + i];
+        if (!std::isfinite(value))
+            fail(LPI_ERR_INVALID, "state entry " + std::to_string(i) +
+                                      " overflows when its compensation carry is added");
+        largest = std::fmax(largest, std::fabs(value));
+    }
+    for (std::size_t i = 0; i < n; ++i)
+        if (std::fabs(state[n + i]) > kMaxRelativeCarry * largest)
+            fail(LPI_ERR_INVALID, "the compensation carry of state entry " + std::to_string(i) +
+                                      " is " + number_text(state[n + i]) +
+                                      ", no rounding remainder of a state whose largest entry "
+                                      "is " + number_text(largest));
 }
 
 }  // namespace lpi

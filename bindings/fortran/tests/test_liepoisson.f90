@@ -108,7 +108,22 @@ contains
     subroutine test_statuses()
         integer :: i
         logical :: found
+        type(c_ptr) :: sys
+        character(len=16) :: text
         call check(len(lpi_version_string()) >= 5, "version string")
+        write (text, '(I0,".",I0,".",I0)') lpi_version_number() / 10000, &
+            mod(lpi_version_number() / 100, 100), mod(lpi_version_number(), 100)
+        call check(trim(text) == lpi_version_string(), "version number matches the string")
+        call lpi_rigid_body_create(sys, 1.0_c_double, 2.0_c_double, 3.0_c_double)
+        call check(lpi_kind(sys) == "rigid-body", "kind")
+        call check(lpi_get_method(sys) == "leapfrog", "default method")
+        call check(lpi_get_split(sys) == "casimir-shift", "default split")
+        call lpi_set_method(sys, "strang")
+        call lpi_set_split(sys, "axes")
+        call check(lpi_get_method(sys) == "leapfrog", "an alias reads back as its name")
+        call check(lpi_get_split(sys) == "axes", "split read back")
+        call lpi_destroy(sys)
+        call check(lpi_kind(sys) == "", "null handle has no kind")
         call check(lpi_status_name(LPI_OK) == "LPI_OK", "LPI_OK")
         call check(lpi_status_name(LPI_ERR_SIZE) == "LPI_ERR_SIZE", "LPI_ERR_SIZE")
         call check(lpi_status_name(LPI_ERR_CALLBACK) == "LPI_ERR_CALLBACK", "LPI_ERR_CALLBACK")

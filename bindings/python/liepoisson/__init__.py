@@ -15,6 +15,8 @@ Attributes
 ----------
 version : str
     The loaded library's version, "MAJOR.MINOR.PATCH" (also ``__version__``).
+version_number : int
+    The same as one number to compare, MAJOR * 10000 + MINOR * 100 + PATCH.
 HAVE_NUMPY : bool
     True when arrays are numpy arrays.
 STATUS : dict
@@ -61,7 +63,7 @@ PathLike = Union[str, bytes, os.PathLike]
 Observer = Callable[["System", int, float], Any]
 
 __all__ = [
-    "version", "methods", "Method", "status_name", "status_message", "HAVE_NUMPY",
+    "version", "version_number", "methods", "Method", "status_name", "status_message", "HAVE_NUMPY",
     "System", "Trajectory", "RigidBody", "Pendulum", "Generic", "Moments", "SineEuler",
     "load", "load_bytes", "fftw_wisdom_import_file", "fftw_wisdom_export_file",
     "fftw_wisdom_import_string", "fftw_wisdom_export_string",
@@ -129,6 +131,8 @@ def _c_path(path):
 #: The library's version, "MAJOR.MINOR.PATCH".
 version = _text(lib.lpi_version_string())
 __version__ = version
+#: The same as one number, MAJOR * 10000 + MINOR * 100 + PATCH: compare this.
+version_number = lib.lpi_version_number()
 
 
 def status_name(status: int) -> str:
@@ -462,8 +466,6 @@ class System:
         self._handle = handle
         self._keep = []        # ctypes callbacks the library holds
         self._pending = []     # exception raised inside a callback during the current call
-        self._method = "leapfrog"
-        self._split = None
         self._threads = 1
         self._seconds_per_step = None  # measured by step(), for the SIGINT observer
         self._finalizer = weakref.finalize(self, _destroy, handle, self._keep)
@@ -533,19 +535,31 @@ class System:
         """
         return _text(lib.lpi_last_error(self._h()))
 
+    @property
+    def kind(self) -> str:
+        """The system's kind.
+
+        Returns
+        -------
+        str
+            ``"rigid-body"``, ``"pendulum"``, ``"generic"``, ``"moments"`` or
+            ``"sine-euler"``.
+        """
+        return _text(lib.lpi_kind(self._h()))
+
     # method and split
     @property
-    def method(self) -> Optional[str]:
+    def method(self) -> str:
         """The method's name.
 
         Returns
         -------
-        str or None
-            ``"leapfrog"`` until set, ``"custom"`` after `set_composition`,
-            None for a system from `load` (which still steps with the saved
-            method).
+        str
+            ``"leapfrog"`` until set, ``"custom"`` after `set_composition`;
+            an alias is reported by its name. A system from `load` reports
+            the saved method.
         """
-        return self._method
+        return _text(lib.lpi_get_method(self._h()))
 
     @method.setter
     def method(self, name: str) -> None:
@@ -566,18 +580,17 @@ class System:
             An unknown name; the method is unchanged.
         """
         self._call("lpi_set_method", _c_string(name, "method"))
-        self._method = name
 
     @property
-    def split(self) -> Optional[str]:
+    def split(self) -> str:
         """The split's name.
 
         Returns
         -------
-        str or None
-            The name set, or None for the system's default split.
+        str
+            The name set, or the system's default split.
         """
-        return self._split
+        return _text(lib.lpi_get_split(self._h()))
 
     @split.setter
     def split(self, name: str) -> None:
@@ -598,7 +611,6 @@ class System:
             A split this system does not have; the split is unchanged.
         """
         self._call("lpi_set_split", _c_string(name, "split"))
-        self._split = name
 
     def set_composition(self, gammas: ArrayIn) -> None:
         """Use a symmetric composition of leapfrog (method ``"custom"``).
@@ -610,7 +622,6 @@ class System:
         """
         ptr, n, _keep = _doubles_in(gammas, "gammas")
         self._call("lpi_set_composition", n, ptr)
-        self._method = "custom"
 
     def flows_per_step(self) -> int:
         """The number of piece flows one step computes.
@@ -1021,19 +1032,15 @@ class System:
         return buf.raw[:size.value]
 
     @classmethod
-    def _adopt(cls, handle, method=None):
+    def _adopt(cls, handle):
         """Wraps a handle made by lpi_load*, as the subclass of its kind."""
-        N = c_int32()
-        if lib.lpi_sine_euler_size(handle, byref(N)) == 0:
-            kind = SineEuler
-        elif lib.lpi_rigid_body_exact(handle, 0.0, (c_double * 3)()) == 0:
-            kind = RigidBody
-        else:
-            kind = Pendulum  # generic and moment systems cannot be saved
+        # Generic and moment systems cannot be saved.
+        classes = {"sine-euler": SineEuler, "rigid-body": RigidBody, "pendulum": Pendulum}
+        kind = classes[_text(lib.lpi_kind(handle))]
         self = kind.__new__(kind)
         self._handle = handle
         self._keep, self._pending = [], []
-        self._method, self._split, self._threads = method, None, 1
+        self._threads = 1
         self._seconds_per_step = None
         self._finalizer = weakref.finalize(self, _destroy, handle, self._keep)
         return self
@@ -1045,11 +1052,11 @@ class System:
         Returns
         -------
         tuple
-            ``(_from_checkpoint, (bytes, method, split, threads))``; unpickling
+            ``(_from_checkpoint, (bytes, threads))``; unpickling
             restores an independent system that continues the trajectory bit
             for bit (observers are not kept).
         """
-        return (_from_checkpoint, (self.save_bytes(), self._method, self._split, self._threads))
+        return (_from_checkpoint, (self.save_bytes(), self._threads))
 
     def __copy__(self) -> "System":
         """An independent system in the same state (through a checkpoint).
@@ -1080,7 +1087,7 @@ class System:
     def __repr__(self):
         if self.closed:
             return "<%s (closed)>" % type(self).__name__
-        return "<%s dim=%d method=%r t=%g>" % (type(self).__name__, self.dim, self._method, self.time)
+        return "<%s dim=%d method=%r t=%g>" % (type(self).__name__, self.dim, self.method, self.time)
 
 
 class RigidBody(System):
@@ -1486,8 +1493,8 @@ class SineEuler(System):
 def load(path: PathLike) -> System:
     """A system restored from a checkpoint file (lpi_load).
 
-    It continues the saved trajectory bit for bit, with the saved method (its
-    ``method`` reads None: the name is not kept on the Python side).
+    It continues the saved trajectory bit for bit, with the saved method and
+    split.
 
     Parameters
     ----------
@@ -1511,11 +1518,10 @@ def load(path: PathLike) -> System:
     return System._adopt(handle)
 
 
-def _from_checkpoint(data: bytes, method: Optional[str], split: Optional[str], threads: int) -> System:
-    """A system from checkpoint bytes with the Python-side settings of the
-    system it was saved from (the library restores method and split itself)."""
+def _from_checkpoint(data: bytes, threads: int) -> System:
+    """A system from checkpoint bytes with the thread count of the system it
+    was saved from (the checkpoint restores everything else)."""
     system = load_bytes(data)
-    system._method, system._split = method, split
     if threads != 1:
         system.threads = threads
     return system

@@ -35,6 +35,7 @@ OBSERVER_FN = CFUNCTYPE(c_int, c_handle, c_int64, c_double, c_void_p)
 PROTOTYPES = {
     # version, status codes, methods
     "lpi_version_string": (c_char_p, []),
+    "lpi_version_number": (c_int, []),
     "lpi_status_name": (c_char_p, [c_int]),
     "lpi_status_message": (c_char_p, [c_int]),
     "lpi_method_count": (c_int, []),
@@ -50,6 +51,9 @@ PROTOTYPES = {
     "lpi_destroy": (c_int, [c_handle]),
     "lpi_set_method": (c_int, [c_handle, c_char_p]),
     "lpi_set_split": (c_int, [c_handle, c_char_p]),
+    "lpi_kind": (c_char_p, [c_handle]),
+    "lpi_get_method": (c_char_p, [c_handle]),
+    "lpi_get_split": (c_char_p, [c_handle]),
     "lpi_dim": (c_size_t, [c_handle]),
     "lpi_set_state": (c_int, [c_handle, c_double_p, c_size_t]),
     "lpi_get_state": (c_int, [c_handle, c_double_p, c_size_t]),

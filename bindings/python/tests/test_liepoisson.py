@@ -35,6 +35,8 @@ def generic_rigid_body():
 class TestModule(unittest.TestCase):
     def test_version_and_methods(self):
         self.assertRegex(lp.version, r"^\d+\.\d+\.\d+$")
+        major, minor, patch = (int(p) for p in lp.version.split("."))
+        self.assertEqual(lp.version_number, major * 10000 + minor * 100 + patch)
         by_name = {m.name: m for m in lp.methods()}
         self.assertEqual(by_name["leapfrog"].order, 2)
         self.assertTrue(by_name["leapfrog"].is_poisson)
@@ -78,6 +80,9 @@ class TestCheckpoints(unittest.TestCase):
             for copy in (lp.load(path), lp.load_bytes(data)):
                 with copy:
                     self.assertIsInstance(copy, lp.RigidBody)
+                    self.assertEqual(copy.kind, "rigid-body")
+                    self.assertEqual(copy.method, "kahan-li-6")
+                    self.assertEqual(copy.split, body.split)
                     copy.step(0.01, 50)
                     self.assertEqual(as_list(copy.state), as_list(body.state))
                     self.assertEqual(copy.time, body.time)
@@ -148,6 +153,8 @@ class TestRigidBody(unittest.TestCase):
 
     def test_exact_solution_and_splits(self):
         with lp.RigidBody(*INERTIA) as b:
+            self.assertEqual(b.split, "casimir-shift")  # the default, read back
+            self.assertEqual(b.kind, "rigid-body")
             b.split = "axes"
             self.assertEqual(b.split, "axes")
             b.method = "suzuki-6"

@@ -34,6 +34,7 @@ const Sys = Ptr{Cvoid}   # lpi_system *
 
 # version, status codes, methods
 lpi_version_string() = ccall(_sym(:lpi_version_string), Cstring, ())
+lpi_version_number() = ccall(_sym(:lpi_version_number), Cint, ())
 lpi_status_name(status) = ccall(_sym(:lpi_status_name), Cstring, (Cint,), status)
 lpi_status_message(status) = ccall(_sym(:lpi_status_message), Cstring, (Cint,), status)
 lpi_method_count() = ccall(_sym(:lpi_method_count), Cint, ())
@@ -51,6 +52,9 @@ lpi_pendulum_create(out) = ccall(_sym(:lpi_pendulum_create), Cint, (Ptr{Sys},), 
 lpi_destroy(sys) = ccall(_sym(:lpi_destroy), Cint, (Sys,), sys)
 lpi_set_method(sys, name) = ccall(_sym(:lpi_set_method), Cint, (Sys, Cstring), sys, name)
 lpi_set_split(sys, name) = ccall(_sym(:lpi_set_split), Cint, (Sys, Cstring), sys, name)
+lpi_kind(sys) = ccall(_sym(:lpi_kind), Cstring, (Sys,), sys)
+lpi_get_method(sys) = ccall(_sym(:lpi_get_method), Cstring, (Sys,), sys)
+lpi_get_split(sys) = ccall(_sym(:lpi_get_split), Cstring, (Sys,), sys)
 lpi_dim(sys) = ccall(_sym(:lpi_dim), Csize_t, (Sys,), sys)
 lpi_set_state(sys, x, n) = ccall(_sym(:lpi_set_state), Cint, (Sys, Ptr{Cdouble}, Csize_t), sys, x, n)
 lpi_get_state(sys, x, n) = ccall(_sym(:lpi_get_state), Cint, (Sys, Ptr{Cdouble}, Csize_t), sys, x, n)
@@ -132,6 +136,8 @@ Base.showerror(io::IO, e::LiePoissonError) = print(io, e.name, ": ", e.message)
 status_name(status::Integer) = unsafe_string(C.lpi_status_name(status))
 status_message(status::Integer) = unsafe_string(C.lpi_status_message(status))
 version() = VersionNumber(unsafe_string(C.lpi_version_string()))
+# MAJOR * 10000 + MINOR * 100 + PATCH of the library that runs.
+version_number() = Int(C.lpi_version_number())
 
 function _check(status, handle::Ptr{Cvoid} = C_NULL, cause = nothing)
     status >= 0 && return nothing
@@ -222,6 +228,10 @@ function Generic(dim::Integer, brackets = Tuple{Int,Int,Int,Float64}[])
     System(out -> C.lpi_generic_create(out, dim, length(c), i, j, k, c))
 end
 
+# The system's kind ("rigid-body", ..., "sine-euler"), method and split names.
+kind(sys::System) = unsafe_string(C.lpi_kind(_h(sys)))
+method_name(sys::System) = unsafe_string(C.lpi_get_method(_h(sys)))
+split_name(sys::System) = unsafe_string(C.lpi_get_split(_h(sys)))
 set_method!(sys::System, name::AbstractString) = _call(h -> C.lpi_set_method(h, name), sys)
 set_split!(sys::System, name::AbstractString) = _call(h -> C.lpi_set_split(h, name), sys)
 set_composition!(sys::System, gammas::AbstractVector{<:Real}) =
@@ -403,6 +413,7 @@ end
 
 export LiePoissonError, RigidBody, Pendulum, Generic, Moments, SineEuler, System, save, load,
     save_bytes, load_bytes,
+    kind, method_name, split_name, version_number,
     set_method!, set_split!, set_composition!, flows_per_step, set_implicit_options!,
     set_threads!, dim, state, set_state!, step!, energy, casimir_count, casimirs, last_error,
     exact, poisson_rank, add_piece!, add_casimir!, add_product_piece!, sine_euler_size, modes,

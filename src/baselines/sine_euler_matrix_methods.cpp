@@ -1,6 +1,6 @@
 // Matrix-form baselines for sine-Euler (see the header).
 //
-// Conventions (design notes, section 1): W = sum_m w_m J_m is Hermitian,
+// Conventions: W = sum_m w_m J_m is Hermitian,
 // eq. 5 is dW/dt = [B, W] with B = i f P, f = 1/(2 eps), eps = 2 pi/N and
 // P = sum_{n != 0} w_n / |n|^2 J_n (Hermitian, so B is anti-Hermitian).
 // Entry (a, a + m2) of W is sum_m1 w_(m1,m2) exp(2 pi i m1 k / N) with
@@ -19,6 +19,8 @@
 
 #include "../core/error.hpp"
 #include "../models/sine_euler.hpp"
+#include "fixed_point.hpp"
+#include "runge_kutta4.hpp"
 #include "lpi_config.h"
 
 #if LPI_HAVE_FFTW
@@ -38,35 +40,24 @@ int rep(int a, int N) { return a > N / 2 ? a - N : a; }
 class DirectEq5 final : public Integrator {
 public:
     explicit DirectEq5(int N)
-        : N_(N), sine_(N), weight_(static_cast<std::size_t>(N) * N),
-          k1_(2 * weight_.size()), k2_(k1_.size()), k3_(k1_.size()), k4_(k1_.size()),
-          stage_(k1_.size()) {
+        : N_(N), sine_(N), weight_(static_cast<std::size_t>(N) * N), size_(2 * weight_.size()),
+          stages_(size_) {
         const double two_pi = 2.0 * std::acos(-1.0), eps = two_pi / N;
         // sin(eps m x n) depends on m x n only mod N.
         for (int j = 0; j < N; ++j) sine_[j] = std::sin(two_pi * j / N) / eps;
         for (int a = 0; a < N; ++a)
             for (int b = 0; b < N; ++b) {
                 const int ra = rep(a, N), rb = rep(b, N), norm2 = ra * ra + rb * rb;
-                weight_[a * N + b] = norm2 ? 1.0 / norm2 : 0.0;
+                weight_[static_cast<std::size_t>(a) * N + b] = norm2 ? 1.0 / norm2 : 0.0;
             }
     }
 
-    // The same arithmetic as RungeKutta4, so the two agree to round-off.
+    // The stages of rk4 on the modes, so the two agree to round-off.
     bool advance(Model &, double *x, double dt, std::int64_t n) override {
-        const std::size_t size = k1_.size();
-        for (std::int64_t step = 0; step < n; ++step) {
-            rate(x, k1_.data());
-            for (std::size_t i = 0; i < size; ++i) stage_[i] = x[i] + 0.5 * dt * k1_[i];
-            rate(stage_.data(), k2_.data());
-            for (std::size_t i = 0; i < size; ++i) stage_[i] = x[i] + 0.5 * dt * k2_[i];
-            rate(stage_.data(), k3_.data());
-            for (std::size_t i = 0; i < size; ++i) stage_[i] = x[i] + dt * k3_[i];
-            rate(stage_.data(), k4_.data());
-            for (std::size_t i = 0; i < size; ++i)
-                x[i] += dt / 6.0 * (k1_[i] + 2.0 * k2_[i] + 2.0 * k3_[i] + k4_[i]);
-            if ((step + 1) % kFiniteCheckInterval == 0 && !all_finite(x, size)) return false;
-        }
-        return all_finite(x, size);
+        auto rate = [this](const double *y, double *k) { this->rate(y, k); };
+        return run_checked_steps(
+            n, [&](std::int64_t) { stages_.step(x, dt, rate); },
+            [&] { return all_finite(x, size_); });
     }
 
     std::size_t evaluations_per_step() const override { return 4; }
@@ -74,6 +65,8 @@ public:
 private:
     // dw_m/dt = sum_{n != 0} sin(eps m x n) / (eps |n|^2) w_{m+n} w_{-n}  (eq. 5)
     void rate(const double *modes, double *out) const {
+        // int indices: N <= kDirectEq5MaxN, so none exceeds N^2 = 961, and
+        // the remainders of this O(N^4) loop are cheaper in 32 bits.
         const int N = N_;
         const cplx *w = reinterpret_cast<const cplx *>(modes);
         cplx *r = reinterpret_cast<cplx *>(out);
@@ -97,7 +90,8 @@ private:
 
     int N_;
     std::vector<double> sine_, weight_;
-    std::vector<double> k1_, k2_, k3_, k4_, stage_;
+    std::size_t size_;
+    RungeKutta4Stages<double> stages_;
 };
 
 #if LPI_HAVE_FFTW && LPI_HAVE_LAPACK
@@ -110,11 +104,12 @@ extern "C" void zgemm_(const char *transa, const char *transb, const int *m, con
 // Keeps the mode array Hermitian (w_-m = conj(w_m)) after a matrix-form step,
 // where round-off of the transforms breaks it slightly, and restores the
 // inert mode w_0 exactly.
-void symmetrise_modes(int N, const double *w0, double *modes) {
+void symmetrise_modes(int order, const double *w0, double *modes) {
+    const std::size_t N = static_cast<std::size_t>(order);
     cplx *w = reinterpret_cast<cplx *>(modes);
-    for (int a = 0; a < N; ++a)
-        for (int b = 0; b < N; ++b) {
-            const int m = a * N + b, minus = ((N - a) % N) * N + (N - b) % N;
+    for (std::size_t a = 0; a < N; ++a)
+        for (std::size_t b = 0; b < N; ++b) {
+            const std::size_t m = a * N + b, minus = ((N - a) % N) * N + (N - b) % N;
             if (minus <= m) continue;
             const cplx mean = 0.5 * (w[m] + std::conj(w[minus]));
             w[m] = mean;
@@ -136,17 +131,19 @@ class MatrixForm {
 public:
     explicit MatrixForm(int N)
         : N_(N), index_(static_cast<std::size_t>(N) * N), inverse_laplacian_(index_.size()) {
-        const int half = (N + 1) / 2;  // the inverse of 2 mod N (N odd)
-        for (int m2 = 0; m2 < N; ++m2)
-            for (int k = 0; k < N; ++k) {
-                const int a = static_cast<int>((static_cast<long>(k - m2 + N) * half) % N);
-                const int b = (a + m2) % N;
-                index_[m2 * N + k] = a + b * N;
+        const std::size_t n = static_cast<std::size_t>(N);
+        const std::size_t half = (n + 1) / 2;  // the inverse of 2 mod N (N odd)
+        for (std::size_t m2 = 0; m2 < n; ++m2)
+            for (std::size_t k = 0; k < n; ++k) {
+                const std::size_t a = (k + n - m2) * half % n, b = (a + m2) % n;
+                index_[m2 * n + k] = a + b * n;
             }
-        for (int m2 = 0; m2 < N; ++m2)
-            for (int m1 = 0; m1 < N; ++m1) {
-                const int r1 = rep(m1, N), r2 = rep(m2, N), norm2 = r1 * r1 + r2 * r2;
-                inverse_laplacian_[m2 * N + m1] = norm2 ? 1.0 / (static_cast<double>(N) * norm2) : 0.0;
+        for (std::size_t m2 = 0; m2 < n; ++m2)
+            for (std::size_t m1 = 0; m1 < n; ++m1) {
+                const long r1 = rep(static_cast<int>(m1), N), r2 = rep(static_cast<int>(m2), N);
+                const long norm2 = r1 * r1 + r2 * r2;
+                inverse_laplacian_[m2 * n + m1] =
+                    norm2 ? 1.0 / (static_cast<double>(N) * static_cast<double>(norm2)) : 0.0;
             }
         std::lock_guard<std::mutex> lock(fftw_planner_mutex());
         buffer_ = fftw_alloc_complex(index_.size());
@@ -169,24 +166,24 @@ public:
     MatrixForm &operator=(const MatrixForm &) = delete;
 
     void to_matrix(const double *modes, cplx *W) {
-        const int N = N_;
+        const std::size_t N = static_cast<std::size_t>(N_);
         const cplx *w = reinterpret_cast<const cplx *>(modes);
         cplx *x = reinterpret_cast<cplx *>(buffer_);
-        for (int m1 = 0; m1 < N; ++m1)
-            for (int m2 = 0; m2 < N; ++m2) x[m2 * N + m1] = w[m1 * N + m2];
+        for (std::size_t m1 = 0; m1 < N; ++m1)
+            for (std::size_t m2 = 0; m2 < N; ++m2) x[m2 * N + m1] = w[m1 * N + m2];
         fftw_execute(backward_);
         scatter(W);
     }
 
     void to_modes(const cplx *W, double *modes) {
-        const int N = N_;
+        const std::size_t N = static_cast<std::size_t>(N_);
         gather(W);
         fftw_execute(forward_);
         const cplx *x = reinterpret_cast<const cplx *>(buffer_);
         cplx *w = reinterpret_cast<cplx *>(modes);
-        const double scale = 1.0 / N;
-        for (int m1 = 0; m1 < N; ++m1)
-            for (int m2 = 0; m2 < N; ++m2) w[m1 * N + m2] = scale * x[m2 * N + m1];
+        const double scale = 1.0 / N_;
+        for (std::size_t m1 = 0; m1 < N; ++m1)
+            for (std::size_t m2 = 0; m2 < N; ++m2) w[m1 * N + m2] = scale * x[m2 * N + m1];
     }
 
     // P = sum_{n != 0} w_n / |n|^2 J_n for W = sum_n w_n J_n.
@@ -217,7 +214,7 @@ private:
     }
 
     int N_;
-    std::vector<int> index_;                // [m2 * N + k] -> entry (a, a + m2) of W
+    std::vector<std::size_t> index_;        // [m2 * N + k] -> entry (a, a + m2) of W
     std::vector<double> inverse_laplacian_;  // [m2 * N + m1] = 1 / (N |m|^2), 0 at m = 0
     fftw_complex *buffer_ = nullptr;
     fftw_plan forward_ = nullptr, backward_ = nullptr;
@@ -242,11 +239,9 @@ protected:
     bool run(double *state, double dt, std::int64_t n) {
         const double w0[2] = {state[0], state[1]};
         form_.to_matrix(state, W_.data());
-        for (std::int64_t s = 0; s < n; ++s) {
-            step(dt, s);
-            if ((s + 1) % kFiniteCheckInterval == 0 && !matrix_finite(W_)) return false;
-        }
-        if (!matrix_finite(W_)) return false;
+        if (!run_checked_steps(n, [&](std::int64_t s) { step(dt, s); },
+                               [&] { return matrix_finite(W_); }))
+            return false;
         form_.to_modes(W_.data(), state);
         symmetrise_modes(N_, w0, state);
         return all_finite(state, 2 * size_);
@@ -255,10 +250,10 @@ protected:
     // Out = i f (X - X^dagger): the Hermitian [B, W] when X = P W, since
     // W P = (P W)^dagger for Hermitian P and W.
     void commutator(const cplx *X, cplx *out) const {
-        const int N = N_;
+        const std::size_t N = static_cast<std::size_t>(N_);
         const cplx factor(0.0, f_);
-        for (int j = 0; j < N; ++j)
-            for (int i = 0; i < N; ++i)
+        for (std::size_t j = 0; j < N; ++j)
+            for (std::size_t i = 0; i < N; ++i)
                 out[i + j * N] = factor * (X[i + j * N] - std::conj(X[j + i * N]));
     }
 
@@ -272,8 +267,7 @@ protected:
 // Classical RK4 on dW/dt = [B(W), W]: one P(W) and one zgemm per stage.
 class RungeKutta4Matrix final : public MatrixIntegrator {
 public:
-    explicit RungeKutta4Matrix(int N)
-        : MatrixIntegrator(N), k1_(size_), k2_(size_), k3_(size_), k4_(size_), stage_(size_) {}
+    explicit RungeKutta4Matrix(int N) : MatrixIntegrator(N), stages_(size_) {}
 
     bool advance(Model &, double *state, double dt, std::int64_t n) override {
         return run(state, dt, n);
@@ -288,19 +282,10 @@ private:
     }
 
     void step(double dt, std::int64_t) override {
-        cplx *W = W_.data();
-        rate(W, k1_.data());
-        for (std::size_t i = 0; i < size_; ++i) stage_[i] = W[i] + 0.5 * dt * k1_[i];
-        rate(stage_.data(), k2_.data());
-        for (std::size_t i = 0; i < size_; ++i) stage_[i] = W[i] + 0.5 * dt * k2_[i];
-        rate(stage_.data(), k3_.data());
-        for (std::size_t i = 0; i < size_; ++i) stage_[i] = W[i] + dt * k3_[i];
-        rate(stage_.data(), k4_.data());
-        for (std::size_t i = 0; i < size_; ++i)
-            W[i] += dt / 6.0 * (k1_[i] + 2.0 * k2_[i] + 2.0 * k3_[i] + k4_[i]);
+        stages_.step(W_.data(), dt, [this](const cplx *W, cplx *k) { rate(W, k); });
     }
 
-    std::vector<cplx> k1_, k2_, k3_, k4_, stage_;
+    RungeKutta4Stages<cplx> stages_;
 };
 
 // The isospectral midpoint method for dW/dt = [B(W), W] (K. Modin and
@@ -335,9 +320,9 @@ private:
     void step(double h, std::int64_t s) override {
         const int N = N_;
         cplx *W = W_.data(), *mid = mid_.data(), *next = next_.data();
-        double scale = 1.0;
+        double largest = 0.0;
         for (std::size_t i = 0; i < size_; ++i)
-            scale = std::max({scale, std::fabs(W[i].real()), std::fabs(W[i].imag())});
+            largest = std::max({largest, std::fabs(W[i].real()), std::fabs(W[i].imag())});
         // Start from the previous midpoint reflected through W_n (error
         // O(h^2), one iteration fewer than starting from W_n), except on the
         // first step of a run.
@@ -347,6 +332,8 @@ private:
             for (std::size_t i = 0; i < size_; ++i) mid[i] = 2.0 * W[i] - mid[i];
         // B Wt B = -f^2 P Wt P, symmetrised so Wt stays exactly Hermitian.
         const double quad = -0.25 * h * h * f_ * f_;
+        const std::size_t n = static_cast<std::size_t>(N);
+        const FixedPointTest test(settings_, largest, "isomp", s);
         bool converged = false;
         for (int k = 0; k < settings_.max_iterations && !converged; ++k) {
             form_.stream(mid, P_.data());
@@ -355,30 +342,21 @@ private:
             commutator(X_.data(), C_.data());
             ++iterations_;
             double change = 0.0;
-            for (int j = 0; j < N; ++j)
-                for (int i = 0; i < N; ++i) {
-                    const std::size_t e = i + static_cast<std::size_t>(j) * N;
-                    const cplx sym = 0.5 * (Y_[e] + std::conj(Y_[j + static_cast<std::size_t>(i) * N]));
+            for (std::size_t j = 0; j < n; ++j)
+                for (std::size_t i = 0; i < n; ++i) {
+                    const std::size_t e = i + j * n;
+                    const cplx sym = 0.5 * (Y_[e] + std::conj(Y_[j + i * n]));
                     next[e] = W[e] + 0.5 * h * C_[e] + quad * sym;
                     const double d = std::max(std::fabs(next[e].real() - mid[e].real()),
                                               std::fabs(next[e].imag() - mid[e].imag()));
-                    if (d > change || std::isnan(d)) change = d;  // a NaN, once seen, stays
+                    change = max_change(change, d);
                 }
-            if (!std::isfinite(change))
-                fail(LPI_ERR_NO_CONVERGENCE,
-                     "isomp: fixed-point iteration diverged at step " + std::to_string(s) +
-                         " (dt too large for the iteration); state rolled back");
-            converged = change <= settings_.tolerance * scale;
+            converged = test.converged(change);
             std::swap(mid_, next_);
             mid = mid_.data();
             next = next_.data();
         }
-        if (!converged)
-            fail(LPI_ERR_NO_CONVERGENCE,
-                 "isomp: fixed-point iteration did not converge in " +
-                     std::to_string(settings_.max_iterations) + " iterations at step " +
-                     std::to_string(s) + " (dt too large for the iteration, or raise the limit "
-                     "with lpi_set_implicit_options); state rolled back");
+        if (!converged) test.failed();
         // W_{n+1} = W_n + h [B(Wt), Wt] with the last iterate's commutator.
         for (std::size_t i = 0; i < size_; ++i) W[i] += h * C_[i];
     }
@@ -393,37 +371,79 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Integrator> make_sine_euler_matrix_integrator(const Method &method,
-                                                              const Model &model,
-                                                              const ImplicitSettings &implicit) {
+namespace {
+
+// The order N of the sine-Euler model, or LPI_ERR_UNSUPPORTED: these methods
+// integrate sine-Euler's matrix form and apply to no other system.
+int sine_euler_order(const Method &method, const Model &model) {
     const auto *sine_euler = dynamic_cast<const SineEulerModel *>(&model);
     if (!sine_euler)
         fail(LPI_ERR_UNSUPPORTED, "method '" + method.name + "' integrates the matrix form of "
                                   "sine-Euler and applies to sine-Euler systems only (this "
                                   "system is " + model.kind() + ")");
-    const int N = sine_euler->order();
-    if (method.kind == MethodKind::DirectEq5) {
-        if (N > kDirectEq5MaxN)
-            fail(LPI_ERR_UNSUPPORTED,
-                 "method 'direct-eq5' sums eq. 5 term by term (O(N^4) per evaluation) as a "
-                 "correctness reference and accepts N <= " + std::to_string(kDirectEq5MaxN) +
-                     " only, this system has N = " + std::to_string(N) +
-                     " (use rk4, rk4-matrix or a splitting method)");
-        return std::make_unique<DirectEq5>(N);
-    }
+    return sine_euler->order();
+}
+
+std::unique_ptr<Integrator> make_direct_eq5(const Method &method, const Model &model,
+                                            const ImplicitSettings &) {
+    const int N = sine_euler_order(method, model);
+    if (N > kDirectEq5MaxN)
+        fail(LPI_ERR_UNSUPPORTED,
+             "method 'direct-eq5' sums eq. 5 term by term (O(N^4) per evaluation) as a "
+             "correctness check and accepts N <= " + std::to_string(kDirectEq5MaxN) +
+                 " only, this system has N = " + std::to_string(N) +
+                 " (use rk4, rk4-matrix or a splitting method)");
+    return std::make_unique<DirectEq5>(N);
+}
+
 #if LPI_HAVE_FFTW && LPI_HAVE_LAPACK
-    if (method.kind == MethodKind::IsospectralMidpoint)
-        return std::make_unique<IsospectralMidpoint>(N, implicit);
-    if (method.kind == MethodKind::RungeKutta4Matrix) return std::make_unique<RungeKutta4Matrix>(N);
+std::unique_ptr<Integrator> make_isospectral_midpoint(const Method &method, const Model &model,
+                                                      const ImplicitSettings &implicit) {
+    return std::make_unique<IsospectralMidpoint>(sine_euler_order(method, model), implicit);
+}
+
+std::unique_ptr<Integrator> make_runge_kutta4_matrix(const Method &method, const Model &model,
+                                                     const ImplicitSettings &) {
+    return std::make_unique<RungeKutta4Matrix>(sine_euler_order(method, model));
+}
 #else
-    (void)implicit;
-    if (method.kind == MethodKind::IsospectralMidpoint ||
-        method.kind == MethodKind::RungeKutta4Matrix)
-        fail(LPI_ERR_UNSUPPORTED, "method '" + method.name + "' needs BLAS (zgemm, e.g. "
-                                  "OpenBLAS) and FFTW3; this build lacks " +
-                                  std::string(LPI_HAVE_LAPACK ? "FFTW3" : "BLAS/LAPACK"));
+// This build lacks what the matrix form needs: refused for every system.
+std::unique_ptr<Integrator> refuse_matrix_form(const Method &method, const Model &model,
+                                               const ImplicitSettings &) {
+    sine_euler_order(method, model);
+    fail(LPI_ERR_UNSUPPORTED, "method '" + method.name + "' needs BLAS (zgemm, e.g. "
+                              "OpenBLAS) and FFTW3; this build lacks " +
+                              std::string(LPI_HAVE_LAPACK ? "FFTW3" : "BLAS/LAPACK"));
+}
+const IntegratorFactory make_isospectral_midpoint = refuse_matrix_form;
+const IntegratorFactory make_runge_kutta4_matrix = refuse_matrix_form;
 #endif
-    fail(LPI_ERR_INTERNAL, "method '" + method.name + "' is not a sine-Euler matrix method");
+
+}  // namespace
+
+std::vector<Method> sine_euler_matrix_methods() {
+    // isomp is a Lie-Poisson integrator in exact arithmetic, but solved by
+    // fixed-point iteration it keeps the Casimirs only to the iteration's
+    // tolerance, not to round-off: a baseline here.
+    return {
+        baseline_method(
+            "isomp", 2,
+            "isospectral midpoint method on the matrix form of sine-Euler, fixed-point "
+            "iteration, BLAS-3 (K. Modin and M. Viviani, Found. Comput. Math. 20 (2020) 889; "
+            "M. Viviani, BIT Numer. Math. 60 (2020) 741); Casimirs kept to the iteration "
+            "tolerance; sine-Euler only",
+            make_isospectral_midpoint),
+        baseline_method(
+            "rk4-matrix", 4,
+            "classical Runge-Kutta on the matrix form dW/dt = (i/(2 eps)) [P, W] of sine-Euler "
+            "(V. Zeitlin, Physica D 49 (1991) 353), BLAS-3; not a Poisson map; sine-Euler only",
+            make_runge_kutta4_matrix),
+        baseline_method(
+            "direct-eq5", 4,
+            "classical Runge-Kutta on McLachlan 1993 eq. (5) summed term by term, O(N^4) per "
+            "evaluation: a correctness check; sine-Euler with N <= 31 only",
+            make_direct_eq5),
+    };
 }
 
 }  // namespace lpi

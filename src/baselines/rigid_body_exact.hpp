@@ -1,5 +1,5 @@
 // The exact solution of the free rigid body, dm/dt = m x (m / I), by Jacobi
-// elliptic functions: the reference against which the rigid-body methods are
+// elliptic functions: the exact solution against which the rigid-body methods are
 // measured. Handles both sides of the separatrix, the separatrix itself,
 // symmetric bodies and steady rotation about an axis.
 #pragma once

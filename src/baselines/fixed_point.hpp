@@ -1,0 +1,52 @@
+// The stopping test of the implicit baselines' fixed-point iterations
+// (implicit-midpoint, isomp), written once.
+#pragma once
+
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+
+#include "../core/integrator.hpp"
+
+namespace lpi {
+
+// The largest change of an iteration so far, updated by one more
+// component's change d: a NaN, once seen, stays.
+inline double max_change(double change, double d) {
+    return d > change || std::isnan(d) ? d : change;
+}
+
+// One step's test: the iteration has converged when its largest change is at
+// most tolerance * max(1, max|x|) (lpi_set_implicit_options), x the state
+// the step starts from. The bound is formed once per step; where the product
+// overflows, the true bound exceeds every double and DBL_MAX stands for it,
+// so that the test never compares against +inf.
+class FixedPointTest {
+public:
+    FixedPointTest(const ImplicitSettings &settings, double largest, const char *method,
+                   std::int64_t step)
+        : settings_(settings), method_(method), step_(step) {
+        const double bound = settings.tolerance * std::fmax(1.0, largest);
+        bound_ = std::isfinite(bound) ? bound : DBL_MAX;
+    }
+
+    // Whether an iteration whose largest change is `change` has converged;
+    // LPI_ERR_NO_CONVERGENCE when it diverged (a change that is not finite).
+    bool converged(double change) const {
+        if (!std::isfinite(change)) diverged();
+        return change <= bound_;
+    }
+
+    // LPI_ERR_NO_CONVERGENCE: no convergence in settings.max_iterations.
+    [[noreturn]] void failed() const;
+
+private:
+    [[noreturn]] void diverged() const;
+
+    const ImplicitSettings &settings_;
+    const char *method_;
+    std::int64_t step_;
+    double bound_;
+};
+
+}  // namespace lpi
