@@ -394,6 +394,24 @@ std::string read_data_array(const RunOptions &o, const std::string &name, Array 
     return read_hdf5(path, name, a, &found);
 }
 
+// The method of a resumed run given no --method: the checkpoint's, which the
+// library does not name; the interrupted run's data does.
+std::string earlier_method(const RunOptions &o) {
+    std::string method;
+    if (o.format == "h5") {
+        if (read_hdf5_text(data_path(o), "method", method).empty()) return method;
+    } else if (FILE *f = std::fopen((data_path(o) + "/attributes.json").c_str(), "r")) {
+        char text[4096] = "";
+        const std::size_t n = std::fread(text, 1, sizeof text - 1, f);
+        std::fclose(f);
+        text[n] = '\0';
+        const char *at = std::strstr(text, "\"method\": \"");
+        const char *end = at ? std::strchr(at + 11, '"') : nullptr;
+        if (end) return std::string(at + 11, end);
+    }
+    return "the checkpoint's method";
+}
+
 // The snapshots of the interrupted run up to `start`, from its data; a note
 // on stdout (not an error) when they cannot be read.
 void keep_snapshots(const RunOptions &o, int64_t start, RunData &d) {
@@ -567,7 +585,9 @@ int run_command(int argc, char **argv) {
     lpi_system *sys = h.get();
     if (!o.method.empty()) check_option(lpi_set_method(sys, o.method.c_str()), sys, "--method");
     if (o.threads != 1) check_option(lpi_set_threads(sys, o.threads), sys, "--threads");
-    const std::string method = !o.method.empty() ? o.method : o.resume.empty() ? "leapfrog" : "the checkpoint's method";
+    const std::string method = !o.method.empty()     ? o.method
+                               : o.resume.empty()    ? "leapfrog"
+                                                     : earlier_method(o);
 
     // Steps are counted from the start of the whole run, and the lpi_step
     // calls (one per row) end at the multiples of `every` and at the end: an
@@ -714,10 +734,12 @@ int run_command(int argc, char **argv) {
                 static_cast<long long>(start), static_cast<long long>(end), dt, method.c_str(),
                 static_cast<long long>(every));
     std::fflush(stdout);
+    // Caught before the first row: once it is written, a signal stops the run
+    // cleanly (before the first step, if it comes that early).
+    catch_interrupts();
     save(start, true);
     if (kept.empty()) row(start);
     if (o.resume.empty()) snapshot(0);
-    catch_interrupts();
     Progress progress(start, end);
     Watch watch;
     watch.progress = &progress;
