@@ -3,13 +3,14 @@
 #include <sys/stat.h>
 
 #include <algorithm>
-#include <cstdarg>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <map>
 #include <string>
 #include <vector>
+
+#include "plots.hpp"
 
 // OpenBLAS's own call, when OpenBLAS is the BLAS the library loaded (weak:
 // null otherwise, and no link dependency).
@@ -224,33 +225,6 @@ std::string method_label(const std::string &method) {
            (stages == 1 ? " stage)" : " stages)");
 }
 
-// A log axis over the whole decades around [lo, hi] (the positive finite
-// data), labelled 10^k at every decade, or every 2nd, 3rd ... when there are
-// many: each label once, none between decades.
-std::string decade_axis(const char *axis, double lo, double hi) {
-    if (!(lo > 0.0) || !(hi >= lo) || !std::isfinite(hi)) return "";
-    int first = static_cast<int>(std::floor(std::log10(lo) + 1e-9));
-    int last = static_cast<int>(std::ceil(std::log10(hi) - 1e-9));
-    if (last <= first) last = first + 1;
-    const int stride = (last - first + 7) / 8;
-    first = static_cast<int>(std::floor(static_cast<double>(first) / stride)) * stride;
-    last = static_cast<int>(std::ceil(static_cast<double>(last) / stride)) * stride;
-    char text[256];
-    std::snprintf(text, sizeof text,
-                  "set logscale %s 10\nset %srange [1e%d:1e%d]\nset %stics 1e%d, 1e%d, 1e%d\n"
-                  "set m%stics %d\nset format %s '10^{%%L}'\n",
-                  axis, axis, first, last, axis, first, stride, last, axis, stride == 1 ? 10 : stride, axis);
-    return text;
-}
-
-// The positive finite values' range, for decade_axis.
-struct Range {
-    double lo = INFINITY, hi = 0.0;
-    void add(double v) {
-        if (v > 0.0 && std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
-    }
-};
-
 // Starts a gnuplot script: CSV input, a grid, the key outside.
 FILE *open_plot_script(const std::string &path) {
     FILE *f = std::fopen(path.c_str(), "w");
@@ -258,29 +232,6 @@ FILE *open_plot_script(const std::string &path) {
         std::fprintf(f, "set datafile separator ','\nset grid xtics ytics mxtics mytics lw 0.5, lw 0.2\n"
                         "set key below center horizontal maxcols 3 samplen 3\nset xlabel offset 0,0.5\nset bmargin 12\nset tics out nomirror\nset border 3\n");
     return f;
-}
-
-// Writes a figure's commands twice: BASE.png, then BASE.svg beside it.
-void emit_figure(FILE *f, const std::string &base, int width, int height, const std::string &commands) {
-    std::fprintf(f, "set terminal pngcairo size %d,%d enhanced font ',11'\nset output '%s.png'\n%s",
-                 width, height, base.c_str(), commands.c_str());
-    std::fprintf(f, "set terminal svg size %d,%d enhanced font 'Helvetica,11' background '#ffffff'\n"
-                    "set output '%s.svg'\n%sset output\n",
-                 width, height, base.c_str(), commands.c_str());
-}
-
-std::string format(const char *pattern, ...) __attribute__((format(printf, 1, 2)));
-std::string format(const char *pattern, ...) {
-    va_list args, again;
-    va_start(args, pattern);
-    va_copy(again, args);
-    const int n = std::vsnprintf(nullptr, 0, pattern, args);
-    va_end(args);
-    std::string text(static_cast<std::size_t>(std::max(n, 0)) + 1, '\0');
-    std::vsnprintf(&text[0], text.size(), pattern, again);
-    va_end(again);
-    text.resize(static_cast<std::size_t>(std::max(n, 0)));
-    return text;
 }
 
 // Draws the work-precision and energy plots with gnuplot from the CSV files.
@@ -604,7 +555,8 @@ bool plot_long(const std::string &base, const LongRunScene &scene, const std::ve
         format("set multiplot layout 2,1 title '%s, %s: each method at its run nearest %.3g CPU seconds' "
                "noenhanced\nset logscale y\nunset logscale x\nset autoscale x\nset xtics autofreq\n"
                "set mxtics default\nset format x '%%g'\nset xlabel 'time'\nset key default\n"
-               "set key outside right top vertical samplen 3\nset lmargin 12\nset rmargin at screen 0.68\n",
+               "set key outside right top vertical samplen 3\nset lmargin 12\nset bmargin 3.5\n"
+               "set rmargin at screen 0.58\n",
                scene.name.c_str(), scene.setting.c_str(), history_cpu);
     for (const Panel &p : panels) {
         Range y;
