@@ -219,9 +219,11 @@ public:
         last_ = elapsed;
         const double f = static_cast<double>(done - first_) / static_cast<double>(total_);
         const int width = 40, filled = static_cast<int>(f * width);
-        const double left = f > 0 ? elapsed * (1.0 - f) / f : 0.0;
-        std::fprintf(stderr, "\r[%.*s%*s] %5.1f%%  %.0f s left   ", filled,
-                     "########################################", width - filled, "", 100.0 * f, left);
+        // The time left, once 1% is done: before that the rate is noise.
+        char left[32] = "";
+        if (f >= 0.01) std::snprintf(left, sizeof left, "%.0f s left", elapsed * (1.0 - f) / f);
+        std::fprintf(stderr, "\r[%.*s%*s] %5.1f%%  %-14s", filled, "########################################",
+                     width - filled, "", 100.0 * f, left);
         std::fflush(stderr);
     }
     void finish() {
