@@ -116,42 +116,75 @@ for every in 10 7; do
         { echo "--every $every: the resumed CSV differs:"; diff "$out/whole/pendulum.csv" "$out/parts/pendulum.csv"; exit 1; }
 done
 
-# Ctrl-C: SIGINT to a long run ends it with status 130, a complete last row
-# on the --every grid and a checkpoint from which the same command, resumed,
-# ends bit for bit where the uninterrupted run ends (a few rows further on,
-# at a step that is not a multiple of --every).
+# Ctrl-C: SIGINT stops a long run through the library's observer within a
+# few steps, even inside one long lpi_step call: status 130, a complete last
+# row at the step where it stopped, and the checkpoint of the last row on the
+# --every grid (the start of the interrupted call: resuming in the middle of a
+# call would split it, and its merged flows, in two). The same command,
+# resumed, ends bit for bit where the uninterrupted run ends (a few rows
+# further on, at a step that is not a multiple of --every): CSV and data.
 if [ "$have_sine_euler" = 1 ]; then
-    long="sine-euler --N 9 --snapshots 0"; csv=sine-euler.csv; per_row=1000
+    long="sine-euler --N 9 --snapshots 5"; scene=sine-euler; per_row=1000
 else
-    long="rigid-body"; csv=rigid-body.csv; per_row=100000
+    long="rigid-body --snapshots 5"; scene=rigid-body; per_row=100000
 fi
-for every in $per_row $((per_row * 7 / 9 + 1)); do
-    rm -rf "$out/int" "$out/ref" "$out/int.lpi"
-    "$lpi" run $long --dt 0.01 --steps 1000000000 --every $every --out "$out/int" \
-        --checkpoint "$out/int.lpi" >/dev/null &
+csv=$scene.csv
+interrupt() {  # interrupt EVERY FORMAT: runs, stops it, checks; sets stop, held
+    rm -rf "$out/int" "$out/int.lpi"
+    "$lpi" run $long --dt 0.01 --steps 1000000000 --every "$1" --format "$2" --out "$out/int" \
+        --checkpoint "$out/int.lpi" >"$out/int.out" &
     pid=$!
-    # Three rows: the handler is in place; then let it run a little.
-    while [ ! -f "$out/int/$csv" ] || [ "$(wc -l < "$out/int/$csv")" -lt 3 ]; do
+    # The first row is written once the handler is in place; then let it run.
+    while [ ! -f "$out/int/$csv" ] || [ "$(wc -l < "$out/int/$csv")" -lt 2 ]; do
         kill -0 $pid 2>/dev/null || { echo "the long run ended early"; exit 1; }
         sleep 0.05
     done
-    sleep 0.2
+    sleep 0.3
     kill -INT $pid
     waited=0
     while kill -0 $pid 2>/dev/null && [ $waited -lt 300 ]; do sleep 0.1; waited=$((waited + 1)); done
-    kill -0 $pid 2>/dev/null && { kill -KILL $pid; echo "SIGINT did not stop the run within 30 s"; exit 1; }
+    kill -0 $pid 2>/dev/null && { kill -KILL $pid; echo "SIGINT did not stop the run within 30 s (--every $1)"; exit 1; }
     rc=0; wait $pid || rc=$?
     [ "$rc" -eq 130 ] || { echo "SIGINT: exit status $rc, expected 130"; exit 1; }
     [ "$(tail -c 1 "$out/int/$csv" | od -An -c | tr -d ' ')" = '\n' ] || { echo "SIGINT: last row cut"; exit 1; }
     fields=$(head -n 1 "$out/int/$csv" | tr -cd , | wc -c)
     [ "$(tail -n 1 "$out/int/$csv" | tr -cd , | wc -c)" -eq "$fields" ] || { echo "SIGINT: last row incomplete"; exit 1; }
     stop=$(tail -n 1 "$out/int/$csv" | cut -d, -f1)
-    [ $((stop % every)) -eq 0 ] || { echo "SIGINT: stopped at step $stop, off the --every $every grid"; exit 1; }
-    end=$((stop + 2 * every + 5))
-    "$lpi" run $long --dt 0.01 --steps $end --every $every --out "$out/int" --checkpoint "$out/int.lpi" \
-        --resume "$out/int.lpi" >/dev/null
-    "$lpi" run $long --dt 0.01 --steps $end --every $every --out "$out/ref" >/dev/null
-    cmp -s "$out/ref/$csv" "$out/int/$csv" ||
-        { echo "interrupted at $stop (--every $every) and resumed: the CSV differs"; diff "$out/ref/$csv" "$out/int/$csv" | tail -4; exit 1; }
+    [ "$stop" -gt 0 ] || { echo "SIGINT: no step made before the stop"; exit 1; }
+    held=$(sed -n 's/.* holds step \([0-9]*\) .*/\1/p' "$out/int.out")
+    [ "$held" = $((stop - stop % $1)) ] ||
+        { echo "SIGINT at step $stop (--every $1): the checkpoint holds step '$held'"; cat "$out/int.out"; exit 1; }
+}
+same_data() {  # same_data FORMAT WHAT: the data of int/ and ref/ are the same bytes
+    if [ "$1" = h5 ]; then
+        cmp -s "$out/ref/$scene.h5" "$out/int/$scene.h5" || { echo "$2: the HDF5 data differs"; exit 1; }
+    else
+        diff -r "$out/ref/$scene" "$out/int/$scene" >/dev/null || { echo "$2: the .npy data differs"; exit 1; }
+    fi
+}
+formats=npy
+"$lpi" run rigid-body --steps 1 --format h5 --out "$out/probe" >/dev/null 2>&1 && formats="npy h5"
+for format in $formats; do
+    for every in $per_row $((per_row * 7 / 9 + 1)); do
+        interrupt $every $format
+        end=$((stop + 2 * every + 5))
+        rm -rf "$out/ref"
+        "$lpi" run $long --dt 0.01 --steps $end --every $every --format $format --out "$out/int" \
+            --checkpoint "$out/int.lpi" --resume "$out/int.lpi" >/dev/null
+        "$lpi" run $long --dt 0.01 --steps $end --every $every --format $format --out "$out/ref" >/dev/null
+        cmp -s "$out/ref/$csv" "$out/int/$csv" ||
+            { echo "interrupted at $stop (--every $every) and resumed: the CSV differs"; diff "$out/ref/$csv" "$out/int/$csv" | tail -4; exit 1; }
+        same_data $format "interrupted at $stop (--every $every) and resumed"
+    done
 done
+# One call of 10^9 steps (minutes): SIGINT still stops it at once, the
+# checkpoint is the run's start, and the resumed run is the uninterrupted one.
+interrupt 1000000000 npy
+[ "$held" -eq 0 ] || { echo "one long call: the checkpoint holds step $held, not 0"; exit 1; }
+rm -rf "$out/ref"
+"$lpi" run $long --dt 0.01 --steps $((stop + 3)) --every 1000000000 --format npy --out "$out/int" \
+    --resume "$out/int.lpi" >/dev/null
+"$lpi" run $long --dt 0.01 --steps $((stop + 3)) --every 1000000000 --format npy --out "$out/ref" >/dev/null
+cmp -s "$out/ref/$csv" "$out/int/$csv" || { echo "one long call, interrupted and resumed: the CSV differs"; exit 1; }
+same_data npy "one long call, interrupted and resumed"
 echo "lpi run: bad options refused, failures reported, SIGINT and --resume continue to the bit"

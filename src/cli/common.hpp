@@ -4,6 +4,7 @@
 
 #include <liepoisson.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -181,6 +182,30 @@ inline double energy_of(const lpi_system *sys) {
     double h = 0.0;
     check(lpi_energy(sys, &h), sys, "energy");
     return h;
+}
+
+// Drift of a sine-Euler spectrum: the largest change of an eigenvalue of W
+// relative to the largest |eigenvalue|. Relative to each eigenvalue itself,
+// an eigenvalue near zero would turn round-off into an arbitrarily large
+// "drift"; this measure is bounded by |dW| / |W| (Weyl), so it reads the same
+// for every field.
+inline double spectrum_drift(const std::vector<double> &spectrum, const std::vector<double> &spectrum0) {
+    double scale = 0.0, change = 0.0;
+    for (std::size_t i = 0; i < spectrum0.size(); ++i) {
+        scale = std::max(scale, std::fabs(spectrum0[i]));
+        change = std::max(change, std::fabs(spectrum[i] - spectrum0[i]));
+    }
+    return scale > 0.0 ? change / scale : change;
+}
+
+// Casimir drift: separate Casimirs (|m|^2; the moments' I and K) each
+// relative to itself, a spectrum as above.
+inline double casimir_drift(bool spectrum, const std::vector<double> &c, const std::vector<double> &c0) {
+    if (spectrum) return spectrum_drift(c, c0);
+    double drift = 0.0;
+    for (std::size_t i = 0; i < c.size(); ++i)
+        drift = std::max(drift, std::fabs(c[i] - c0[i]) / std::max(std::fabs(c0[i]), 1e-300));
+    return drift;
 }
 
 }  // namespace lpi_cli

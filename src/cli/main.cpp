@@ -48,7 +48,7 @@ void print_report_usage(FILE *to) {
                  "  time, energy error and Casimir drift against CPU time, one core, measured\n"
                  "  in this run), then the CPU time each method needs for a given error.\n"
                  "  --out DIR   write DIR/SCENE.csv, DIR/SCENE_energy.csv and, with gnuplot,\n"
-                 "              the PNG plots there (default ./lpi-report)\n"
+                 "              the plots there as PNG and SVG (default ./lpi-report)\n"
                  "  --N N       the sine-Euler scenes' N (odd >= 3, default 31)\n"
                  "  --T T       the sine-euler-long scene's final time (default 2000)\n");
     print_scenes(to);
@@ -90,7 +90,7 @@ int report_command(int argc, char **argv) {
     std::printf("liepoisson %s: error against CPU time, one core, measured in this run\n",
                 lpi_version_string());
     for (const Scene *s : chosen) run_report(*s, options);
-    std::printf("\nCSV and PNG files are in %s/\n", options.out_dir.c_str());
+    std::printf("\nCSV, PNG and SVG files are in %s/\n", options.out_dir.c_str());
     return 0;
 }
 

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "plots.hpp"
+
 // OpenBLAS's own call, when OpenBLAS is the BLAS the library loaded (weak:
 // null otherwise, and no link dependency).
 extern "C" void openblas_set_num_threads(int) __attribute__((weak));
@@ -43,6 +45,12 @@ struct Sample {
     double time, energy_error, casimir_drift;
 };
 
+// One method's energy history: its step and the samples.
+struct History {
+    double dt = 0.0;
+    std::vector<Sample> samples;
+};
+
 double distance(const std::vector<double> &a, const std::vector<double> &b) {
     double s = 0.0;
     for (std::size_t i = 0; i < a.size(); ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
@@ -62,40 +70,37 @@ std::vector<double> reference_state(const Scene &scene) {
     return state_of(h.get());
 }
 
-// Drift of a sine-Euler spectrum: the largest change of an eigenvalue of W
-// relative to the largest |eigenvalue|. Relative to each eigenvalue itself,
-// an eigenvalue near zero would turn round-off into an arbitrarily large
-// "drift"; this measure is bounded by |dW| / |W| (Weyl), so it reads the same
-// for every field.
-double spectrum_drift(const std::vector<double> &spectrum, const std::vector<double> &spectrum0) {
-    double scale = 0.0, change = 0.0;
-    for (std::size_t i = 0; i < spectrum0.size(); ++i) {
-        scale = std::max(scale, std::fabs(spectrum0[i]));
-        change = std::max(change, std::fabs(spectrum[i] - spectrum0[i]));
-    }
-    return scale > 0.0 ? change / scale : change;
-}
-
-// Casimir drift: separate Casimirs (|m|^2; the moments' I and K) each
-// relative to itself, a spectrum as above.
-double casimir_drift(bool spectrum, const std::vector<double> &c, const std::vector<double> &c0) {
-    if (spectrum) return spectrum_drift(c, c0);
-    double drift = 0.0;
-    for (std::size_t i = 0; i < c.size(); ++i)
-        drift = std::max(drift, std::fabs(c[i] - c0[i]) / std::max(std::fabs(c0[i]), 1e-300));
-    return drift;
-}
-
 bool is_sine_euler(const lpi_system *sys) {
     int32_t N = 0;
     return lpi_sine_euler_size(sys, &N) == LPI_OK;
 }
 
+// A run of `steps` steps of dt sampled at most `samples` times, equally
+// spaced in steps: the energy error and Casimir drift at each sample (up to
+// a failed step, if one fails).
+std::vector<Sample> diagnose(const Scene &scene, const char *method, double dt, int64_t steps, int samples) {
+    Handle h = scene.create();
+    check(lpi_set_method(h.get(), method), h.get(), "set method");
+    const double h0 = energy_of(h.get());
+    const std::vector<double> c0 = casimirs_of(h.get());
+    const bool spectrum = is_sine_euler(h.get());
+    const int64_t count = std::min<int64_t>(steps, samples);
+    std::vector<Sample> out;
+    int64_t done = 0;
+    for (int64_t k = 1; k <= count; ++k) {
+        const int64_t target = steps * k / count;
+        if (lpi_step(h.get(), dt, target - done) != LPI_OK) break;
+        done = target;
+        out.push_back({lpi_time(h.get()), std::fabs((energy_of(h.get()) - h0) / h0),
+                       casimir_drift(spectrum, casimirs_of(h.get()), c0)});
+    }
+    return out;
+}
+
 // One (method, dt) cell: a timed pass (one lpi_step call, repeated until the
 // clock resolves it), then a diagnostic pass sampling energy and Casimirs.
 Row measure(const Scene &scene, const char *method, int order, double dt,
-            const std::vector<double> &reference, const ReportOptions &options,
-            std::vector<Sample> *history) {
+            const std::vector<double> &reference, const ReportOptions &options) {
     Row row;
     row.method = method;
     row.order = order;
@@ -121,23 +126,10 @@ Row measure(const Scene &scene, const char *method, int order, double dt,
     } while (elapsed < options.min_timing_seconds);
     row.cpu = elapsed / repeats;
     row.error = distance(end, reference);
-
-    Handle h = scene.create();
-    check(lpi_set_method(h.get(), method), h.get(), "set method");
-    const double h0 = energy_of(h.get());
-    const std::vector<double> c0 = casimirs_of(h.get());
-    const bool spectrum = is_sine_euler(h.get());
-    const int64_t samples = std::min<int64_t>(row.steps, options.samples);
-    int64_t done = 0;
-    for (int64_t k = 1; k <= samples; ++k) {
-        const int64_t target = row.steps * k / samples;
-        if (lpi_step(h.get(), row.dt, target - done) != LPI_OK) break;
-        done = target;
-        const double de = std::fabs((energy_of(h.get()) - h0) / h0);
-        const double dc = casimir_drift(spectrum, casimirs_of(h.get()), c0);
-        row.energy_error = std::max(row.energy_error, de);
-        row.casimir_drift = std::max(row.casimir_drift, dc);
-        if (history) history->push_back({lpi_time(h.get()), de, dc});
+    const std::vector<Sample> samples = diagnose(scene, method, row.dt, row.steps, options.samples);
+    for (const Sample &s : samples) {
+        row.energy_error = std::max(row.energy_error, s.energy_error);
+        row.casimir_drift = std::max(row.casimir_drift, s.casimir_drift);
     }
     return row;
 }
@@ -178,14 +170,13 @@ void write_csv(const std::string &path, const std::vector<Row> &rows, const Scen
     std::fclose(f);
 }
 
-void write_history(const std::string &path, const std::map<std::string, std::vector<Sample>> &histories,
-                   double dt) {
+void write_history(const std::string &path, const std::map<std::string, History> &histories) {
     FILE *f = std::fopen(path.c_str(), "w");
     if (!f) return;
     std::fprintf(f, "method,dt,time,energy_error,casimir_drift\n");
-    for (const auto &[method, samples] : histories)
-        for (const Sample &s : samples)
-            std::fprintf(f, "%s,%.17g,%.10g,%.6e,%.6e\n", method.c_str(), dt, s.time,
+    for (const auto &[method, history] : histories)
+        for (const Sample &s : history.samples)
+            std::fprintf(f, "%s,%.17g,%.10g,%.6e,%.6e\n", method.c_str(), history.dt, s.time,
                          s.energy_error, s.casimir_drift);
     std::fclose(f);
 }
@@ -201,62 +192,92 @@ bool is_poisson(const std::string &method) { return lpi_method_is_poisson(method
 
 bool have_gnuplot() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
 
-// The i-th method's colour in a plot: ten that read apart on white (no yellow).
+// The i-th method's colour in a plot: twenty that read apart on white
+// (Okabe and Ito's, then Kelly's colours of maximum contrast).
 std::string plot_colour(std::size_t i) {
     static const char *const colours[] = {"#0072b2", "#d55e00", "#009e73", "#cc79a7", "#56b4e9",
-                                          "#e69f00", "#000000", "#8c564b", "#7f7f7f", "#bcbd22"};
-    return std::string("rgb '") + colours[i % 10] + "'";
+                                          "#e69f00", "#000000", "#875692", "#be0032", "#848482",
+                                          "#8db600", "#654522", "#604e97", "#f99379", "#2b3d26",
+                                          "#a1caf1", "#b3446c", "#c2b280", "#882d17", "#dcd300"};
+    return std::string("rgb '") + colours[i % 20] + "'";
 }
 
-// The i-th method of a plot: its own colour and point shape (filled shapes
-// first); the baselines (not Poisson maps) dashed, so the two families read
-// apart at a glance.
+// The i-th method's marker: gnuplot's fifteen shapes (filled ones first),
+// then five glyphs; twenty in all, as many as the colours.
+std::string plot_marker(std::size_t i) {
+    static const char *const markers[] = {"7", "5", "9", "11", "13", "15", "6", "4", "8", "10",
+                                          "12", "14", "1", "2", "3", "'★'", "'♣'", "'♠'", "'♥'", "'#'"};
+    return std::string("pt ") + markers[i % 20];
+}
+
+// The i-th method of a plot: its own colour and marker; the baselines (not
+// Poisson maps) dashed, so the two families read apart at a glance.
 std::string plot_style(std::size_t i, const std::string &method) {
-    static const int shapes[] = {7, 5, 9, 11, 13, 6, 4, 8, 10, 12, 1, 2, 3};
-    char text[96];
-    std::snprintf(text, sizeof text, "lc %s pt %d dt %d", plot_colour(i).c_str(), shapes[i % 13],
-                  is_poisson(method) ? 1 : 2);
-    return text;
+    return "lc " + plot_colour(i) + " " + plot_marker(i) + " dt " + (is_poisson(method) ? "1" : "2");
 }
 
-// Starts a gnuplot script: CSV input, PNG output, log-log axes labelled at
-// the decades, a grid and the key outside.
+// A method's legend entry: its order and stages (a step's cost in leapfrog
+// steps), which is what tells the curves apart.
+std::string method_label(const std::string &method) {
+    const int i = method_index(method);
+    const int stages = lpi_method_stages(i);
+    return method + " (order " + std::to_string(lpi_method_order(i)) + ", " + std::to_string(stages) +
+           (stages == 1 ? " stage)" : " stages)");
+}
+
+// Starts a gnuplot script: CSV input, a grid, the key outside.
 FILE *open_plot_script(const std::string &path) {
     FILE *f = std::fopen(path.c_str(), "w");
     if (f)
-        std::fprintf(f, "set datafile separator ','\nset terminal pngcairo size 1000,700 enhanced\n"
-                        "set logscale xy\nset grid xtics ytics mxtics mytics lw 0.5, lw 0.2\n"
-                        "set key outside right\nset format y '10^{%%L}'\nset format x '10^{%%L}'\n");
+        std::fprintf(f, "set datafile separator ','\nset grid xtics ytics mxtics mytics lw 0.5, lw 0.2\n"
+                        "set key below center horizontal maxcols 3 samplen 3\nset xlabel offset 0,0.5\nset bmargin 12\nset tics out nomirror\nset border 3\n");
     return f;
 }
 
 // Draws the work-precision and energy plots with gnuplot from the CSV files.
-bool plot(const std::string &dir, const Scene &scene, const std::vector<std::string> &methods) {
+bool plot(const std::string &dir, const Scene &scene, const std::vector<std::string> &methods,
+          const std::vector<Row> &rows, const std::map<std::string, History> &histories) {
     const std::string script = dir + "/" + scene.name + ".gp";
     FILE *f = open_plot_script(script);
     if (!f) return false;
     const std::string base = dir + "/" + scene.name;
-    std::fprintf(f,
-                 "set output '%s_work_precision.png'\n"
-                 "set title '%s: error at T = %g against CPU time'\n"
-                 "set xlabel 'CPU seconds'\nset ylabel 'error |x(T) - x_{ref}(T)|'\nplot ",
-                 base.c_str(), scene.name.c_str(), scene.final_time);
+    Range cpu, error, energy;
+    for (const Row &r : rows)
+        if (r.status == LPI_OK) cpu.add(r.cpu), error.add(r.error);
+    for (const auto &entry : histories)
+        for (const Sample &s : entry.second.samples) energy.add(s.energy_error);
+    std::string commands = format("set title '%s: error at T = %g against CPU time' noenhanced\n"
+                                  "set xlabel 'CPU seconds'\nset ylabel 'error |x(T) - x_{ref}(T)|'\n",
+                                  scene.name.c_str(), scene.final_time) +
+                           decade_axis("x", cpu.lo, cpu.hi) + decade_axis("y", error.lo, error.hi) + "plot ";
     for (std::size_t i = 0; i < methods.size(); ++i)
-        std::fprintf(f, "%s'%s.csv' using (strcol(2) eq '%s' && strcol(10) eq 'LPI_OK' ? $6 : 1/0):7 "
-                        "with linespoints %s title '%s'",
-                     i ? ", " : "", base.c_str(), methods[i].c_str(),
-                     plot_style(i, methods[i]).c_str(), methods[i].c_str());
-    std::fprintf(f,
-                 "\nset output '%s_energy.png'\nset title '%s: relative energy error against time'\n"
-                 "unset logscale x\nset format x '%%g'\nset xlabel 'time'\n"
-                 "set ylabel '|H(t) - H(0)| / |H(0)|'\nplot ",
-                 base.c_str(), scene.name.c_str());
-    for (std::size_t i = 0; i < methods.size(); ++i)
-        std::fprintf(f, "%s'%s_energy.csv' using (strcol(1) eq '%s' ? $3 : 1/0):($4 > 0 ? $4 : 1/0) "
-                        "with lines lc %s dt %d title '%s'",
-                     i ? ", " : "", base.c_str(), methods[i].c_str(), plot_colour(i).c_str(),
-                     is_poisson(methods[i]) ? 1 : 2, methods[i].c_str());
-    std::fprintf(f, "\n");
+        commands += format("%s'%s.csv' using (strcol(2) eq '%s' && strcol(10) eq 'LPI_OK' ? $6 : 1/0):7 "
+                           "with linespoints %s lw 1.5 ps 1.2 title '%s' noenhanced",
+                           i ? ", " : "", base.c_str(), methods[i].c_str(), plot_style(i, methods[i]).c_str(),
+                           method_label(methods[i]).c_str());
+    emit_figure(f, base + "_work_precision", 1000, 820, commands + "\n");
+
+    const double history_dt = histories.empty() ? 0.0 : histories.begin()->second.dt;
+    commands = format("set title '%s: relative energy error against time, every method at dt = %g' noenhanced\n"
+                      "unset logscale x\nset xrange [0:%g]\nset xtics autofreq\nset mxtics default\n"
+                      "set format x '%%g'\nset xlabel 'time'\nset ylabel '|H(t) - H(0)| / |H(0)|'\n",
+                      scene.name.c_str(), history_dt, scene.final_time) +
+               decade_axis("y", energy.lo, energy.hi) + "plot ";
+    for (std::size_t i = 0; i < methods.size(); ++i) {
+        // Markers on every few samples only, each method's at its own offset.
+        const auto h = histories.find(methods[i]);
+        const std::size_t n = h == histories.end() ? 0 : h->second.samples.size();
+        const std::size_t interval = std::max<std::size_t>(1, n / 8);
+        commands += format("%s'%s_energy.csv' using (strcol(1) eq '%s' && (int($0) + %zu) %% %zu == 0 ? $3 : 1/0):"
+                           "($4 > 0 ? $4 : 1/0) with points %s ps 1.1 notitle, "
+                           "'' using (strcol(1) eq '%s' ? $3 : 1/0):($4 > 0 ? $4 : 1/0) with lines lc %s dt %d "
+                           "lw 1.2 notitle, 1/0 with linespoints %s ps 1.1 lw 1.2 title '%s' noenhanced",
+                           i ? ", " : "", base.c_str(), methods[i].c_str(), i * interval / methods.size(), interval,
+                           plot_style(i, methods[i]).c_str(), methods[i].c_str(), plot_colour(i).c_str(),
+                           is_poisson(methods[i]) ? 1 : 2, plot_style(i, methods[i]).c_str(),
+                           method_label(methods[i]).c_str());
+    }
+    emit_figure(f, base + "_energy", 1000, 820, commands + "\n");
     std::fclose(f);
     return std::system(("gnuplot '" + script + "' 2>/dev/null").c_str()) == 0;
 }
@@ -289,8 +310,12 @@ void run_report(const Scene &scene, const ReportOptions &options) {
 
     std::vector<Row> rows;
     std::vector<std::string> methods;
-    std::map<std::string, std::vector<Sample>> histories;
+    std::map<std::string, History> histories;
+    // Every method's energy history at one step size, sampled as densely as
+    // the others (at its stretched step a 35-stage method makes 3 steps to
+    // T = 10): the legend gives the stages, a step's cost.
     const double history_dt = scene.steps[scene.steps.size() / 2];
+    const int64_t history_steps = std::max<int64_t>(1, std::llround(scene.final_time / history_dt));
     const std::vector<bool> accepted = accepted_methods(scene.create);
     for (int i = 0; i < lpi_method_count(); ++i) {
         const char *method = lpi_method_name(i);
@@ -309,14 +334,16 @@ void run_report(const Scene &scene, const ReportOptions &options) {
             const int64_t steps = std::max<int64_t>(1, std::llround(scene.final_time / dt));
             if (steps == previous_steps) continue;
             previous_steps = steps;
-            std::vector<Sample> *history = base_dt == history_dt ? &histories[method] : nullptr;
-            const Row r = measure(scene, method, lpi_method_order(i), dt, reference, options, history);
+            const Row r = measure(scene, method, lpi_method_order(i), dt, reference, options);
             rows.push_back(r);
             std::printf("%-24s %9.4g %9lld %11.3e %11.3e %11.3e %11.3e %10.1f  %s\n", r.method.c_str(),
                         r.dt, static_cast<long long>(r.steps), r.cpu, r.error, r.energy_error,
                         r.casimir_drift, 1e9 * r.cpu / static_cast<double>(r.steps),
                         r.status == LPI_OK ? "" : lpi_status_name(r.status));
         }
+        History &history = histories[method];
+        history.dt = scene.final_time / static_cast<double>(history_steps);
+        history.samples = diagnose(scene, method, history.dt, history_steps, options.samples);
     }
 
     std::printf("\n   CPU seconds to reach a final error (interpolated along each sweep;\n   < = reached at the largest step already, an upper bound; - = not reached):\n");
@@ -371,13 +398,13 @@ void run_report(const Scene &scene, const ReportOptions &options) {
 
     const std::string base = options.out_dir + "/" + scene.name;
     write_csv(base + ".csv", rows, scene);
-    write_history(base + "_energy.csv", histories, history_dt);
-    std::printf("   wrote %s.csv and %s_energy.csv (energy history at dt = %g)\n", base.c_str(),
-                base.c_str(), history_dt);
+    write_history(base + "_energy.csv", histories);
+    std::printf("   wrote %s.csv and %s_energy.csv (energy history of every method at dt = %g)\n", base.c_str(),
+                base.c_str(), scene.final_time / static_cast<double>(history_steps));
     if (!have_gnuplot())
         std::printf("   gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n");
-    else if (plot(options.out_dir, scene, methods))
-        std::printf("   wrote %s_work_precision.png and %s_energy.png\n", base.c_str(), base.c_str());
+    else if (plot(options.out_dir, scene, methods, rows, histories))
+        std::printf("   wrote %s_work_precision.png and %s_energy.png, each with .svg\n", base.c_str(), base.c_str());
     else
         std::printf("   gnuplot failed: see %s.gp\n", base.c_str());
 }
@@ -482,52 +509,81 @@ bool plot_long(const std::string &base, const LongRunScene &scene, const std::ve
     struct Panel {
         const char *file, *title, *label;
         int column;  // in SCENE.csv
+        double LongRow::*maximum;
+        double Sample::*sample;
+        int history_column;  // in SCENE_history.csv
     };
-    const Panel panels[] = {{"energy", "energy error", energy_label, 9},
-                            {"casimirs", "Casimir drift (spectrum of W)", casimir_label, 10}};
-    std::fprintf(f, "set key below\nset xlabel 'CPU seconds (the steps only)'\n");
+    const Panel panels[] = {
+        {"energy", "energy error", energy_label, 9, &LongRow::energy_error, &Sample::energy_error, 5},
+        {"casimirs", "Casimir drift (spectrum of W)", casimir_label, 10, &LongRow::casimir_drift,
+         &Sample::casimir_drift, 6}};
+    Range cpu;
+    for (const LongRow &r : rows)
+        if (r.status == LPI_OK) cpu.add(r.cpu);
     for (const Panel &p : panels) {
-        std::fprintf(f, "set output '%s_%s.png'\nset title '%s, %s: maximum %s over the run' noenhanced\n"
-                        "set ylabel 'max_{t <= T} %s'\nplot ",
-                     base.c_str(), p.file, scene.name.c_str(), scene.setting.c_str(), p.title, p.label);
+        Range y;
+        for (const LongRow &r : rows)
+            if (r.status == LPI_OK) y.add(r.*p.maximum);
+        std::string commands =
+            format("set xlabel 'CPU seconds (the steps only)'\n"
+                   "set title '%s, %s: maximum %s over the run' noenhanced\nset ylabel 'max_{t <= T} %s'\n",
+                   scene.name.c_str(), scene.setting.c_str(), p.title, p.label) +
+            decade_axis("x", cpu.lo, cpu.hi) + decade_axis("y", y.lo, y.hi) + "plot ";
         for (std::size_t i = 0; i < methods.size(); ++i) {
             std::vector<double> steps;
             for (const LongRow &r : rows)
                 if (r.method == methods[i] && r.status == LPI_OK) steps.push_back(r.dt);
-            std::fprintf(f, "%s'%s.csv' using (strcol(3) eq '%s' && strcol(13) eq 'LPI_OK' ? $8 : 1/0):"
-                            "($%d > 0 ? $%d : 1/0) with linespoints %s lw 1.5 ps 1.5 title '%s, dt = %s' noenhanced",
-                         i ? ", " : "", base.c_str(), methods[i].c_str(), p.column, p.column,
-                         plot_style(i, methods[i]).c_str(), methods[i].c_str(), format_steps(steps).c_str());
+            commands += format("%s'%s.csv' using (strcol(3) eq '%s' && strcol(13) eq 'LPI_OK' ? $8 : 1/0):"
+                               "($%d > 0 ? $%d : 1/0) with linespoints %s lw 1.5 ps 1.5 title '%s, dt = %s' "
+                               "noenhanced",
+                               i ? ", " : "", base.c_str(), methods[i].c_str(), p.column, p.column,
+                               plot_style(i, methods[i]).c_str(), method_label(methods[i]).c_str(),
+                               format_steps(steps).c_str());
         }
-        std::fprintf(f, "\n");
+        emit_figure(f, base + "_" + p.file, 1000, 820, commands + "\n");
     }
-    // Against time: one panel per measure, the key once, on the right.
-    std::fprintf(f, "set terminal pngcairo size 1000,900 enhanced\nset output '%s_history.png'\n"
-                    "set multiplot layout 2,1 title '%s, %s: each method at its run nearest %.3g CPU seconds' noenhanced\n"
-                    "unset logscale x\nset format x '%%g'\nset xlabel 'time'\n"
-                    "set key default\nset key outside right top vertical\n"
-                    "set lmargin 12\nset rmargin at screen 0.72\n",
-                 base.c_str(), scene.name.c_str(), scene.setting.c_str(), history_cpu);
-    const Panel *history_panels[] = {&panels[0], &panels[1]};
-    for (const Panel *p : history_panels) {
-        std::fprintf(f, "set title '%s' noenhanced\nset ylabel '%s'\nplot ", p->title, p->label);
+    // Against time: one panel per measure, the key once, on the right; each
+    // method's run nearest the given CPU time.
+    std::vector<const LongRow *> nearest(methods.size(), nullptr);
+    for (std::size_t i = 0; i < methods.size(); ++i)
+        for (const LongRow &r : rows)
+            if (r.method == methods[i] && r.status == LPI_OK &&
+                (!nearest[i] || std::fabs(std::log(r.cpu / history_cpu)) <
+                                    std::fabs(std::log(nearest[i]->cpu / history_cpu))))
+                nearest[i] = &r;
+    std::string commands =
+        format("set multiplot layout 2,1 title '%s, %s: each method at its run nearest %.3g CPU seconds' "
+               "noenhanced\nset logscale y\nunset logscale x\nset autoscale x\nset xtics autofreq\n"
+               "set mxtics default\nset format x '%%g'\nset xlabel 'time'\nset key default\n"
+               "set key outside right top vertical samplen 3\nset lmargin 12\nset bmargin 3.5\n"
+               "set rmargin at screen 0.58\n",
+               scene.name.c_str(), scene.setting.c_str(), history_cpu);
+    for (const Panel &p : panels) {
+        Range y;
+        for (const LongRow *r : nearest)
+            if (r)
+                for (const Sample &s : r->history) y.add(s.*p.sample);
+        commands += format("set title '%s' noenhanced\nset ylabel '%s'\n", p.title, p.label) +
+                    decade_axis("y", y.lo, y.hi) + "plot ";
+        bool first = true;
         for (std::size_t i = 0; i < methods.size(); ++i) {
-            const LongRow *nearest = nullptr;
-            for (const LongRow &r : rows)
-                if (r.method == methods[i] && r.status == LPI_OK &&
-                    (!nearest || std::fabs(std::log(r.cpu / history_cpu)) <
-                                     std::fabs(std::log(nearest->cpu / history_cpu))))
-                    nearest = &r;
-            if (!nearest) continue;
-            const int column = p == &panels[0] ? 5 : 6;  // in SCENE_history.csv
-            std::fprintf(f, "%s'%s_history.csv' using ($1 == %d ? $4 : 1/0):($%d > 0 ? $%d : 1/0) "
-                            "with lines lc %s dt %d lw 1.5 title '%s, dt = %g' noenhanced",
-                         i ? ", " : "", base.c_str(), nearest->run, column, column, plot_colour(i).c_str(),
-                         is_poisson(methods[i]) ? 1 : 2, methods[i].c_str(), nearest->dt);
+            if (!nearest[i]) continue;
+            const int c = p.history_column;
+            const std::size_t interval = std::max<std::size_t>(1, nearest[i]->history.size() / 8);
+            commands += format("%s'%s_history.csv' using ($1 == %d && (int($0) + %zu) %% %zu == 0 ? $4 : 1/0):"
+                               "($%d > 0 ? $%d : 1/0) with points %s ps 1.1 notitle, "
+                               "'' using ($1 == %d ? $4 : 1/0):($%d > 0 ? $%d : 1/0) with lines lc %s dt %d "
+                               "lw 1.5 notitle, 1/0 with linespoints %s ps 1.1 lw 1.5 title '%s, dt = %g' noenhanced",
+                               first ? "" : ", ", base.c_str(), nearest[i]->run, i * interval / methods.size(),
+                               interval, c, c, plot_style(i, methods[i]).c_str(), nearest[i]->run, c, c,
+                               plot_colour(i).c_str(), is_poisson(methods[i]) ? 1 : 2,
+                               plot_style(i, methods[i]).c_str(), method_label(methods[i]).c_str(),
+                               nearest[i]->dt);
+            first = false;
         }
-        std::fprintf(f, "\nunset key\n");
+        commands += "\nunset key\n";
     }
-    std::fprintf(f, "unset multiplot\n");
+    emit_figure(f, base + "_history", 1000, 900, commands + "unset multiplot\n");
     std::fclose(f);
     return std::system(("gnuplot '" + base + ".gp' 2>/dev/null").c_str()) == 0;
 }

@@ -1,0 +1,422 @@
+#include "data_files.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+
+#if LPI_CLI_HAVE_HDF5
+#include <hdf5.h>
+#include <hdf5_hl.h>
+#endif
+
+namespace lpi_cli {
+
+namespace {
+
+// The most values lpi reads from one file (2 GiB of doubles): a bound on
+// what a corrupt or hostile header can make it allocate.
+const std::size_t kMaxValues = std::size_t(1) << 28;
+
+std::size_t element_count(const std::vector<std::size_t> &shape, bool *too_many) {
+    std::size_t count = 1;
+    *too_many = false;
+    for (std::size_t n : shape) {
+        if (n != 0 && count > kMaxValues / n) *too_many = true;
+        count = *too_many ? 0 : count * n;
+    }
+    return count;
+}
+
+// A temporary file beside `path` (same directory, so rename is atomic).
+struct TemporaryFile {
+    std::string name;
+    int fd = -1;
+    explicit TemporaryFile(const std::string &path) : name(path + ".tmp-XXXXXX") {
+        fd = mkstemp(&name[0]);
+    }
+    ~TemporaryFile() {
+        if (fd >= 0) close(fd);
+        if (!name.empty()) unlink(name.c_str());
+    }
+    // fsync, close and rename onto `path`; "" or the reason.
+    std::string commit(const std::string &path) {
+        std::string why;
+        if (fsync(fd) != 0) why = std::strerror(errno);
+        if (close(fd) != 0 && why.empty()) why = std::strerror(errno);
+        fd = -1;
+        if (why.empty() && std::rename(name.c_str(), path.c_str()) != 0) why = std::strerror(errno);
+        if (why.empty()) name.clear();  // renamed: nothing left to remove
+        return why;
+    }
+};
+
+bool write_all(int fd, const void *data, std::size_t size) {
+    const char *p = static_cast<const char *>(data);
+    while (size > 0) {
+        const ssize_t n = write(fd, p, size);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) return false;
+        p += n;
+        size -= static_cast<std::size_t>(n);
+    }
+    return true;
+}
+
+// Little-endian bytes, whatever the host's order.
+void put_le(std::uint64_t v, unsigned char *out) {
+    for (int i = 0; i < 8; ++i) out[i] = static_cast<unsigned char>(v >> (8 * i));
+}
+std::uint64_t get_le(const unsigned char *in, int bytes) {
+    std::uint64_t v = 0;
+    for (int i = 0; i < bytes; ++i) v |= static_cast<std::uint64_t>(in[i]) << (8 * i);
+    return v;
+}
+
+// The value of 'key' in a .npy header dictionary: the text after "'key':",
+// up to the next top-level comma (a shape tuple is kept whole).
+std::string header_value(const std::string &header, const std::string &key) {
+    const std::size_t at = header.find("'" + key + "'");
+    if (at == std::string::npos) return "";
+    std::size_t i = header.find(':', at);
+    if (i == std::string::npos) return "";
+    ++i;
+    while (i < header.size() && header[i] == ' ') ++i;
+    int depth = 0;
+    std::string value;
+    for (; i < header.size(); ++i) {
+        const char c = header[i];
+        if (c == '(') ++depth;
+        if (c == ')') --depth;
+        if ((c == ',' || c == '}') && depth == 0) break;
+        value += c;
+    }
+    while (!value.empty() && value.back() == ' ') value.pop_back();
+    return value;
+}
+
+bool parse_shape(const std::string &text, std::vector<std::size_t> &shape) {
+    if (text.size() < 2 || text.front() != '(' || text.back() != ')') return false;
+    shape.clear();
+    const char *p = text.c_str() + 1;
+    for (;;) {
+        while (*p == ' ' || *p == ',') ++p;
+        if (*p == ')') return true;
+        if (*p < '0' || *p > '9') return false;
+        char *end = nullptr;
+        errno = 0;
+        const unsigned long long n = std::strtoull(p, &end, 10);
+        if (errno == ERANGE || n > kMaxValues) return false;
+        shape.push_back(static_cast<std::size_t>(n));
+        p = end;
+    }
+}
+
+}  // namespace
+
+std::string npy_header(const Array &a) {
+    std::string dict = std::string("{'descr': '") + (a.integer ? "<i8" : "<f8") +
+                       "', 'fortran_order': False, 'shape': (";
+    for (std::size_t n : a.shape) dict += std::to_string(n) + (a.shape.size() == 1 ? ",)" : ", ");
+    if (a.shape.size() != 1) {
+        if (!a.shape.empty()) dict.resize(dict.size() - 2);
+        dict += ")";
+    }
+    dict += ", }";
+    // magic (6) + version (2) + length (2) + dictionary + padding + '\n'
+    std::size_t total = 10 + dict.size() + 1;
+    total = (total + 63) / 64 * 64;
+    dict.append(total - 10 - 1 - dict.size(), ' ');
+    dict += '\n';
+    const std::size_t length = dict.size();
+    std::string header("\x93NUMPY\x01\x00", 8);
+    header += static_cast<char>(length & 0xff);
+    header += static_cast<char>(length >> 8);
+    return header + dict;
+}
+
+std::string write_npy(const std::string &path, const Array &a) {
+    TemporaryFile tmp(path);
+    if (tmp.fd < 0) return std::string("cannot create a file beside it: ") + std::strerror(errno);
+    const std::string header = npy_header(a);
+    std::vector<unsigned char> data(8 * a.values.size());
+    for (std::size_t i = 0; i < a.values.size(); ++i) {
+        std::uint64_t bits;
+        if (a.integer) {
+            bits = static_cast<std::uint64_t>(static_cast<std::int64_t>(a.values[i]));
+        } else {
+            std::memcpy(&bits, &a.values[i], 8);
+        }
+        put_le(bits, &data[8 * i]);
+    }
+    if (!write_all(tmp.fd, header.data(), header.size()) || !write_all(tmp.fd, data.data(), data.size()))
+        return std::strerror(errno);
+    return tmp.commit(path);
+}
+
+std::string read_npy(const std::string &path, Array &a) {
+    std::unique_ptr<FILE, int (*)(FILE *)> f(std::fopen(path.c_str(), "rb"), std::fclose);
+    if (!f) return std::strerror(errno);
+    unsigned char start[12];
+    if (std::fread(start, 1, 10, f.get()) != 10 || std::memcmp(start, "\x93NUMPY", 6) != 0)
+        return "not a NumPy .npy file (no \\x93NUMPY magic)";
+    const int major = start[6];
+    std::size_t length = 0;
+    if (major == 1) {
+        length = get_le(start + 8, 2);
+    } else if (major == 2 || major == 3) {
+        if (std::fread(start + 10, 1, 2, f.get()) != 2) return "truncated header";
+        length = get_le(start + 8, 4);
+    } else {
+        return "NumPy format version " + std::to_string(major) + " is not known here (1, 2 or 3)";
+    }
+    if (length > 1 << 20) return "header length " + std::to_string(length) + " is absurd";
+    std::string header(length, '\0');
+    if (std::fread(&header[0], 1, length, f.get()) != length) return "truncated header";
+    const std::string descr = header_value(header, "descr");
+    const std::string order = header_value(header, "fortran_order");
+    int item = 0;
+    bool integer = false;
+    if (descr == "'<f8'") item = 8;
+    else if (descr == "'<f4'") item = 4;
+    else if (descr == "'<i8'") item = 8, integer = true;
+    else if (descr == "'<i4'") item = 4, integer = true;
+    else return "dtype " + (descr.empty() ? std::string("(none)") : descr) +
+                " is not read here (little-endian float64, float32, int64 or int32)";
+    if (order != "False" && order != "True") return "no fortran_order in the header";
+    Array out;
+    out.integer = integer;
+    if (!parse_shape(header_value(header, "shape"), out.shape)) return "no readable shape in the header";
+    bool too_many = false;
+    const std::size_t count = element_count(out.shape, &too_many);
+    if (too_many) return "more than 2^28 values";
+    std::vector<unsigned char> bytes(count * item);
+    if (std::fread(bytes.data(), 1, bytes.size(), f.get()) != bytes.size())
+        return "truncated: the data is shorter than its shape says";
+    if (std::fgetc(f.get()) != EOF) return "bytes after the data its shape says";
+    out.values.resize(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::uint64_t bits = get_le(&bytes[i * item], item);
+        if (integer) {
+            out.values[i] = item == 8 ? static_cast<double>(static_cast<std::int64_t>(bits))
+                                      : static_cast<double>(static_cast<std::int32_t>(bits));
+        } else if (item == 8) {
+            std::memcpy(&out.values[i], &bits, 8);
+        } else {
+            const std::uint32_t b32 = static_cast<std::uint32_t>(bits);
+            float v;
+            std::memcpy(&v, &b32, 4);
+            out.values[i] = v;  // exact
+        }
+    }
+    if (order == "True" && out.shape.size() > 1) {
+        // Fortran order: the first index runs fastest. Reorder to C order.
+        std::vector<double> c_order(count);
+        std::vector<std::size_t> index(out.shape.size(), 0);
+        for (std::size_t k = 0; k < count; ++k) {
+            std::size_t c = 0;
+            for (std::size_t d = 0; d < out.shape.size(); ++d) c = c * out.shape[d] + index[d];
+            c_order[c] = out.values[k];
+            for (std::size_t d = 0; d < out.shape.size() && ++index[d] == out.shape[d]; ++d) index[d] = 0;
+        }
+        out.values.swap(c_order);
+    }
+    a = std::move(out);
+    return "";
+}
+
+bool is_hdf5_file(const std::string &path) {
+    // The signature is at offset 0 or, after a user block, 512, 1024, ...
+    std::unique_ptr<FILE, int (*)(FILE *)> f(std::fopen(path.c_str(), "rb"), std::fclose);
+    if (!f) return false;
+    for (long offset = 0; offset <= (1L << 20); offset = offset ? 2 * offset : 512) {
+        unsigned char signature[8];
+        if (std::fseek(f.get(), offset, SEEK_SET) != 0 || std::fread(signature, 1, 8, f.get()) != 8) return false;
+        if (std::memcmp(signature, "\x89HDF\r\n\x1a\n", 8) == 0) return true;
+    }
+    return false;
+}
+
+#if LPI_CLI_HAVE_HDF5
+
+namespace {
+
+// Closes an HDF5 identifier on scope exit.
+class Id {
+public:
+    Id(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+    Id(const Id &) = delete;
+    Id &operator=(const Id &) = delete;
+    ~Id() {
+        if (id_ >= 0) close_(id_);
+    }
+    hid_t get() const { return id_; }
+    bool ok() const { return id_ >= 0; }
+
+private:
+    hid_t id_;
+    herr_t (*close_)(hid_t);
+};
+
+// HDF5 prints its error stack by default; lpi reports failures itself.
+void quiet_hdf5() {
+    static const bool quiet = [] { return H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr) >= 0; }();
+    (void)quiet;
+}
+
+std::string write_attribute(hid_t file, const Attribute &attr) {
+    Id space(H5Screate(H5S_SCALAR), H5Sclose);
+    if (attr.is_text) {
+        Id type(H5Tcopy(H5T_C_S1), H5Tclose);
+        H5Tset_size(type.get(), H5T_VARIABLE);
+        H5Tset_cset(type.get(), H5T_CSET_UTF8);
+        Id a(H5Acreate2(file, attr.name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+        const char *text = attr.text.c_str();
+        if (!a.ok() || H5Awrite(a.get(), type.get(), &text) < 0) return "attribute " + attr.name;
+    } else if (attr.integer) {
+        const std::int64_t whole = static_cast<std::int64_t>(attr.number);
+        Id a(H5Acreate2(file, attr.name.c_str(), H5T_STD_I64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+        if (!a.ok() || H5Awrite(a.get(), H5T_NATIVE_INT64, &whole) < 0) return "attribute " + attr.name;
+    } else {
+        Id a(H5Acreate2(file, attr.name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+             H5Aclose);
+        if (!a.ok() || H5Awrite(a.get(), H5T_NATIVE_DOUBLE, &attr.number) < 0) return "attribute " + attr.name;
+    }
+    return "";
+}
+
+}  // namespace
+
+bool have_hdf5() { return true; }
+
+std::string write_hdf5(const std::string &path, const std::vector<Dataset> &datasets,
+                       const std::vector<Attribute> &attributes, std::vector<std::uint64_t> *offsets) {
+    quiet_hdf5();
+    TemporaryFile tmp(path);
+    if (tmp.fd < 0) return std::string("cannot create a file beside it: ") + std::strerror(errno);
+    std::string why;
+    {
+        Id file(H5Fcreate(tmp.name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+        if (!file.ok()) return "HDF5 cannot create " + tmp.name;
+        // No modification times in the objects: the same run gives the same bytes.
+        Id creation(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+        H5Pset_obj_track_times(creation.get(), false);
+        std::vector<std::unique_ptr<Id>> ids;
+        offsets->clear();
+        for (const Dataset &d : datasets) {
+            std::vector<hsize_t> dims(d.array.shape.begin(), d.array.shape.end());
+            Id space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose);
+            const hid_t file_type = d.array.integer ? H5T_STD_I64LE : H5T_IEEE_F64LE;
+            ids.push_back(std::make_unique<Id>(
+                H5Dcreate2(file.get(), d.name.c_str(), file_type, space.get(), H5P_DEFAULT, creation.get(), H5P_DEFAULT),
+                H5Dclose));
+            const hid_t set = ids.back()->get();
+            if (set < 0) return "HDF5 cannot create dataset " + d.name;
+            herr_t status = 0;
+            if (d.array.values.empty()) {
+                // nothing to write: an empty dataset has no raw data
+            } else if (d.array.integer) {
+                std::vector<std::int64_t> whole(d.array.values.begin(), d.array.values.end());
+                status = H5Dwrite(set, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, whole.data());
+            } else {
+                status = H5Dwrite(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, d.array.values.data());
+            }
+            if (status < 0) return "HDF5 cannot write dataset " + d.name;
+            const haddr_t at = H5Dget_offset(set);
+            offsets->push_back(at == HADDR_UNDEF ? UINT64_MAX : static_cast<std::uint64_t>(at));
+            if (d.is_scale && H5DSset_scale(set, d.name.c_str()) < 0) return "HDF5 cannot make " + d.name + " a scale";
+        }
+        for (std::size_t i = 0; i < datasets.size(); ++i)
+            for (std::size_t axis = 0; axis < datasets[i].dims.size(); ++axis) {
+                const std::string &scale = datasets[i].dims[axis];
+                if (scale.empty()) continue;
+                for (std::size_t j = 0; j < datasets.size(); ++j)
+                    if (datasets[j].name == scale &&
+                        H5DSattach_scale(ids[i]->get(), ids[j]->get(), static_cast<unsigned>(axis)) < 0)
+                        return "HDF5 cannot attach " + scale + " to " + datasets[i].name;
+            }
+        for (const Attribute &attr : attributes) {
+            why = write_attribute(file.get(), attr);
+            if (!why.empty()) return "HDF5 cannot write " + why;
+        }
+        ids.clear();
+        if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0) return "HDF5 cannot flush " + tmp.name;
+    }
+    return tmp.commit(path);
+}
+
+std::string read_hdf5(const std::string &path, const std::string &name, Array &a, bool *found) {
+    quiet_hdf5();
+    *found = false;
+    if (!is_hdf5_file(path)) return "not an HDF5 file";
+    Id file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+    if (!file.ok()) return "HDF5 cannot open it (damaged?)";
+    if (H5Lexists(file.get(), name.c_str(), H5P_DEFAULT) <= 0) return "no dataset " + name;
+    *found = true;
+    Id set(H5Dopen2(file.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
+    if (!set.ok()) return name + " is not a dataset";
+    Id type(H5Dget_type(set.get()), H5Tclose);
+    const H5T_class_t kind = H5Tget_class(type.get());
+    if (kind != H5T_FLOAT && kind != H5T_INTEGER) return name + " holds neither floats nor integers";
+    Id space(H5Dget_space(set.get()), H5Sclose);
+    const int rank = H5Sget_simple_extent_ndims(space.get());
+    if (rank < 0 || rank > 8) return name + " has an unreadable shape";
+    std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+    H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr);
+    Array out;
+    out.integer = kind == H5T_INTEGER;
+    out.shape.assign(dims.begin(), dims.end());
+    bool too_many = false;
+    const std::size_t count = element_count(out.shape, &too_many);
+    if (too_many) return name + " has more than 2^28 values";
+    out.values.resize(count);
+    if (count > 0 && H5Dread(set.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.values.data()) < 0)
+        return "HDF5 cannot read " + name + " (damaged?)";
+    a = std::move(out);
+    return "";
+}
+
+std::string read_hdf5_text(const std::string &path, const std::string &name, std::string &text) {
+    quiet_hdf5();
+    if (!is_hdf5_file(path)) return "not an HDF5 file";
+    Id file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+    if (!file.ok()) return "HDF5 cannot open it (damaged?)";
+    if (H5Aexists(file.get(), name.c_str()) <= 0) return "no attribute " + name;
+    Id attr(H5Aopen(file.get(), name.c_str(), H5P_DEFAULT), H5Aclose);
+    Id type(H5Aget_type(attr.get()), H5Tclose);
+    if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) <= 0)
+        return "attribute " + name + " is not a text";
+    Id memory(H5Tcopy(H5T_C_S1), H5Tclose);
+    H5Tset_size(memory.get(), H5T_VARIABLE);
+    H5Tset_cset(memory.get(), H5Tget_cset(type.get()));
+    char *value = nullptr;
+    if (H5Aread(attr.get(), memory.get(), &value) < 0 || !value) return "HDF5 cannot read attribute " + name;
+    text = value;
+    H5free_memory(value);
+    return "";
+}
+
+#else
+
+bool have_hdf5() { return false; }
+
+std::string read_hdf5_text(const std::string &, const std::string &, std::string &) {
+    return "this lpi is built without HDF5";
+}
+
+std::string write_hdf5(const std::string &, const std::vector<Dataset> &, const std::vector<Attribute> &,
+                       std::vector<std::uint64_t> *) {
+    return "this lpi is built without HDF5";
+}
+
+std::string read_hdf5(const std::string &, const std::string &, Array &, bool *found) {
+    *found = false;
+    return "this lpi is built without HDF5 (give a .npy file)";
+}
+
+#endif
+
+}  // namespace lpi_cli

@@ -1,0 +1,180 @@
+#!/bin/sh
+# check_lpi_data.sh LPI OUTDIR
+# lpi run sine-euler keeps its run as data: .npy files (NumPy format 1.0,
+# '<f8'/'<i8', header padded to 64 bytes) and, when built with HDF5, one .h5
+# file that h5py (and xarray, when installed) reads. Checked against numpy
+# when a Python with numpy is found (the energy recomputed from the vorticity
+# snapshot by FFT), byte by byte otherwise. --init takes an N x N grid from
+# .npy (float64, float32, either order) or from a run's .h5, and refuses a
+# bad file with exit status 1 (unreadable) or 2 (no usable N x N grid).
+# Exits 77 without sine-Euler (FFTW).
+set -eu
+lpi="$1"; out="$2"
+rm -rf "$out"
+mkdir -p "$out"
+fail() { echo "FAIL: $*"; exit 1; }
+run() { "$lpi" run sine-euler --N 9 --dt 0.05 --steps 12 --every 3 --snapshots 2 "$@" >/dev/null; }
+if ! run --out "$out/npy" --format npy 2>"$out/err"; then
+    grep -q "not available in this build" "$out/err" && { echo "SKIP: no sine-Euler in this build"; exit 77; }
+    cat "$out/err"; fail "lpi run sine-euler"
+fi
+have_h5=0
+run --out "$out/h5" --format h5 2>/dev/null && have_h5=1
+python=""
+for p in python3 /usr/bin/python3; do
+    if "$p" -c 'import numpy' 2>/dev/null; then python=$p; break; fi
+done
+
+# Byte level: the .npy header of the snapshots (5 rows, snapshots at rows 0, 2, 4).
+v="$out/npy/sine-euler/vorticity.npy"
+[ "$(head -c 8 "$v" | od -An -tx1 | tr -d ' \n')" = 934e554d50590100 ] || fail "vorticity.npy: no NumPy 1.0 magic"
+header_len=$(head -c 10 "$v" | tail -c 2 | od -An -tu2 --endian=little | tr -d ' ')
+[ $(((10 + header_len) % 64)) -eq 0 ] || fail "vorticity.npy: header of $header_len bytes, not padded to 64"
+header=$(head -c $((10 + header_len)) "$v" | tail -c "$header_len")
+case $header in
+"{'descr': '<f8', 'fortran_order': False, 'shape': (3, 9, 9), }"*) ;;
+*) fail "vorticity.npy header: $header" ;;
+esac
+[ "$(wc -c < "$v")" -eq $((10 + header_len + 3 * 81 * 8)) ] || fail "vorticity.npy: size"
+grep -q '"method": "leapfrog"' "$out/npy/sine-euler/attributes.json" || fail "attributes.json"
+if [ "$have_h5" = 1 ]; then
+    [ "$(head -c 8 "$out/h5/sine-euler.h5" | od -An -tx1 | tr -d ' \n')" = 894844460d0a1a0a ] || fail "no HDF5 signature"
+fi
+# The raw data is kept beside the images drawn from it.
+if command -v gnuplot >/dev/null 2>&1; then
+    for f in vorticity_000000.png vorticity_000012.svg; do [ -s "$out/npy/$f" ] || fail "no $f"; done
+    [ -s "$v" ] || fail "the snapshot data was removed after plotting"
+fi
+
+# Exit statuses of bad --init files.
+refused() {  # refused STATUS MESSAGE-PART lpi-run-arguments...
+    want=$1 what=$2; shift 2
+    rc=0
+    "$lpi" run "$@" --steps 1 --out "$out/bad" >/dev/null 2>"$out/err" || rc=$?
+    [ "$rc" -eq "$want" ] || { cat "$out/err"; fail "lpi run $*: exit status $rc, expected $want"; }
+    grep -q -e "$what" "$out/err" || { cat "$out/err"; fail "lpi run $*: no message with '$what'"; }
+}
+echo "not a grid" > "$out/text.npy"
+head -c 100 "$v" > "$out/truncated.npy"
+refused 1 "No such file" sine-euler --init "$out/missing.npy"
+refused 1 "magic" sine-euler --init "$out/text.npy"
+refused 1 "truncated" sine-euler --init "$out/truncated.npy"
+refused 2 "shape (3, 9, 9)" sine-euler --init "$v"
+refused 2 "not (N, N)" sine-euler --init "$out/npy/sine-euler/time.npy"
+refused 2 "exclude" sine-euler --init "$v" --resume "$out/x.lpi"
+if [ "$have_h5" = 1 ]; then
+    # A run's .h5: the last snapshot; --N must agree with it.
+    refused 2 "but --N is 11" sine-euler --N 11 --init "$out/h5/sine-euler.h5"
+    refused 2 "not a sine-Euler scene" rigid-body --init "$out/h5/sine-euler.h5"
+    head -c 3000 "$out/h5/sine-euler.h5" > "$out/truncated.h5"
+    refused 1 "HDF5 cannot" sine-euler --init "$out/truncated.h5"
+    "$lpi" run rigid-body --steps 2 --format h5 --out "$out/rb" >/dev/null
+    refused 2 "no dataset /init or /vorticity" sine-euler --init "$out/rb/rigid-body.h5"
+fi
+
+if [ -z "$python" ]; then
+    echo "PASS (byte level; no Python with numpy): lpi run data and --init"
+    exit 0
+fi
+"$python" - "$lpi" "$out" "$have_h5" <<'EOF'
+import json, math, os, subprocess, sys
+import numpy as np
+lpi, out, have_h5 = sys.argv[1], sys.argv[2], sys.argv[3] == "1"
+N = 9
+
+def energy(grid):
+    # H = 1/2 sum_{m != 0} |w_m|^2 / |m|^2, w_m the Fourier coefficients of
+    # the grid w(2 pi a / N, 2 pi b / N), |m| from the representative in -4..4.
+    w = np.fft.fft2(grid) / N**2
+    m = np.fft.fftfreq(N, 1.0 / N)
+    m2 = m[:, None]**2 + m[None, :]**2
+    m2[0, 0] = np.inf
+    return 0.5 * np.sum(np.abs(w)**2 / m2)
+
+def load_npy(folder):
+    return {n[:-4]: np.load(os.path.join(folder, n)) for n in os.listdir(folder) if n.endswith(".npy")}
+
+runs = {"npy": load_npy(os.path.join(out, "npy", "sine-euler"))}
+attrs = json.load(open(os.path.join(out, "npy", "sine-euler", "attributes.json")))
+assert attrs["N"] == N and attrs["dt"] == 0.05 and attrs["scene"] == "sine-euler", attrs
+if have_h5:
+    try:
+        import h5py
+    except ImportError:
+        h5py = None
+        print("no h5py: the .h5 file is checked by its signature only")
+    if h5py:
+        with h5py.File(os.path.join(out, "h5", "sine-euler.h5"), "r") as f:
+            runs["h5"] = {k: f[k][()] for k in f}
+            assert f.attrs["method"] == "leapfrog" and f.attrs["N"] == N and f.attrs["dt"] == 0.05, dict(f.attrs)
+            assert f["vorticity"].dims[0][0].name == "/snapshot_time", "no dimension scale on vorticity"
+            assert f["energy"].dims[0][0].name == "/time"
+        try:
+            import h5netcdf, xarray
+        except ImportError:
+            xarray = None
+            print("no xarray with h5netcdf: skipped reading through xarray")
+        if xarray:
+            ds = xarray.open_dataset(os.path.join(out, "h5", "sine-euler.h5"), engine="h5netcdf")
+            assert ds["vorticity"].dims == ("snapshot_time", "x", "y"), ds["vorticity"].dims
+            print("xarray reads it:", dict(ds.sizes))
+csv = np.loadtxt(os.path.join(out, "npy", "sine-euler.csv"), delimiter=",", skiprows=1, ndmin=2)
+for fmt, d in runs.items():
+    assert d["vorticity"].shape == (3, N, N) and d["vorticity"].dtype == np.float64, fmt
+    assert list(d["step"]) == [0, 3, 6, 9, 12] and d["step"].dtype == np.int64, (fmt, d["step"])
+    assert list(d["snapshot_step"]) == [0, 6, 12], (fmt, d["snapshot_step"])
+    # The rows are the CSV's, to the bit.
+    assert np.array_equal(d["energy"], csv[:, 2]) and np.array_equal(d["time"], csv[:, 1]), fmt
+    assert np.array_equal(d["casimirs"], csv[:, 4:]), fmt
+    # Each snapshot is the state whose energy the row at its step holds.
+    for k, step in enumerate(d["snapshot_step"]):
+        row = list(d["step"]).index(step)
+        e = energy(d["vorticity"][k])
+        assert abs(e - d["energy"][row]) < 1e-13 * abs(e), (fmt, step, e, d["energy"][row])
+    assert abs(d["x"][1] - 2 * math.pi / N) < 1e-15, fmt
+    print(f"{fmt}: rows and snapshots agree with the CSV and with the energy computed by FFT")
+if "h5" in runs:
+    for k in runs["npy"]:
+        assert np.array_equal(runs["npy"][k], runs["h5"][k]), k
+
+# --init: a grid w(x, y) = cos(x) + 0.5 sin(2 y) + 0.3 cos(x + y): the run's
+# first snapshot is that grid and its energy the energy computed here, for
+# float64 and float32, C and Fortran order.
+a = np.arange(N) * 2 * np.pi / N
+grid = np.cos(a)[:, None] + 0.5 * np.sin(2 * a)[None, :] + 0.3 * np.cos(a[:, None] + a[None, :])
+cases = {"f8": grid, "f4": grid.astype(np.float32), "fortran": np.asfortranarray(grid)}
+for name, g in cases.items():
+    path = os.path.join(out, f"init_{name}.npy")
+    np.save(path, g)
+    folder = os.path.join(out, f"init_{name}")
+    subprocess.run([lpi, "run", "sine-euler", "--init", path, "--dt", "0.05", "--steps", "4", "--every", "2",
+                    "--snapshots", "1", "--format", "npy", "--out", folder], check=True, stdout=subprocess.DEVNULL)
+    d = load_npy(os.path.join(folder, "sine-euler"))
+    expected = np.asarray(g, dtype=np.float64)
+    assert np.max(np.abs(d["vorticity"][0] - expected)) < 1e-13, name
+    assert abs(d["energy"][0] - energy(expected)) < 1e-13 * energy(expected), name
+print("--init: .npy float64, float32 and Fortran order start from the given grid")
+bad = os.path.join(out, "nan.npy")
+g = grid.copy(); g[2, 3] = np.nan
+np.save(bad, g)
+rc = subprocess.run([lpi, "run", "sine-euler", "--init", bad, "--steps", "1", "--out", os.path.join(out, "bad")],
+                    stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+assert rc.returncode == 2 and b"--init" in rc.stderr, rc
+np.save(bad, np.zeros((8, 8)))
+rc = subprocess.run([lpi, "run", "sine-euler", "--init", bad, "--steps", "1", "--out", os.path.join(out, "bad")],
+                    stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+assert rc.returncode == 2 and b"N odd" in rc.stderr, rc
+np.save(bad, grid.astype(">f8"))
+rc = subprocess.run([lpi, "run", "sine-euler", "--init", bad, "--steps", "1", "--out", os.path.join(out, "bad")],
+                    stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+assert rc.returncode == 1 and b">f8" in rc.stderr, rc
+if "h5" in runs:
+    # A run's .h5 continues from its last snapshot.
+    folder = os.path.join(out, "from_h5")
+    subprocess.run([lpi, "run", "sine-euler", "--init", os.path.join(out, "h5", "sine-euler.h5"), "--steps", "2",
+                    "--snapshots", "1", "--format", "npy", "--out", folder], check=True, stdout=subprocess.DEVNULL)
+    d = load_npy(os.path.join(folder, "sine-euler"))
+    assert np.max(np.abs(d["vorticity"][0] - runs["h5"]["vorticity"][-1])) < 1e-13
+    print("--init: a run's .h5 continues from its last snapshot")
+EOF
+echo "PASS: lpi run data (.npy$( [ "$have_h5" = 1 ] && echo ', HDF5')) and --init"
