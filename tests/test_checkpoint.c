@@ -53,6 +53,7 @@ typedef struct {
 } sink;
 
 static void put(sink *b, const void *v, size_t n) {
+    if (n == 0) return; /* memcpy from a NULL source is undefined even for 0 bytes */
     b->p = realloc(b->p, b->n + n);
     assert_non_null(b->p);
     memcpy(b->p + b->n, v, n);
