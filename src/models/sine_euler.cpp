@@ -30,6 +30,7 @@
 #include <cstdio>
 #include <cstdint>
 #include <cstring>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -446,31 +447,28 @@ std::vector<int> prime_factors(int N) {
 // prime N ((0,1), then (1,m), m = 0..N-1), then, for composite N, the other
 // classes in lexicographic order. A nonzero mode belongs to the first
 // direction whose line through the origin contains it.
-// O(N^2) with a small constant: the primes of N dividing a residue are a bit
-// mask (k is primitive, gcd(k1, k2, N) = 1, when the masks of k1 and k2 are
-// disjoint), and for composite N one byte per mode marks the modes owned so
-// far. A primitive k is owned exactly when its class was met before (a
-// non-unit multiple is never primitive), so the same byte says which classes
-// remain. For prime N each direction owns its whole line and the N + 1
-// classes are the paper's.
+// Setup is O(N^2) in sequential passes, by these facts (g(x) = gcd(x, N)):
+// - a mode p lies on (0,1) when p1 = 0, else on (1,m) when p2 = p1 m, which
+//   has a solution when g(p1) divides p2, the least m < N / g(p1); so (1,m)
+//   owns s (the mode (s, s m)) when m < N / g(s), and (0,1) owns its line;
+// - a class k with a non-unit k1 is met first at k1 = g(k1) (the least
+//   residue of that gcd), so only rows k1 = g, the divisors 1 < g < N of N,
+//   hold new classes; in row g, k2 and u k2 are one class for the units
+//   u = 1 mod N/g;
+// - on a later class's line, s k is owned there when s is a unit (a primitive
+//   mode lies on its own class only); for a non-unit s, by (0,1) or (1,m) as
+//   above, or, when neither, by the first later class met (one byte per
+//   mode, for these modes only: N with a squared prime factor).
 void SineEuler::build_directions() {
     const int N = N_;
-    const std::vector<int> primes = prime_factors(N);  // at most 8 odd primes below 2^31
-    std::vector<std::uint16_t> divisors(N, 0);  // bit i: primes[i] divides the residue
-    std::size_t classes = N;  // N prod_{p | N} (1 + 1/p)
-    for (std::size_t i = 0; i < primes.size(); ++i) {
-        for (int x = 0; x < N; x += primes[i]) divisors[x] |= static_cast<std::uint16_t>(1u << i);
-        classes = classes / primes[i] * (primes[i] + 1);
-    }
-    const bool prime = classes == static_cast<std::size_t>(N) + 1;
-    std::vector<unsigned char> owned_mode(prime ? 0 : dim(), 0);
-    dirs_.reserve(classes);
-    auto consider = [&](int k1, int k2) {
-        if ((divisors[k1] & divisors[k2]) != 0) return;  // not primitive
-        if (!prime && owned_mode[mode_index(k1, k2, N)]) return;  // a class met before
-        // The class of k is first met as (1, m) when k1 is a unit; scale it
-        // to k2 = 1 when k2 is a unit (the Column layout).
-        if (divisors[k1] != 0 && divisors[k2] == 0) {
+    std::vector<int> gcd_with_n(N);
+    for (int x = 0; x < N; ++x) gcd_with_n[x] = std::gcd(x, N);
+    auto unit = [&](int x) { return gcd_with_n[x] == 1; };
+    std::vector<unsigned char> claimed;  // modes owned by a later class, allocated when needed
+
+    auto add = [&](int k1, int k2) {
+        // A class met with a unit k2 is scaled to k2 = 1 (the Column layout).
+        if (!unit(k1) && unit(k2)) {
             k1 = modulo(static_cast<std::int64_t>(k1) * inverse_mod(k2, N), N);
             k2 = 1;
         }
@@ -478,17 +476,25 @@ void SineEuler::build_directions() {
         D.k1 = k1;
         D.k2 = k2;
         D.owned.assign(N, 0);
-        for (int s = 1, a = k1, b = k2; s < N; ++s) {  // (a, b) = s k
-            if (prime) {
-                D.owned[s] = 1;
-            } else if (!owned_mode[mode_index(a, b, N)]) {
-                owned_mode[mode_index(a, b, N)] = 1;
-                D.owned[s] = 1;
+        if (k1 == 0) {  // (0,1), the first
+            std::fill(D.owned.begin() + 1, D.owned.end(), 1);
+        } else if (k1 == 1) {  // (1,m)
+            for (int s = 1; s < N; ++s) D.owned[s] = k2 < N / gcd_with_n[s];
+        } else {
+            for (int s = 1, a = k1, b = k2; s < N; ++s) {  // (a, b) = s k
+                if (unit(s)) {
+                    D.owned[s] = 1;
+                } else if (a != 0 && b % gcd_with_n[a] != 0) {
+                    if (claimed.empty()) claimed.assign(dim(), 0);
+                    unsigned char &owner = claimed[mode_index(a, b, N)];
+                    D.owned[s] = !owner;
+                    owner = 1;
+                }
+                a += k1;
+                if (a >= N) a -= N;
+                b += k2;
+                if (b >= N) b -= N;
             }
-            a += k1;
-            if (a >= N) a -= N;
-            b += k2;
-            if (b >= N) b -= N;
         }
         // Lines d j + s k, d in Z_N, tile Z_N^2 when j x k is a unit.
         if (k1 == 1) {
@@ -503,7 +509,7 @@ void SineEuler::build_directions() {
             int cross = 0;
             for (int y = 0; y < N && !cross; ++y) {
                 const int c = modulo(k2 - static_cast<std::int64_t>(y) * k1, N);
-                if (divisors[c] == 0) D.j1 = 1, D.j2 = y, cross = c;
+                if (unit(c)) D.j1 = 1, D.j2 = y, cross = c;
             }
             const int inverse = inverse_mod(cross, N);  // scale j so that j x k = 1
             D.j1 = modulo(static_cast<std::int64_t>(D.j1) * inverse, N);
@@ -511,12 +517,19 @@ void SineEuler::build_directions() {
         }
         dirs_.push_back(std::move(D));
     };
-    consider(0, 1);
-    for (int m = 0; m < N; ++m) consider(1, m);
-    // The remaining classes have a non-unit k1 (k1 = 0: only (0, 1)'s class).
-    for (int k1 = 1; k1 < N && dirs_.size() < classes; ++k1)
-        if (divisors[k1] != 0)
-            for (int k2 = 0; k2 < N && dirs_.size() < classes; ++k2) consider(k1, k2);
+    add(0, 1);
+    for (int m = 0; m < N; ++m) add(1, m);
+    std::vector<unsigned char> seen(N);  // row g: k2 whose class was met
+    for (int g = 3; g < N; g += 2) {
+        if (N % g != 0) continue;
+        std::fill(seen.begin(), seen.end(), 0);
+        for (int k2 = 0; k2 < N; ++k2) {
+            if (seen[k2] || std::gcd(gcd_with_n[g], gcd_with_n[k2]) != 1) continue;  // met, or not primitive
+            for (int u = 1; u < N; u += N / g)  // the units u = 1 mod N/g
+                if (unit(u)) seen[modulo(static_cast<std::int64_t>(u) * k2, N)] = 1;
+            add(g, k2);
+        }
+    }
 }
 
 void SineEuler::ensure_plans() {
