@@ -484,7 +484,7 @@ static const bad_case kCases[] = {
     C(lpi_sine_euler_create, "N even", LPI_ERR_INVALID, NONE, .k = 8),
     C(lpi_sine_euler_create, "N = 1", LPI_ERR_INVALID, NONE, .k = 1),
     C(lpi_sine_euler_create, "N < 0", LPI_ERR_INVALID, NONE, .k = -3),
-    C(lpi_sine_euler_create, "N = INT32_MAX", LPI_ERR_INVALID, NONE, .k = INT32_MAX),
+    C(lpi_sine_euler_create, "N = INT32_MAX", LPI_ERR_NO_MEMORY, NONE, .k = INT32_MAX),
 
     /* the handle itself */
     C(lpi_set_method, "NULL handle", LPI_ERR_NULL, NONE, .s = "leapfrog"),

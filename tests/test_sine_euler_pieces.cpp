@@ -1,6 +1,7 @@
 // White-box: for prime and composite N, the pieces (directions of the
 // projective line over Z_N) own every nonzero mode exactly once, so their
-// energies sum to H; their number is N prod_{p | N} (1 + 1/p).
+// energies sum to H; their number is N prod_{p | N} (1 + 1/p). Small N
+// mode by mode, larger N (prime powers, large factors) by the sum.
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -84,6 +85,41 @@ void test_piece_energies_sum_to_h(void **) {
         std::printf("N = %2d: %3zu pieces, sum of piece energies - H = %.1e\n", N,
                     model->piece_count(), sum - H);
         assert_true(std::fabs(sum - H) <= 1e-13 * H);
+    }
+    // Larger N, composite with large or repeated factors (4097 = 17 x 241):
+    // every energy term |w_m|^2 / |m|^2 is set to a random value in [1/4, 1],
+    // so a mode owned twice or by no piece moves the sum by at least 1/4.
+    for (int N : {81, 121, 135, 147, 243, 343, 1155, 4097}) {
+        auto model = lpi::make_sine_euler(N);
+        auto &se = dynamic_cast<lpi::SineEulerModel &>(*model);
+        assert_true(model->piece_count() == projective_line_size(N));
+        std::vector<double> x(static_cast<std::size_t>(N) * N), state(2 * x.size());
+        unsigned seed = 7;
+        x[0] = 0.0;
+        for (std::size_t i = 1; i < x.size(); i += 2) {
+            seed = seed * 1103515245u + 12345u;
+            const double angle = seed / 4294967296.0 * 6.283185307179586;
+            seed = seed * 1103515245u + 12345u;
+            const double amplitude = std::sqrt(0.25 + 0.75 * (seed / 4294967296.0));
+            x[i] = amplitude * std::cos(angle);
+            x[i + 1] = amplitude * std::sin(angle);
+        }
+        model->from_public(x.data(), state.data());
+        // Scale each mode by |m| (representatives -M .. M).
+        for (int a = 0; a < N; ++a)
+            for (int b = 0; b < N; ++b) {
+                const double ra = a > N / 2 ? a - N : a, rb = b > N / 2 ? b - N : b;
+                const double norm = std::sqrt(ra * ra + rb * rb);
+                state[2 * (static_cast<std::size_t>(a) * N + b)] *= norm;
+                state[2 * (static_cast<std::size_t>(a) * N + b) + 1] *= norm;
+            }
+        double sum = 0.0;
+        for (std::size_t k = 0; k < model->piece_count(); ++k) sum += se.piece_energy(k, state.data());
+        const double H = model->energy(state.data());
+        assert_true(std::fabs(sum - H) < 0.1);
+        assert_true(H > 0.25 * 0.5 * (static_cast<double>(N) * N - 1));
+        std::printf("N = %4d: %4zu pieces, H = %.6g, sum of piece energies - H = %.1e\n", N,
+                    model->piece_count(), H, sum - H);
     }
 #endif
 }

@@ -9,15 +9,26 @@
 // so exp(t Lambda_l) = u_{l-c} conj(u_{l+c}) with u_l = exp(i t B_l / (2 eps)).
 // One FFT gives B; each line costs a forward and a backward FFT, and lines
 // -c are the conjugates of lines c, so M = (N-1)/2 lines are integrated.
-// Every flow is exactly unitary; what remains of the Casimir drift is FFTW's
-// own round-trip norm bias (a property of each plan: measured -6e-17 per round
-// trip at N = 31, -1e-16 at 61, +3.4e-16 at 127), accumulated over the
-// (2P-2) M line round trips of a step.
+// Every flow is exactly unitary, and it is applied as an increment,
+//     z <- z + F^-1 ((exp(t Lambda) - 1) F z) / N,
+// added to the modes as they are scattered back. Round-off then has no bias:
+// an FFTW forward/backward pair rescales what it transforms by some 1 + tau
+// (a property of each plan: measured -6e-17 per round trip at N = 31, -1e-16
+// at 61, +3.4e-16 at 127), and applied to the whole line it rescaled every
+// mode by 1 + tau in every flow, a drift of the Casimirs linear in time. On
+// the increment D = (U - I) z it changes |z|^2 by 2 tau Re<z + D, D> =
+// tau |D|^2 only (U unitary: 2 Re<z, D> = -|D|^2), second order in t Lambda;
+// what remains is the rounding of the final sum z + D, to nearest, of either
+// sign: the Casimirs wander like the square root of the number of steps. The
+// factors exp(i phi) - 1 come from v_l = u_l - 1 = (-2 sin^2(phi_l/2),
+// sin phi_l) without cancellation, so the increment's own rounding scales
+// with the angles, not with the field.
 #include "sine_euler.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <cstring>
 #include <numeric>
 #include <string>
@@ -31,6 +42,11 @@
 #endif
 #if LPI_HAVE_OPENMP
 #include <omp.h>
+#endif
+#if defined(__has_include)
+#if __has_include(<unistd.h>)
+#include <unistd.h>
+#endif
 #endif
 
 namespace lpi {
@@ -57,17 +73,25 @@ namespace {
 // for every thread count.
 constexpr int kBlock = 16;
 
-int gcd(int a, int b) { return std::gcd(a, b); }
-int modulo(long a, int N) {
-    const long r = a % N;
+// Index arithmetic: a mode (a, b) is entry a N + b of N^2, beyond int for
+// large N, so every offset into the mode array is a std::size_t; products of
+// two residues are formed in 64 bits before they are reduced.
+int modulo(std::int64_t a, int N) {
+    const std::int64_t r = a % N;
     return static_cast<int>(r < 0 ? r + N : r);
 }
 int rep(int a, int N) { return a > N / 2 ? a - N : a; }
-// The inverse of a unit a mod N (setup only: a linear search is enough).
+std::size_t mode_index(int a, int b, int N) { return static_cast<std::size_t>(a) * N + b; }
+std::size_t mirror_index(int a, int b, int N) { return mode_index(a ? N - a : 0, b ? N - b : 0, N); }
+// The inverse of a unit a mod N (extended Euclid).
 int inverse_mod(int a, int N) {
-    int inverse = 1;
-    while (modulo(static_cast<long>(inverse) * a, N) != 1) ++inverse;
-    return inverse;
+    std::int64_t r0 = N, r1 = a, t0 = 0, t1 = 1;
+    while (r1 != 0) {
+        const std::int64_t q = r0 / r1;
+        std::int64_t r = r0 - q * r1, t = t0 - q * t1;
+        r0 = r1, r1 = r, t0 = t1, t1 = t;
+    }
+    return modulo(t0, N);  // r0 = gcd(a, N) = 1
 }
 
 struct Direction {
@@ -93,8 +117,8 @@ struct Plans {
     fftw_plan forward[2] = {nullptr, nullptr};  // [0]: full block, [1]: remainder
     fftw_plan backward[2] = {nullptr, nullptr};
     fftw_complex *b = nullptr;     // N
-    double *up = nullptr;    // 3N complex: up[i] = u_{i mod N}
-    double *down = nullptr;  // 3N complex: down[i] = u_{-i mod N}
+    double *up = nullptr;    // 3N complex: up[i] = v_{i mod N}, v_l = u_l - 1
+    double *down = nullptr;  // 3N complex: down[i] = v_{-i mod N}
     std::vector<fftw_complex *> blocks;  // one N * kBlock buffer per thread
 
     ~Plans() {
@@ -119,25 +143,26 @@ struct Plans {
 #endif
 
 // Multiplies the transformed block x (N rows of `count` lines) by the line
-// flows exp(t Lambda_l) / N. Line i of the block (d = d0 + i) has c = sigma d,
-// so its phase u_{l-c} conj(u_{l+c}) is e = u_{l+d} conj(u_{l-d}) for
-// sigma = -1 and conj(e) for sigma = +1: `sign` = -sigma multiplies Im e, an
-// exact negation. With up = &up[N + d0], down = &down[N + d0], u_{l+d} =
-// up[l + i] and u_{l-d} = down[i - l]: both run forwards along a row of x,
-// so the loop vectorises. Dividing by N, not multiplying by a rounded 1/N:
-// t * fl(1/N) would scale every mode by the same N fl(1/N) != 1 in every flow,
-// a drift of the Casimirs linear in time (measured: 3e-15 per step at N = 31,
-// against 1.5e-15 with the division).
+// flows' increments (exp(t Lambda_l) - 1) / N. Line i of the block
+// (d = d0 + i) has c = sigma d, so exp(t Lambda_l) = u_{l-c} conj(u_{l+c}) is
+// e = u_{l+d} conj(u_{l-d}) for sigma = -1 and conj(e) for sigma = +1: `sign`
+// = -sigma multiplies Im e, an exact negation. With p = v_{l+d}, q = v_{l-d}
+// (v = u - 1), e - 1 = p + conj(q) + p conj(q): no cancellation, each term as
+// small as the angles. With up = &up[N + d0], down = &down[N + d0], v_{l+d} =
+// up[l + i] and v_{l-d} = down[i - l]: both run forwards along a row of x, so
+// the loop vectorises. Dividing by N, not multiplying by a rounded 1/N, which
+// would scale every increment by the same N fl(1/N) != 1.
 LPI_SIMD_CLONES
 void apply_phase(int N, int count, const double *up, const double *down, double sign, double *x) {
     const double n_real = N;
     for (int l = 0; l < N; ++l) {
-        double *z = x + 2 * l * count;
+        double *z = x + 2 * static_cast<std::size_t>(l) * count;
         const double *p = up + 2 * l;
         const double *q = down - 2 * l;
         for (int i = 0; i < count; ++i) {
-            const double er = p[2 * i] * q[2 * i] + p[2 * i + 1] * q[2 * i + 1];
-            const double ei = sign * (p[2 * i + 1] * q[2 * i] - p[2 * i] * q[2 * i + 1]);
+            const double pr = p[2 * i], pi = p[2 * i + 1], qr = q[2 * i], qi = q[2 * i + 1];
+            const double er = (pr + qr) + (pr * qr + pi * qi);
+            const double ei = sign * ((pi - qi) + (pi * qr - pr * qi));
             const double zr = z[2 * i], zi = z[2 * i + 1];
             z[2 * i] = (er * zr - ei * zi) / n_real;
             z[2 * i + 1] = (er * zi + ei * zr) / n_real;
@@ -151,6 +176,9 @@ void apply_phase(int N, int count, const double *up, const double *down, double 
 // o = s m + d0 (slope m = k2, or k1), and its conjugate mirror at position
 // -(o + i) mod N of lane -s. Rows: lane s starts at s N and positions step by
 // 1; columns: lane s starts at s and positions step by N.
+// The gather copies the lines out; the scatter adds the increments computed
+// from them back in place and writes the conjugates of the sums to the
+// mirror lines -d (which no block gathers), so every mode is written once.
 
 // Count > 0: the block size, known at compile time (full blocks); 0: count.
 template <bool Rows, int Count>
@@ -158,10 +186,10 @@ inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
                         const double *__restrict w, double *__restrict x) {
     const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
     const int n = Count > 0 ? Count : count;
-    int o = static_cast<int>((d0 + static_cast<long>(first_lane) * slope) % N);
+    int o = modulo(d0 + static_cast<std::int64_t>(first_lane) * slope, N);
     for (int k = 0, s = first_lane; k < N; ++k, s = s + 1 < N ? s + 1 : 0) {
         const double *src = w + 2 * lane * s;
-        double *dst = x + 2 * s * n;
+        double *dst = x + 2 * static_cast<std::size_t>(s) * n;
         const int first = o <= N - n ? n : N - o;  // the run wraps at most once
         for (int i = 0; i < first; ++i) {
             dst[2 * i] = src[2 * step * (o + i)];
@@ -176,24 +204,27 @@ inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
     }
 }
 
-// Writes n values at positions p0 .. p0+n-1 (p0 + n <= N) of a lane and their
-// conjugates at positions -(p0 + r) mod N of the mirror lane.
-inline void put_run(int N, std::size_t step, int p0, int n, const double *__restrict src, double *lane,
+// Adds n increments to positions p0 .. p0+n-1 (p0 + n <= N) of a lane, keeps
+// the sums in `increment`, and writes their conjugates at positions
+// -(p0 + r) mod N of the mirror lane.
+inline void put_run(int N, std::size_t step, int p0, int n, double *__restrict increment, double *lane,
                     double *mirror) {
     if (n <= 0) return;
     for (int r = 0; r < n; ++r) {
-        lane[2 * step * (p0 + r)] = src[2 * r];
-        lane[2 * step * (p0 + r) + 1] = src[2 * r + 1];
+        double *z = lane + 2 * step * (p0 + r);
+        const double re = z[0] + increment[2 * r], im = z[1] + increment[2 * r + 1];
+        z[0] = increment[2 * r] = re;
+        z[1] = increment[2 * r + 1] = im;
     }
     int r0 = 0;
     if (p0 == 0) {  // position 0 is its own mirror position
-        mirror[0] = src[0];
-        mirror[1] = -src[1];
+        mirror[0] = increment[0];
+        mirror[1] = -increment[1];
         r0 = 1;
     }
     // Upwards through the mirror lane: position N - p0 - r, r = n-1 .. r0.
     double *m = mirror + 2 * step * (N - p0 - (n - 1));
-    const double *z = src + 2 * (n - 1);
+    const double *z = increment + 2 * (n - 1);
     for (int q = 0; q < n - r0; ++q) {
         m[2 * step * q] = z[-2 * q];
         m[2 * step * q + 1] = -z[-2 * q + 1];
@@ -201,13 +232,13 @@ inline void put_run(int N, std::size_t step, int p0, int n, const double *__rest
 }
 
 template <bool Rows, int Count>
-inline void scatter_runs(int N, int slope, int d0, int count, int first_lane,
-                         const double *__restrict x, double *w) {
+inline void scatter_runs(int N, int slope, int d0, int count, int first_lane, double *__restrict x,
+                         double *w) {
     const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
     const int n = Count > 0 ? Count : count;
-    int o = static_cast<int>((d0 + static_cast<long>(first_lane) * slope) % N);
+    int o = modulo(d0 + static_cast<std::int64_t>(first_lane) * slope, N);
     for (int k = 0, s = first_lane; k < N; ++k, s = s + 1 < N ? s + 1 : 0) {
-        const double *src = x + 2 * s * n;
+        double *src = x + 2 * static_cast<std::size_t>(s) * n;
         double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
         if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
             put_run(N, step, o, n, src, dst, mirror);
@@ -224,12 +255,12 @@ inline void scatter_runs(int N, int slope, int d0, int count, int first_lane,
 // Any direction, one mode at a time: element s of line d0 + i is at
 // (d0 + i) j + s k.
 inline void gather_general(const Direction &D, int N, int d0, int count, const double *w, double *x) {
-    int a0 = modulo(static_cast<long>(d0) * D.j1, N), b0 = modulo(static_cast<long>(d0) * D.j2, N);
+    int a0 = modulo(static_cast<std::int64_t>(d0) * D.j1, N), b0 = modulo(static_cast<std::int64_t>(d0) * D.j2, N);
     for (int s = 0; s < N; ++s) {
         int a = a0, b = b0;
-        double *dst = x + 2 * s * count;
+        double *dst = x + 2 * static_cast<std::size_t>(s) * count;
         for (int i = 0; i < count; ++i) {
-            const double *src = w + 2 * (static_cast<std::size_t>(a) * N + b);
+            const double *src = w + 2 * mode_index(a, b, N);
             dst[2 * i] = src[0];
             dst[2 * i + 1] = src[1];
             a += D.j1;
@@ -245,17 +276,17 @@ inline void gather_general(const Direction &D, int N, int d0, int count, const d
 }
 
 inline void scatter_general(const Direction &D, int N, int d0, int count, const double *x, double *w) {
-    int a0 = modulo(static_cast<long>(d0) * D.j1, N), b0 = modulo(static_cast<long>(d0) * D.j2, N);
+    int a0 = modulo(static_cast<std::int64_t>(d0) * D.j1, N), b0 = modulo(static_cast<std::int64_t>(d0) * D.j2, N);
     for (int s = 0; s < N; ++s) {
         int a = a0, b = b0;
-        const double *src = x + 2 * s * count;
+        const double *src = x + 2 * static_cast<std::size_t>(s) * count;
         for (int i = 0; i < count; ++i) {
-            double *dst = w + 2 * (static_cast<std::size_t>(a) * N + b);
-            dst[0] = src[2 * i];
-            dst[1] = src[2 * i + 1];
-            double *mirror = w + 2 * (static_cast<std::size_t>(a ? N - a : 0) * N + (b ? N - b : 0));
-            mirror[0] = src[2 * i];
-            mirror[1] = -src[2 * i + 1];
+            double *dst = w + 2 * mode_index(a, b, N);
+            dst[0] += src[2 * i];
+            dst[1] += src[2 * i + 1];
+            double *mirror = w + 2 * mirror_index(a, b, N);
+            mirror[0] = dst[0];
+            mirror[1] = -dst[1];
             a += D.j1;
             if (a >= N) a -= N;
             b += D.j2;
@@ -268,7 +299,8 @@ inline void scatter_general(const Direction &D, int N, int d0, int count, const 
     }
 }
 
-// These only move numbers (and negate): every clone gives the same bits.
+// These move numbers, negate and add one increment per mode: every clone
+// gives the same bits.
 LPI_SIMD_CLONES
 void gather_block(const Direction &D, int N, int d0, int count, int first_lane, const double *w,
                   double *x) {
@@ -286,7 +318,7 @@ void gather_block(const Direction &D, int N, int d0, int count, int first_lane, 
 }
 
 LPI_SIMD_CLONES
-void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
+void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, double *x,
                    double *w) {
     switch (D.layout) {
         case Direction::Row:
@@ -341,9 +373,9 @@ public:
         double sum = 0.0;
         for (int a = 0; a < N_; ++a)
             for (int b = 0; b < N_; ++b) {
-                const int norm2 = norm2_of(a, b);
+                const double norm2 = norm2_of(a, b);
                 if (norm2 == 0) continue;
-                const double *z = state + 2 * (a * N_ + b);
+                const double *z = state + 2 * mode_index(a, b, N_);
                 sum += (z[0] * z[0] + z[1] * z[1]) / norm2;
             }
         return 0.5 * sum;
@@ -353,9 +385,9 @@ public:
         double sum = 0.0;
         for (int s = 1; s < N_; ++s) {
             if (!D.owned[s]) continue;
-            const int a = modulo(static_cast<long>(s) * D.k1, N_);
-            const int b = modulo(static_cast<long>(s) * D.k2, N_);
-            const double *z = state + 2 * (a * N_ + b);
+            const int a = modulo(static_cast<std::int64_t>(s) * D.k1, N_);
+            const int b = modulo(static_cast<std::int64_t>(s) * D.k2, N_);
+            const double *z = state + 2 * mode_index(a, b, N_);
             sum += (z[0] * z[0] + z[1] * z[1]) / norm2_of(a, b);
         }
         return 0.5 * sum;
@@ -379,9 +411,10 @@ public:
     double run_fft_floor(std::size_t flows) override;
 
 private:
-    int norm2_of(int a, int b) const {
-        const int ra = rep(a, N_), rb = rep(b, N_);
-        return ra * ra + rb * rb;
+    // |m|^2 of the representative, exact (an int would overflow past N = 65535).
+    double norm2_of(int a, int b) const {
+        const std::int64_t ra = rep(a, N_), rb = rep(b, N_);
+        return static_cast<double>(ra * ra + rb * rb);
     }
     int block_count() const { return (M_ + kBlock - 1) / kBlock; }
     void build_directions();
@@ -398,33 +431,69 @@ private:
     std::unique_ptr<Plans> plans_;
 };
 
+// The odd primes dividing N, by trial division.
+std::vector<int> prime_factors(int N) {
+    std::vector<int> primes;
+    for (int p = 3; static_cast<std::int64_t>(p) * p <= N; p += 2)
+        if (N % p == 0) {
+            primes.push_back(p);
+            while (N % p == 0) N /= p;
+        }
+    if (N > 1) primes.push_back(N);
+    return primes;
+}
+
 // The directions of the projective line over Z_N, in the paper's order for
 // prime N ((0,1), then (1,m), m = 0..N-1), then, for composite N, the other
 // classes in lexicographic order. A nonzero mode belongs to the first
 // direction whose line through the origin contains it.
+// Setup is O(N^2) in sequential passes, by these facts (g(x) = gcd(x, N)):
+// - a mode p lies on (0,1) when p1 = 0, else on (1,m) when p2 = p1 m, which
+//   has a solution when g(p1) divides p2, the least m < N / g(p1); so (1,m)
+//   owns s (the mode (s, s m)) when m < N / g(s), and (0,1) owns its line;
+// - a class k with a non-unit k1 is met first at k1 = g(k1) (the least
+//   residue of that gcd), so only rows k1 = g, the divisors 1 < g < N of N,
+//   hold new classes; in row g, k2 and u k2 are one class for the units
+//   u = 1 mod N/g;
+// - on a later class's line, s k is owned there when s is a unit (a primitive
+//   mode lies on its own class only); for a non-unit s, by (0,1) or (1,m) as
+//   above, or, when neither, by the first later class met (one byte per
+//   mode, for these modes only: N with a squared prime factor).
 void SineEuler::build_directions() {
     const int N = N_;
-    std::vector<unsigned char> seen(static_cast<std::size_t>(N) * N, 0);
-    std::vector<int> owner(static_cast<std::size_t>(N) * N, -1);
-    auto consider = [&](int k1, int k2) {
-        if (gcd(gcd(k1, k2), N) != 1 || seen[k1 * N + k2]) return;
-        // The class of k is first met as (1, m) when k1 is a unit; scale it
-        // to k2 = 1 when k2 is a unit (the Column layout).
-        if (gcd(k1, N) != 1 && gcd(k2, N) == 1) {
-            k1 = modulo(static_cast<long>(k1) * inverse_mod(k2, N), N);
+    std::vector<int> gcd_with_n(N);
+    for (int x = 0; x < N; ++x) gcd_with_n[x] = std::gcd(x, N);
+    auto unit = [&](int x) { return gcd_with_n[x] == 1; };
+    std::vector<unsigned char> claimed;  // modes owned by a later class, allocated when needed
+
+    auto add = [&](int k1, int k2) {
+        // A class met with a unit k2 is scaled to k2 = 1 (the Column layout).
+        if (!unit(k1) && unit(k2)) {
+            k1 = modulo(static_cast<std::int64_t>(k1) * inverse_mod(k2, N), N);
             k2 = 1;
         }
         Direction D;
         D.k1 = k1;
         D.k2 = k2;
-        const int index = static_cast<int>(dirs_.size());
         D.owned.assign(N, 0);
-        for (int s = 1; s < N; ++s) {
-            const int a = modulo(static_cast<long>(s) * k1, N), b = modulo(static_cast<long>(s) * k2, N);
-            if (gcd(s, N) == 1) seen[a * N + b] = 1;  // unit multiples: the same direction
-            if (owner[a * N + b] < 0) {
-                owner[a * N + b] = index;
-                D.owned[s] = 1;
+        if (k1 == 0) {  // (0,1), the first
+            std::fill(D.owned.begin() + 1, D.owned.end(), 1);
+        } else if (k1 == 1) {  // (1,m)
+            for (int s = 1; s < N; ++s) D.owned[s] = k2 < N / gcd_with_n[s];
+        } else {
+            for (int s = 1, a = k1, b = k2; s < N; ++s) {  // (a, b) = s k
+                if (unit(s)) {
+                    D.owned[s] = 1;
+                } else if (a != 0 && b % gcd_with_n[a] != 0) {
+                    if (claimed.empty()) claimed.assign(dim(), 0);
+                    unsigned char &owner = claimed[mode_index(a, b, N)];
+                    D.owned[s] = !owner;
+                    owner = 1;
+                }
+                a += k1;
+                if (a >= N) a -= N;
+                b += k2;
+                if (b >= N) b -= N;
             }
         }
         // Lines d j + s k, d in Z_N, tile Z_N^2 when j x k is a unit.
@@ -433,23 +502,34 @@ void SineEuler::build_directions() {
         } else if (k2 == 1) {
             D.j1 = 1, D.j2 = 0, D.layout = Direction::Column, D.sigma = 1;
         } else {
+            // k1 and k2 are both non-units here. j = (1, y): for each prime p
+            // of N, j x k = k2 - y k1 vanishes mod p for at most one y mod p,
+            // so the first unit comes after a few y.
             D.layout = Direction::General, D.sigma = 1;
             int cross = 0;
-            for (int x = 0; x < N && !cross; ++x)
-                for (int y = 0; y < N && !cross; ++y) {
-                    const int c = modulo(static_cast<long>(x) * k2 - static_cast<long>(y) * k1, N);
-                    if (c != 0 && gcd(c, N) == 1) D.j1 = x, D.j2 = y, cross = c;
-                }
+            for (int y = 0; y < N && !cross; ++y) {
+                const int c = modulo(k2 - static_cast<std::int64_t>(y) * k1, N);
+                if (unit(c)) D.j1 = 1, D.j2 = y, cross = c;
+            }
             const int inverse = inverse_mod(cross, N);  // scale j so that j x k = 1
-            D.j1 = modulo(static_cast<long>(D.j1) * inverse, N);
-            D.j2 = modulo(static_cast<long>(D.j2) * inverse, N);
+            D.j1 = modulo(static_cast<std::int64_t>(D.j1) * inverse, N);
+            D.j2 = modulo(static_cast<std::int64_t>(D.j2) * inverse, N);
         }
         dirs_.push_back(std::move(D));
     };
-    consider(0, 1);
-    for (int m = 0; m < N; ++m) consider(1, m);
-    for (int k1 = 0; k1 < N; ++k1)
-        for (int k2 = 0; k2 < N; ++k2) consider(k1, k2);
+    add(0, 1);
+    for (int m = 0; m < N; ++m) add(1, m);
+    std::vector<unsigned char> seen(N);  // row g: k2 whose class was met
+    for (int g = 3; g < N; g += 2) {
+        if (N % g != 0) continue;
+        std::fill(seen.begin(), seen.end(), 0);
+        for (int k2 = 0; k2 < N; ++k2) {
+            if (seen[k2] || std::gcd(gcd_with_n[g], gcd_with_n[k2]) != 1) continue;  // met, or not primitive
+            for (int u = 1; u < N; u += N / g)  // the units u = 1 mod N/g
+                if (unit(u)) seen[modulo(static_cast<std::int64_t>(u) * k2, N)] = 1;
+            add(g, k2);
+        }
+    }
 }
 
 void SineEuler::ensure_plans() {
@@ -503,8 +583,8 @@ bool SineEuler::line_spectrum(const Direction &D, const double *w) {
     for (int s = 0; s < N; ++s) {
         if (D.owned[s]) {
             const double scale = 1.0 / norm2_of(a, c);
-            b[s][0] = w[2 * (a * N + c)] * scale;
-            b[s][1] = w[2 * (a * N + c) + 1] * scale;
+            b[s][0] = w[2 * mode_index(a, c, N)] * scale;
+            b[s][1] = w[2 * mode_index(a, c, N) + 1] * scale;
             active = active || b[s][0] != 0.0 || b[s][1] != 0.0;
         } else {
             b[s][0] = b[s][1] = 0.0;
@@ -519,28 +599,30 @@ bool SineEuler::line_spectrum(const Direction &D, const double *w) {
     return true;
 }
 
-// u_l = exp(i t B_l / (2 eps)) with factor = t / (2 eps), stored three times
-// over, forwards and backwards, so that u_{l-c} and u_{l+c} need no reduction
-// mod N and run forwards along the lines of a block. Each l writes its own
-// entries only, so threads may share the loop over l.
+// v_l = u_l - 1 = exp(i phi_l) - 1 = (-2 sin^2(phi_l / 2), sin phi_l), phi_l =
+// factor B_l with factor = t / (2 eps), stored three times over, forwards and
+// backwards, so that v_{l-c} and v_{l+c} need no reduction mod N and run
+// forwards along the lines of a block. Each l writes its own entries only, so
+// threads may share the loop over l.
 void SineEuler::line_phase(int l, double factor) {
-    const int N = N_;
+    const std::size_t N = N_;
     double *up = plans_->up, *down = plans_->down;
     const double angle = factor * plans_->b[l][0];
-    const double cs = std::cos(angle), sn = std::sin(angle);
-    const int minus = l == 0 ? 0 : N - l;
-    for (int copy = 0; copy < 3; ++copy) {
-        up[2 * (l + copy * N)] = cs;
-        up[2 * (l + copy * N) + 1] = sn;
-        down[2 * (minus + copy * N)] = cs;
-        down[2 * (minus + copy * N) + 1] = sn;
+    const double half = std::sin(0.5 * angle);
+    const double re = -2.0 * half * half, im = std::sin(angle);
+    const std::size_t minus = l == 0 ? 0 : N - l;
+    for (std::size_t copy = 0; copy < 3; ++copy) {
+        up[2 * (l + copy * N)] = re;
+        up[2 * (l + copy * N) + 1] = im;
+        down[2 * (minus + copy * N)] = re;
+        down[2 * (minus + copy * N) + 1] = im;
     }
 }
 
 // Lines d = d0 .. d0+count-1 of direction D: gather z_s = w_{d j + s k} into
 // X[s * count + (d - d0)], transform along s, multiply by the line's
-// exp(t Lambda_l) / N, transform back, scatter, and write the conjugates to
-// the lines -d.
+// (exp(t Lambda_l) - 1) / N, transform back, add the increments to the modes
+// and write the conjugates of the sums to the lines -d.
 void SineEuler::move_block(const Direction &D, int block, fftw_complex *X, double *w) const {
     const int d0 = 1 + block * kBlock;
     const int count = std::min(kBlock, M_ - block * kBlock);
@@ -550,10 +632,11 @@ void SineEuler::move_block(const Direction &D, int block, fftw_complex *X, doubl
     // blocks are not in the same lane of w at the same moment (the lanes meet
     // at the blocks' edges, in shared cache lines). Every mode is written
     // once per flow, so the order changes no bit.
-    const int first_lane = static_cast<int>(static_cast<long>(block) * N_ / block_count());
+    const int first_lane = static_cast<int>(static_cast<std::int64_t>(block) * N_ / block_count());
     gather_block(D, N_, d0, count, first_lane, w, x);
     fftw_execute_dft(plans_->forward[plan], X, X);
-    apply_phase(N_, count, plans_->up + 2 * (N_ + d0), plans_->down + 2 * (N_ + d0), -D.sigma, x);
+    const std::size_t phase0 = 2 * (static_cast<std::size_t>(N_) + d0);
+    apply_phase(N_, count, plans_->up + phase0, plans_->down + phase0, -D.sigma, x);
     fftw_execute_dft(plans_->backward[plan], X, X);
     scatter_block(D, N_, d0, count, first_lane, x, w);
 }
@@ -620,7 +703,7 @@ double SineEuler::run_fft_floor(std::size_t flows) {
 template <class F>
 void for_half_plane(int N, F &&f) {
     const int M = (N - 1) / 2;
-    int i = 0;
+    std::size_t i = 0;
     for (int b = 1; b <= M; ++b) f(i++, 0, b);
     for (int a = 1; a <= M; ++a)
         for (int b = -M; b <= M; ++b) f(i++, a, modulo(b, N));
@@ -629,9 +712,9 @@ void for_half_plane(int N, F &&f) {
 void SineEuler::to_public(const double *state, double *x) const {
     const int N = N_;
     x[0] = state[0];
-    for_half_plane(N, [&](int i, int a, int b) {
-        x[1 + 2 * i] = state[2 * (a * N + b)];
-        x[2 + 2 * i] = state[2 * (a * N + b) + 1];
+    for_half_plane(N, [&](std::size_t i, int a, int b) {
+        x[1 + 2 * i] = state[2 * mode_index(a, b, N)];
+        x[2 + 2 * i] = state[2 * mode_index(a, b, N) + 1];
     });
 }
 
@@ -642,8 +725,8 @@ void SineEuler::from_public(const double *x, double *state) const {
             fail(LPI_ERR_NONFINITE, "state entry " + std::to_string(i) + " is not finite");
     state[0] = x[0];
     state[1] = 0.0;
-    for_half_plane(N, [&](int i, int a, int b) {
-        const std::size_t m = a * N + b, minus = (a ? N - a : 0) * N + (b ? N - b : 0);
+    for_half_plane(N, [&](std::size_t i, int a, int b) {
+        const std::size_t m = mode_index(a, b, N), minus = mirror_index(a, b, N);
         state[2 * m] = x[1 + 2 * i];
         state[2 * m + 1] = x[2 + 2 * i];
         state[2 * minus] = x[1 + 2 * i];
@@ -666,8 +749,8 @@ void SineEuler::public_from_modes(const double *w, double *x) const {
         fail(LPI_ERR_INVALID, "modes are not Hermitian: w(0,0) must be real, its imaginary part is " +
                                   std::to_string(w[1]));
     x[0] = w[0];
-    for_half_plane(N, [&](int i, int a, int b) {
-        const std::size_t m = a * N + b, minus = (a ? N - a : 0) * N + (b ? N - b : 0);
+    for_half_plane(N, [&](std::size_t i, int a, int b) {
+        const std::size_t m = mode_index(a, b, N), minus = mirror_index(a, b, N);
         const double dr = w[2 * m] - w[2 * minus], di = w[2 * m + 1] + w[2 * minus + 1];
         if (std::hypot(dr, di) > tolerance) {
             char text[256];
@@ -735,12 +818,66 @@ void SineEuler::public_from_grid(const double *values, double *x) const {
 
 }  // namespace
 
+namespace {
+
+// a * b, or false when it does not fit a std::size_t.
+bool checked_multiply(std::size_t a, std::size_t b, std::size_t &product) {
+    if (b != 0 && a > SIZE_MAX / b) return false;
+    product = a * b;
+    return true;
+}
+
+// Bytes of physical memory, 0 when the system does not say.
+std::size_t physical_memory() {
+#if defined(_SC_PHYS_PAGES) && defined(_SC_PAGESIZE)
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    std::size_t bytes = 0;
+    if (pages > 0 && page > 0 && checked_multiply(pages, page, bytes)) return bytes;
+#endif
+    return 0;
+}
+
+std::string gib(double bytes) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.3g GiB", bytes / (1024.0 * 1024.0 * 1024.0));
+    return text;
+}
+
+// A sine-Euler system holds two working states of 2 N^2 doubles (the state
+// and the copy a failed step rolls back to), one byte per mode and direction
+// to say which modes each piece owns, and for composite N one byte per mode
+// while the directions are built. Refused before anything is allocated when
+// that cannot be had: zero-filling vectors larger than the machine would
+// bring the out-of-memory killer, not std::bad_alloc.
+void require_memory(int N) {
+    std::size_t classes = N;
+    for (int p : prime_factors(N)) classes = classes / p * (p + 1);
+    const bool prime = classes == static_cast<std::size_t>(N) + 1;
+    const std::size_t n = N;
+    std::size_t modes = 0, states = 0, tables = 0, bytes = 0;
+    const bool fits = checked_multiply(n, n, modes) &&
+                      checked_multiply(modes, 2 * 2 * sizeof(double), states) &&
+                      checked_multiply(classes + (prime ? 0 : n), n, tables) &&
+                      states <= SIZE_MAX - tables;
+    const std::string what = "sine-Euler N = " + std::to_string(N) + " needs ";
+    const std::string parts = " (two working states of 2 N^2 doubles and the direction tables)";
+    if (!fits)
+        fail(LPI_ERR_NO_MEMORY, what + "more than " + std::to_string(SIZE_MAX) + " bytes" + parts);
+    bytes = states + tables;
+    const std::size_t available = physical_memory();
+    if (available != 0 && bytes > available)
+        fail(LPI_ERR_NO_MEMORY, what + std::to_string(bytes) + " bytes (" + gib(bytes) + ")" + parts +
+                                    "; this machine has " + std::to_string(available) + " bytes (" +
+                                    gib(available) + ") of physical memory");
+}
+
+}  // namespace
+
 std::unique_ptr<Model> make_sine_euler(int N) {
     if (N < 3 || N % 2 == 0)
         fail(LPI_ERR_INVALID, "N must be odd and >= 3 (Zeitlin's su(N) truncation), got " +
                                   std::to_string(N));
-    if (N > 46339)  // N^2 must fit an int index
-        fail(LPI_ERR_INVALID, "N = " + std::to_string(N) + " is too large");
+    require_memory(N);
     return std::make_unique<SineEuler>(N);
 }
 

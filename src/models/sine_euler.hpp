@@ -37,7 +37,8 @@ public:
 };
 
 // Throws LPI_ERR_UNSUPPORTED when built without FFTW3, LPI_ERR_INVALID for
-// even N or N < 3.
+// even N or N < 3, LPI_ERR_NO_MEMORY (before allocating anything) when the
+// system would need more bytes than the machine's physical memory.
 std::unique_ptr<Model> make_sine_euler(int N);
 
 // The FFTW planner is not thread-safe: every plan creation, destruction and

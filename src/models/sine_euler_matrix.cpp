@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -29,15 +30,17 @@ std::vector<cplx> roots_of_unity(int N) {
 }
 
 int rep(int a, int N) { return a > N / 2 ? a - N : a; }
+// Entry (a, b) of an N x N array; a N + b overflows an int past N = 46340.
+std::size_t at(int a, int b, int N) { return static_cast<std::size_t>(a) * N + b; }
 
 // C = A B for N x N row-major complex matrices.
 void multiply(int N, const cplx *A, const cplx *B, cplx *C) {
-    for (int i = 0; i < N * N; ++i) C[i] = 0.0;
+    std::fill(C, C + at(N, 0, N), cplx(0.0));
     for (int i = 0; i < N; ++i)
         for (int k = 0; k < N; ++k) {
-            const cplx a = A[i * N + k];
-            const cplx *b = B + k * N;
-            cplx *c = C + i * N;
+            const cplx a = A[at(i, k, N)];
+            const cplx *b = B + at(k, 0, N);
+            cplx *c = C + at(i, 0, N);
             for (int j = 0; j < N; ++j) c[j] += a * b[j];
         }
 }
@@ -54,11 +57,11 @@ void sine_euler_modes_to_matrix(int N, const double *modes, double *W_out) {
             cplx sum = 0.0;
             int phase = 0;
             for (int m1 = 0; m1 < N; ++m1) {
-                sum += w[m1 * N + m2] * root[phase];
+                sum += w[at(m1, m2, N)] * root[phase];
                 phase += step;
                 if (phase >= N) phase -= N;
             }
-            W[a * N + (a + m2) % N] = sum;
+            W[at(a, (a + m2) % N, N)] = sum;
         }
 }
 
@@ -70,10 +73,10 @@ void sine_euler_matrix_to_modes(int N, const double *W_in, double *modes) {
         for (int m2 = 0; m2 < N; ++m2) {
             cplx sum = 0.0;
             for (int a = 0; a < N; ++a) {
-                const int phase = static_cast<int>((static_cast<long>(m1) * (2 * a + m2)) % N);
-                sum += W[a * N + (a + m2) % N] * std::conj(root[phase]);
+                const int phase = static_cast<int>((static_cast<std::int64_t>(m1) * (2 * a + m2)) % N);
+                sum += W[at(a, (a + m2) % N, N)] * std::conj(root[phase]);
             }
-            w[m1 * N + m2] = sum / static_cast<double>(N);
+            w[at(m1, m2, N)] = sum / static_cast<double>(N);
         }
 }
 
@@ -83,9 +86,9 @@ void sine_euler_matrix_vector_field(int N, const double *modes, double *rate) {
     const cplx *w = reinterpret_cast<const cplx *>(modes);
     for (int a = 0; a < N; ++a)
         for (int b = 0; b < N; ++b) {
-            const int ra = rep(a, N), rb = rep(b, N);
-            const int norm2 = ra * ra + rb * rb;
-            p[a * N + b] = norm2 ? w[a * N + b] / static_cast<double>(norm2) : 0.0;
+            const std::int64_t ra = rep(a, N), rb = rep(b, N);
+            const std::int64_t norm2 = ra * ra + rb * rb;
+            p[at(a, b, N)] = norm2 ? w[at(a, b, N)] / static_cast<double>(norm2) : 0.0;
         }
     sine_euler_modes_to_matrix(N, modes, reinterpret_cast<double *>(W.data()));
     sine_euler_modes_to_matrix(N, reinterpret_cast<const double *>(p.data()),
@@ -109,7 +112,7 @@ void sine_euler_traces(int N, const double *modes, int kmax, double *out) {
             power.swap(next);
         }
         double trace = 0.0;
-        for (int i = 0; i < N; ++i) trace += power[i * N + i].real();
+        for (int i = 0; i < N; ++i) trace += power[at(i, i, N)].real();
         out[k - 1] = trace / N;
     }
 }
