@@ -141,6 +141,14 @@ struct Plans {
 #else
 #define LPI_SIMD_CLONES
 #endif
+// The line moves below are inlined into the cloned gather_block and
+// scatter_block: a function they call instead would be compiled for the
+// baseline only.
+#if defined(__GNUC__)
+#define LPI_INLINE inline __attribute__((always_inline))
+#else
+#define LPI_INLINE inline
+#endif
 
 // Multiplies the transformed block x (N rows of `count` lines) by the line
 // flows' increments (exp(t Lambda_l) - 1) / N. Line i of the block
@@ -182,7 +190,7 @@ void apply_phase(int N, int count, const double *up, const double *down, double 
 
 // Count > 0: the block size, known at compile time (full blocks); 0: count.
 template <bool Rows, int Count>
-inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
+LPI_INLINE void gather_runs(int N, int slope, int d0, int count, int first_lane,
                         const double *__restrict w, double *__restrict x) {
     const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
     const int n = Count > 0 ? Count : count;
@@ -204,41 +212,41 @@ inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
     }
 }
 
-// Adds n increments to positions p0 .. p0+n-1 (p0 + n <= N) of a lane, keeps
-// the sums in `increment`, and writes their conjugates at positions
-// -(p0 + r) mod N of the mirror lane.
-inline void put_run(int N, std::size_t step, int p0, int n, double *__restrict increment, double *lane,
-                    double *mirror) {
+// Adds n increments to positions p0 .. p0+n-1 (p0 + n <= N) of a lane and
+// writes the conjugates of the sums at positions -(p0 + r) mod N of the
+// mirror lane.
+LPI_INLINE void put_run(int N, std::size_t step, int p0, int n, const double *__restrict increment,
+                        double *lane, double *mirror) {
     if (n <= 0) return;
-    for (int r = 0; r < n; ++r) {
-        double *z = lane + 2 * step * (p0 + r);
-        const double re = z[0] + increment[2 * r], im = z[1] + increment[2 * r + 1];
-        z[0] = increment[2 * r] = re;
-        z[1] = increment[2 * r + 1] = im;
-    }
+    double *z = lane + 2 * step * p0;
     int r0 = 0;
     if (p0 == 0) {  // position 0 is its own mirror position
-        mirror[0] = increment[0];
-        mirror[1] = -increment[1];
+        z[0] += increment[0];
+        z[1] += increment[1];
+        mirror[0] = z[0];
+        mirror[1] = -z[1];
         r0 = 1;
     }
-    // Upwards through the mirror lane: position N - p0 - r, r = n-1 .. r0.
-    double *m = mirror + 2 * step * (N - p0 - (n - 1));
-    const double *z = increment + 2 * (n - 1);
-    for (int q = 0; q < n - r0; ++q) {
-        m[2 * step * q] = z[-2 * q];
-        m[2 * step * q + 1] = -z[-2 * q + 1];
+    // Position p0 + r and its mirror N - p0 - r, in one pass.
+    for (int r = r0; r < n; ++r) {
+        const double re = z[2 * step * r] + increment[2 * r];
+        const double im = z[2 * step * r + 1] + increment[2 * r + 1];
+        double *m = mirror + 2 * step * (N - p0 - r);
+        z[2 * step * r] = re;
+        z[2 * step * r + 1] = im;
+        m[0] = re;
+        m[1] = -im;
     }
 }
 
 template <bool Rows, int Count>
-inline void scatter_runs(int N, int slope, int d0, int count, int first_lane, double *__restrict x,
-                         double *w) {
+LPI_INLINE void scatter_runs(int N, int slope, int d0, int count, int first_lane,
+                         const double *__restrict x, double *w) {
     const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
     const int n = Count > 0 ? Count : count;
     int o = modulo(d0 + static_cast<std::int64_t>(first_lane) * slope, N);
     for (int k = 0, s = first_lane; k < N; ++k, s = s + 1 < N ? s + 1 : 0) {
-        double *src = x + 2 * static_cast<std::size_t>(s) * n;
+        const double *src = x + 2 * static_cast<std::size_t>(s) * n;
         double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
         if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
             put_run(N, step, o, n, src, dst, mirror);
@@ -254,7 +262,7 @@ inline void scatter_runs(int N, int slope, int d0, int count, int first_lane, do
 
 // Any direction, one mode at a time: element s of line d0 + i is at
 // (d0 + i) j + s k.
-inline void gather_general(const Direction &D, int N, int d0, int count, const double *w, double *x) {
+LPI_INLINE void gather_general(const Direction &D, int N, int d0, int count, const double *w, double *x) {
     int a0 = modulo(static_cast<std::int64_t>(d0) * D.j1, N), b0 = modulo(static_cast<std::int64_t>(d0) * D.j2, N);
     for (int s = 0; s < N; ++s) {
         int a = a0, b = b0;
@@ -275,7 +283,7 @@ inline void gather_general(const Direction &D, int N, int d0, int count, const d
     }
 }
 
-inline void scatter_general(const Direction &D, int N, int d0, int count, const double *x, double *w) {
+LPI_INLINE void scatter_general(const Direction &D, int N, int d0, int count, const double *x, double *w) {
     int a0 = modulo(static_cast<std::int64_t>(d0) * D.j1, N), b0 = modulo(static_cast<std::int64_t>(d0) * D.j2, N);
     for (int s = 0; s < N; ++s) {
         int a = a0, b = b0;
@@ -318,7 +326,7 @@ void gather_block(const Direction &D, int N, int d0, int count, int first_lane, 
 }
 
 LPI_SIMD_CLONES
-void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, double *x,
+void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
                    double *w) {
     switch (D.layout) {
         case Direction::Row:
@@ -607,9 +615,10 @@ bool SineEuler::line_spectrum(const Direction &D, const double *w) {
 void SineEuler::line_phase(int l, double factor) {
     const std::size_t N = N_;
     double *up = plans_->up, *down = plans_->down;
-    const double angle = factor * plans_->b[l][0];
-    const double half = std::sin(0.5 * angle);
-    const double re = -2.0 * half * half, im = std::sin(angle);
+    // One sincos of the half angle: sin phi = 2 sin(phi/2) cos(phi/2).
+    const double half = 0.5 * factor * plans_->b[l][0];
+    const double sh = std::sin(half), ch = std::cos(half);
+    const double re = -2.0 * sh * sh, im = 2.0 * sh * ch;
     const std::size_t minus = l == 0 ? 0 : N - l;
     for (std::size_t copy = 0; copy < 3; ++copy) {
         up[2 * (l + copy * N)] = re;
