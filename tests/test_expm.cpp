@@ -81,18 +81,30 @@ std::vector<double> random_matrix(std::size_t n, double norm, std::mt19937_64 &r
     return A;
 }
 
+// The terms of A (its nonzeros, each its own parameter, g = its value).
+std::vector<lpi::SparseTerm> terms_of(std::size_t n, const std::vector<double> &A,
+                                      std::vector<double> *g) {
+    std::vector<lpi::SparseTerm> terms;
+    g->clear();
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < n; ++j)
+            if (A[i * n + j] != 0.0) {
+                terms.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j),
+                                 static_cast<std::uint32_t>(g->size()), 1.0});
+                g->push_back(A[i * n + j]);
+            }
+    return terms;
+}
+
 // y = E x for the sparse path, to compare against a dense exponential.
 std::vector<double> apply_sparse(std::size_t n, const std::vector<double> &A, const std::vector<double> &x,
                                  lpi::ExpmPath *path, long *depth) {
-    std::vector<lpi::SparseEntry> entries;
-    for (std::size_t i = 0; i < n; ++i)
-        for (std::size_t j = 0; j < n; ++j)
-            if (A[i * n + j] != 0.0)
-                entries.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j), A[i * n + j]});
-    lpi::ExpmWorkspace workspace;
+    std::vector<double> g;
+    lpi::SparseExponential exponential(n, terms_of(n, A, &g));
     std::vector<double> y = x;
-    *path = workspace.apply(n, entries, 1.0, y.data());
-    *depth = workspace.last_depth();
+    exponential.apply(g.data(), 1.0, y.data());
+    *path = exponential.path();
+    *depth = exponential.depth();
     return y;
 }
 
@@ -219,12 +231,15 @@ void test_nilpotent_matrices(void **) {
     apply_sparse(n, A, x, &path, &depth);
     assert_int_equal(static_cast<int>(path), static_cast<int>(lpi::ExpmPath::Pade));
     assert_int_equal(depth, -1);
-    // An explicit zero does not close a cycle.
-    std::vector<lpi::SparseEntry> cycle = {{0, 1, 2.0}, {1, 0, 0.0}};
-    lpi::ExpmWorkspace workspace;
+    // The pattern decides the path, not the values of a call: a cycle whose
+    // entry is zero in this call is the closed-form 2x2 path, exact here.
+    const std::vector<lpi::SparseTerm> cycle = {{0, 1, 0, 2.0}, {1, 0, 1, 1.0}};
+    lpi::SparseExponential exponential(2, cycle);
+    assert_int_equal(static_cast<int>(exponential.path()), static_cast<int>(lpi::ExpmPath::Plane));
+    assert_int_equal(exponential.depth(), -1);
+    const double g[2] = {1.0, 0.0};
     double z[2] = {3.0, 5.0};
-    assert_int_equal(static_cast<int>(workspace.apply(2, cycle, 0.5, z)),
-                     static_cast<int>(lpi::ExpmPath::Nilpotent));
+    exponential.apply(g, 0.5, z);
     assert_true(z[0] == 3.0 + 0.5 * 2.0 * 5.0 && z[1] == 5.0);
 }
 
@@ -233,20 +248,27 @@ void test_sparse_nilpotent_scales_with_nonzeros(void **) {
     // depth 2. A dense exponential of this size (n = 300000) could not even be
     // stored; the series touches only the nonzeros.
     const std::uint32_t layer = 100000, n = 3 * layer;
-    std::vector<lpi::SparseEntry> entries;
+    struct Entry {
+        std::uint32_t row, col;
+        double value;
+    };
+    std::vector<Entry> entries;
     for (std::uint32_t i = 0; i < 2 * layer; ++i) {
         const std::uint32_t base = (i / layer + 1) * layer, offset = i % layer;
         entries.push_back({base + offset, i, 0.5});
         entries.push_back({base + (offset + 1) % layer, i, -0.25});
     }
+    // One parameter: A = g C with g = 1.
+    std::vector<lpi::SparseTerm> terms;
+    for (const Entry &e : entries) terms.push_back({e.row, e.col, 0, e.value});
     std::vector<double> x(n), y(n);
     for (std::uint32_t i = 0; i < n; ++i) x[i] = std::sin(0.001 * i) + 1.0;
     y = x;
-    const double t = 0.7;
-    lpi::ExpmWorkspace workspace;
-    assert_int_equal(static_cast<int>(workspace.apply(n, entries, t, y.data())),
-                     static_cast<int>(lpi::ExpmPath::Nilpotent));
-    assert_int_equal(workspace.last_depth(), 2);
+    const double t = 0.7, g = 1.0;
+    lpi::SparseExponential exponential(n, terms);
+    assert_int_equal(static_cast<int>(exponential.path()), static_cast<int>(lpi::ExpmPath::Nilpotent));
+    assert_int_equal(exponential.depth(), 2);
+    exponential.apply(&g, t, y.data());
     // Reference: x + t A x + t^2 A^2 x / 2 with plain loops.
     std::vector<double> Ax(n, 0.0), AAx(n, 0.0);
     for (const auto &e : entries) Ax[e.row] += e.value * x[e.col];
