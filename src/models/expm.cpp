@@ -202,29 +202,42 @@ void expm1_with(std::size_t n, const double *A, double *W, std::vector<double> &
 
 // exp(A) - I of a 2x2 A = [[a, b], [c, d]] (W row-major) in closed form:
 // A = tau I + N, tau = (a + d) / 2, N^2 = delta I with delta = -det N, so
-// exp(A) = e^tau (C I + S N), C = cosh or cos of sqrt|delta|, S = sinh or
-// sin of it over itself. Formed as differences from I (C - 1 from the half
-// angle, expm1 for e^tau) so that W is accurate relative to ||A||.
+// exp(A) = e^tau (C I + S N), C = cosh or cos of r = sqrt|delta|, S = sinh r
+// or sin r over r. Formed as differences from I (C - 1 from the half angle,
+// expm1 for e^tau) so that W is accurate relative to ||A||.
 void plane_expm1(double a, double b, double c, double d, double W[4]) {
     const double tau = 0.5 * (a + d), p = 0.5 * (a - d);
-    const double delta = p * p + b * c;
-    double c_minus_1 = 0.0, s = 1.0;
-    if (delta > 0.0) {
-        const double r = std::sqrt(delta), h = std::sinh(0.5 * r);
-        c_minus_1 = 2.0 * h * h;
-        s = 2.0 * h * std::sqrt(1.0 + h * h) / r;  // sinh r / r
-    } else if (delta < 0.0) {
-        const double r = std::sqrt(-delta), h = std::sin(0.5 * r);
+    double c_minus_1 = 0.0, sp = p, sb = b, sc = c;  // C - 1 and S times p, b, c
+    if (p == 0.0 && c == -b) {
+        // A rotation generator (the Lie-Poisson rotations: so(3), e(2)):
+        // r = |b| and S b = sin b, with no square root or division.
+        const double h = std::sin(0.5 * b);
         c_minus_1 = -2.0 * h * h;
-        s = 2.0 * h * std::cos(0.5 * r) / r;  // sin r / r
+        sb = 2.0 * h * std::cos(0.5 * b);
+        sc = -sb;
+    } else {
+        const double delta = p * p + b * c;
+        double s = 1.0;
+        if (delta > 0.0) {
+            const double r = std::sqrt(delta), inverse_r = 1.0 / r, h = std::sinh(0.5 * r);
+            c_minus_1 = 2.0 * h * h;
+            s = 2.0 * h * std::sqrt(1.0 + h * h) * inverse_r;  // sinh r / r
+        } else if (delta < 0.0) {
+            const double r = std::sqrt(-delta), inverse_r = 1.0 / r, h = std::sin(0.5 * r);
+            c_minus_1 = -2.0 * h * h;
+            s = 2.0 * h * std::cos(0.5 * r) * inverse_r;  // sin r / r
+        }
+        sp = s * p;
+        sb = s * b;
+        sc = s * c;
     }
     // The Lie-Poisson rotations are traceless: no exponential to take.
     const double scale_minus_1 = tau == 0.0 ? 0.0 : std::expm1(tau);
     const double scale = 1.0 + scale_minus_1;
-    W[0] = scale * (c_minus_1 + s * p) + scale_minus_1;
-    W[1] = scale * s * b;
-    W[2] = scale * s * c;
-    W[3] = scale * (c_minus_1 - s * p) + scale_minus_1;
+    W[0] = scale * (c_minus_1 + sp) + scale_minus_1;
+    W[1] = scale * sb;
+    W[2] = scale * sc;
+    W[3] = scale * (c_minus_1 - sp) + scale_minus_1;
 }
 
 }  // namespace
@@ -265,12 +278,17 @@ std::size_t square_entries(std::size_t n, const char *what) {
 
 // ---- sparse exponentials of a fixed pattern -----------------------------------
 
-SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> terms)
-    : terms_(std::move(terms)) {
-    std::sort(terms_.begin(), terms_.end(), [](const SparseTerm &a, const SparseTerm &b) {
+SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> terms) {
+    std::sort(terms.begin(), terms.end(), [](const SparseTerm &a, const SparseTerm &b) {
         return std::tie(a.row, a.col, a.parameter) < std::tie(b.row, b.col, b.parameter);
     });
-    // The indices the pattern touches, numbered locally in order of appearance.
+    // Distinct positions (terms first .. end - 1) and the indices they touch,
+    // numbered locally in order of appearance.
+    struct Position {
+        std::uint32_t row, col;  // local
+        std::size_t first, end;
+    };
+    std::vector<Position> positions;
     std::vector<std::int64_t> local_of(n, -1);
     std::vector<std::uint32_t> touched;
     auto local = [&](std::uint32_t g) {
@@ -280,29 +298,27 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
         }
         return static_cast<std::uint32_t>(local_of[g]);
     };
-    for (std::size_t q = 0; q < terms_.size(); ++q) {
-        const SparseTerm &term = terms_[q];
-        if (q > 0 && term.row == terms_[q - 1].row && term.col == terms_[q - 1].col) continue;
-        block_.push_back({local(term.row), local(term.col),
-                          static_cast<std::uint32_t>(term_begin_.size())});
-        term_begin_.push_back(q);
+    for (std::size_t q = 0; q < terms.size(); ++q) {
+        if (q > 0 && terms[q].row == terms[q - 1].row && terms[q].col == terms[q - 1].col) {
+            positions.back().end = q + 1;
+            continue;
+        }
+        positions.push_back({local(terms[q].row), local(terms[q].col), q, q + 1});
     }
-    term_begin_.push_back(terms_.size());
-    scaled_.resize(block_.size());
     const std::size_t m = touched.size();
 
     // Levels by Kahn's algorithm on edges col -> row (x_col drives x_row):
     // level[v] is the longest path ending at v. A cycle (a self-loop
     // included) means the pattern does not force nilpotency.
     std::vector<std::size_t> start(m + 1, 0), cursor;
-    std::vector<std::uint32_t> indegree(m, 0), adjacency(block_.size()), queue;
-    for (const BlockEntry &e : block_) {
+    std::vector<std::uint32_t> indegree(m, 0), adjacency(positions.size()), queue;
+    for (const Position &e : positions) {
         ++start[e.col + 1];
         ++indegree[e.row];
     }
     for (std::size_t v = 0; v < m; ++v) start[v + 1] += start[v];
     cursor.assign(start.begin(), start.end() - 1);
-    for (const BlockEntry &e : block_) adjacency[cursor[e.col]++] = e.row;
+    for (const Position &e : positions) adjacency[cursor[e.col]++] = e.row;
     for (std::uint32_t v = 0; v < m; ++v)
         if (indegree[v] == 0) queue.push_back(v);
     std::vector<std::size_t> level(m, 0);
@@ -319,65 +335,50 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
     if (queue.size() != m) {
         path_ = m <= 2 ? ExpmPath::Plane : ExpmPath::Pade;
         moved_ = std::move(touched);
-        increment_.resize(m);
-        return;
+        for (const Position &e : positions) block_.push_back({e.row, e.col});
+    } else {
+        // Nilpotent: the moved indices (level >= 1) by level are in
+        // topological order; each position goes with the node of its row.
+        path_ = ExpmPath::Nilpotent;
+        std::vector<std::uint32_t> order;
+        for (std::uint32_t v = 0; v < m; ++v)
+            if (level[v] >= 1) order.push_back(v);
+        std::stable_sort(order.begin(), order.end(),
+                         [&](std::uint32_t u, std::uint32_t v) { return level[u] < level[v]; });
+        std::vector<std::uint32_t> node_of(m, 0);
+        for (std::uint32_t r = 0; r < order.size(); ++r) {
+            node_of[order[r]] = r;
+            moved_.push_back(touched[order[r]]);
+            nodes_.push_back({touched[order[r]], 0, 0});
+        }
+        auto fixed = [&](const Position &e) { return level[e.col] == 0; };
+        std::stable_sort(positions.begin(), positions.end(),
+                         [&](const Position &a, const Position &b) {
+                             return std::make_pair(node_of[a.row], !fixed(a)) <
+                                    std::make_pair(node_of[b.row], !fixed(b));
+                         });
+        for (const Position &e : positions) {
+            SeriesNode &node = nodes_[node_of[e.row]];
+            ++(fixed(e) ? node.fixed_columns : node.moved_columns);
+            columns_.push_back(fixed(e) ? touched[e.col] : node_of[e.col]);
+        }
+        lanes_ = depth_ <= 1 ? 1 : depth_ <= 2 ? 2 : depth_ <= 4 ? 4 : depth_ <= 8 ? 8 : depth_;
+        for (std::size_t k = 0; k < lanes_; ++k) inverse_.push_back(1.0 / static_cast<double>(k + 1));
+        coefficients_.resize(nodes_.size() * lanes_);
+        accumulator_.resize(lanes_);
     }
-
-    // Nilpotent: term k of the series, (tA)^k x / k!, is zero except at
-    // indices of level >= k, and only entries whose column has level >= k - 1
-    // feed it. Moved indices (level >= 1) and entries are ordered deepest
-    // first, so that each term uses prefixes of both.
-    path_ = ExpmPath::Nilpotent;
-    std::vector<std::uint32_t> order;
-    for (std::uint32_t v = 0; v < m; ++v)
-        if (level[v] >= 1) order.push_back(v);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](std::uint32_t u, std::uint32_t v) { return level[u] > level[v]; });
-    std::vector<std::uint32_t> moved_index(m, 0);
-    for (std::uint32_t r = 0; r < order.size(); ++r) {
-        moved_index[order[r]] = r;
-        moved_.push_back(touched[order[r]]);
+    for (std::uint32_t j = 0; j < positions.size(); ++j) {
+        first_terms_.push_back(terms[positions[j].first]);
+        for (std::size_t q = positions[j].first + 1; q < positions[j].end; ++q)
+            further_terms_.push_back({j, terms[q].parameter, terms[q].coefficient});
     }
-    std::vector<BlockEntry> by_row = block_;
-    std::stable_sort(by_row.begin(), by_row.end(), [&](const BlockEntry &a, const BlockEntry &b) {
-        if (a.row != b.row) return moved_index[a.row] < moved_index[b.row];
-        return level[a.col] > level[b.col];
-    });
-    const std::size_t moved = order.size();
-    row_begin_.assign(moved + 1, 0);
-    row_end_.assign((depth_ + 1) * moved, 0);
-    for (const BlockEntry &e : by_row) {
-        const std::uint32_t v = moved_index[e.row];
-        ++row_begin_[v + 1];
-        for (std::size_t k = 1; k <= depth_ && level[e.col] + 1 >= k; ++k) ++row_end_[k * moved + v];
-        series_.push_back({moved_index[e.col], touched[e.col], e.source});
-    }
-    for (std::size_t v = 0; v < moved; ++v) {
-        row_begin_[v + 1] += row_begin_[v];
-        for (std::size_t k = 1; k <= depth_; ++k) row_end_[k * moved + v] += row_begin_[v];
-    }
-    block_.clear();
-    rows_used_.assign(depth_ + 1, 0);
-    inverse_.assign(depth_ + 1, 0.0);
-    for (std::size_t k = 1; k <= depth_; ++k) {
-        for (std::uint32_t v : order) rows_used_[k] += level[v] >= k ? 1 : 0;
-        inverse_[k] = 1.0 / static_cast<double>(k);
-    }
-    term_.resize(moved);
-    next_.resize(moved);
-    increment_.resize(moved);
+    scaled_.resize(positions.size());
+    increment_.resize(moved_.size());
 }
 
-void SparseExponential::check_finite(std::size_t m) const {
-    // x is left untouched when the exact flow is not representable.
-    bool finite = true;
-    for (std::size_t v = 0; v < m; ++v) finite &= std::isfinite(increment_[v]);
-    if (!finite) fail_nonfinite(m);
-}
-
-void SparseExponential::fail_nonfinite(std::size_t m) const {
+void SparseExponential::fail_nonfinite() const {
     std::size_t v = 0;
-    while (v + 1 < m && std::isfinite(increment_[v])) ++v;
+    while (v + 1 < moved_.size() && std::isfinite(increment_[v])) ++v;
     fail(LPI_ERR_NONFINITE, "the exact flow overflows (component " + std::to_string(moved_[v]) + ")");
 }
 
@@ -399,71 +400,101 @@ void SparseExponential::check_norm(double norm, double t) const {
     }
 }
 
+void SparseExponential::scale_entries(const double *g, double t) {
+    const SparseTerm *first = first_terms_.data();
+    double *scaled = scaled_.data();
+    const std::size_t count = first_terms_.size();
+    if (further_terms_.empty()) {  // the usual case: one term a position
+        for (std::size_t j = 0; j < count; ++j)
+            scaled[j] = t * (first[j].coefficient * g[first[j].parameter]);
+        return;
+    }
+    for (std::size_t j = 0; j < count; ++j)
+        scaled[j] = first[j].coefficient * g[first[j].parameter];
+    for (const Term &q : further_terms_) scaled[q.position] += q.coefficient * g[q.parameter];
+    for (std::size_t j = 0; j < count; ++j) scaled[j] *= t;
+}
+
+// One pass over the nodes in topological order, each node's Taylor
+// coefficients from those of the nodes it reads: c_v[k] for all k at once,
+// in `Lanes` lanes that the compiler unrolls (0: lanes_ at run time).
+// Lanes beyond a node's level hold exact zeros. A node's component is read
+// (into c_v[0]) before it is written, and written as x + increment, rounded
+// once. Returns false, x restored, when an increment is not finite.
+template <std::size_t Lanes>
+bool SparseExponential::sweep(double *x) {
+    const std::size_t lanes = Lanes ? Lanes : lanes_;
+    double fixed_width[Lanes ? Lanes : 1];
+    double *acc = Lanes ? fixed_width : accumulator_.data();
+    const double *a = scaled_.data();
+    const std::uint32_t *column = columns_.data();
+    const double *inverse = inverse_.data();
+    double *coefficients = coefficients_.data();
+    bool finite = true;
+    for (std::size_t v = 0; v < nodes_.size(); ++v) {
+        const SeriesNode &node = nodes_[v];
+        for (std::size_t k = 0; k < lanes; ++k) acc[k] = 0.0;
+        for (std::uint32_t i = 0; i < node.fixed_columns; ++i, ++a, ++column)
+            acc[0] += *a * x[*column];
+        for (std::uint32_t i = 0; i < node.moved_columns; ++i, ++a, ++column) {
+            const double *c = coefficients + static_cast<std::size_t>(*column) * lanes;
+            for (std::size_t k = 0; k < lanes; ++k) acc[k] += *a * c[k];
+        }
+        // c_v[k + 1] = acc[k] / (k + 1); the increment sums them in order of k.
+        double *own = coefficients + v * lanes;
+        own[0] = x[node.global];
+        double total = 0.0;
+        for (std::size_t k = 0; k < lanes; ++k) {
+            const double term = acc[k] * inverse[k];
+            total += term;
+            if (k + 1 < lanes) own[k + 1] = term;
+        }
+        increment_[v] = total;
+        finite &= std::isfinite(total);
+        x[node.global] = own[0] + total;
+    }
+    if (finite) return true;
+    for (std::size_t v = 0; v < nodes_.size(); ++v) x[nodes_[v].global] = coefficients[v * lanes];
+    return false;
+}
+
 void SparseExponential::apply(const double *g, double t, double *x) {
     scale_entries(g, t);
-    if (path_ == ExpmPath::Nilpotent)
-        apply_series(x);
-    else
+    if (path_ != ExpmPath::Nilpotent) {
         apply_block(t, x);
-}
-
-void SparseExponential::scale_entries(const double *g, double t) {
-    for (std::size_t j = 0; j + 1 < term_begin_.size(); ++j) {
-        double value = 0.0;
-        for (std::size_t q = term_begin_[j]; q < term_begin_[j + 1]; ++q)
-            value += terms_[q].coefficient * g[terms_[q].parameter];
-        scaled_[j] = t * value;
+        return;
     }
-}
-
-void SparseExponential::apply_series(double *x) {
-    const std::size_t moved = moved_.size();
-    if (moved == 0) return;
-    // The first term reads x itself; the k-th the (k-1)-th, on prefixes. Each
-    // row is summed in a register and stored once.
-    for (std::size_t v = 0; v < moved; ++v) {
-        double s = 0.0;
-        for (std::size_t e = row_begin_[v]; e < row_begin_[v + 1]; ++e)
-            s += scaled_[series_[e].source] * x[series_[e].col_global];
-        term_[v] = s;
-        increment_[v] = s;
+    bool finite = true;
+    switch (lanes_) {
+        case 1: finite = sweep<1>(x); break;
+        case 2: finite = sweep<2>(x); break;
+        case 4: finite = sweep<4>(x); break;
+        case 8: finite = sweep<8>(x); break;
+        default: finite = sweep<0>(x); break;
     }
-    for (std::size_t k = 2; k <= depth_; ++k) {
-        const std::size_t *row_end = &row_end_[k * moved];
-        for (std::size_t v = 0; v < rows_used_[k]; ++v) {
-            double s = 0.0;
-            for (std::size_t e = row_begin_[v]; e < row_end[v]; ++e)
-                s += scaled_[series_[e].source] * term_[series_[e].col_local];
-            next_[v] = s * inverse_[k];
-            increment_[v] += next_[v];
-        }
-        term_.swap(next_);
-    }
-    // One rounding on x: the increment is summed first.
-    check_finite(moved);
-    for (std::size_t v = 0; v < moved; ++v) x[moved_[v]] += increment_[v];
+    if (!finite) fail_nonfinite();
 }
 
 void SparseExponential::apply_block(double t, double *x) {
     const std::size_t m = moved_.size();
     if (m <= 2) {
         double A[4] = {0.0, 0.0, 0.0, 0.0};
-        for (const BlockEntry &e : block_) A[e.row * 2 + e.col] = scaled_[e.source];
+        for (std::size_t j = 0; j < block_.size(); ++j)
+            A[block_[j].row * 2 + block_[j].col] = scaled_[j];
         check_norm(std::max(std::fabs(A[0]) + std::fabs(A[2]), std::fabs(A[1]) + std::fabs(A[3])),
                    t);
-        const double x0 = x[moved_[0]];
-        if (m == 1) {
-            increment_[0] = std::expm1(A[0]) * x0;
-        } else {
-            const double x1 = x[moved_[1]];
-            double W[4];
+        const double x0 = x[moved_[0]], x1 = m == 2 ? x[moved_[1]] : 0.0;
+        double W[4];
+        if (m == 1)
+            W[0] = std::expm1(A[0]), W[1] = W[2] = W[3] = 0.0;
+        else
             plane_expm1(A[0], A[1], A[2], A[3], W);
-            increment_[0] = W[0] * x0 + W[1] * x1;
-            increment_[1] = W[2] * x0 + W[3] * x1;
-        }
+        increment_[0] = W[0] * x0 + W[1] * x1;
+        if (m == 2) increment_[1] = W[2] * x0 + W[3] * x1;
     } else {
         dense_.assign(square_entries(m, "exponential's matrix"), 0.0);
-        for (const BlockEntry &e : block_) dense_[e.row * m + e.col] = scaled_[e.source];
+        for (std::size_t j = 0; j < block_.size(); ++j)
+            dense_[block_[j].row * m + block_[j].col] = scaled_[j];
         check_norm(norm1(m, dense_.data()), t);
         exp_.resize(dense_.size());
         expm1_with(m, dense_.data(), exp_.data(), pade_scratch_);
@@ -474,8 +505,11 @@ void SparseExponential::apply_block(double t, double *x) {
         }
     }
     // x += (exp(tA) - I) x: the increment carries its own small rounding
-    // errors, and x is rounded once (as in the nilpotent branch).
-    check_finite(m);
+    // errors, and x is rounded once (as in the nilpotent branch). x is left
+    // untouched when the exact flow is not representable.
+    bool finite = true;
+    for (std::size_t r = 0; r < m; ++r) finite &= std::isfinite(increment_[r]);
+    if (!finite) fail_nonfinite();
     for (std::size_t r = 0; r < m; ++r) x[moved_[r]] += increment_[r];
 }
 

@@ -76,47 +76,52 @@ public:
     void apply(const double *g, double t, double *x);
 
 private:
-    // An entry of the nilpotent path, in the row of the moved index it
-    // feeds: its column is read from x in the first term (global index) and
-    // from the previous term after that (local index).
-    struct SeriesEntry {
-        std::uint32_t col_local;
-        std::uint32_t col_global;
-        std::uint32_t source;  // the distinct position (index into scaled_)
+    // A moved index of the nilpotent path. The nodes are in topological
+    // order (by level); the positions of A follow in the same order, each
+    // node's own first: those whose column is a fixed index, then those whose
+    // column is an earlier node.
+    struct SeriesNode {
+        std::uint32_t global;
+        std::uint32_t fixed_columns;
+        std::uint32_t moved_columns;
     };
-    struct BlockEntry {  // an entry of the block, local indices
+    struct BlockEntry {  // where a position lies in the block (local indices)
         std::uint32_t row;
         std::uint32_t col;
-        std::uint32_t source;
+    };
+    struct Term {  // a further term of a position with several
+        std::uint32_t position;
+        std::uint32_t parameter;
+        double coefficient;
     };
 
     void scale_entries(const double *g, double t);  // scaled_ = entries of t A
-    void apply_series(double *x);
+    template <std::size_t Lanes>
+    bool sweep(double *x);
     void apply_block(double t, double *x);
     void check_norm(double norm, double t) const;
-    // Of increment_, before x changes: throws LPI_ERR_NONFINITE naming the
-    // first non-finite component.
-    void check_finite(std::size_t m) const;
-    [[noreturn]] void fail_nonfinite(std::size_t m) const;
+    // Throws LPI_ERR_NONFINITE naming the first non-finite increment.
+    [[noreturn]] void fail_nonfinite() const;
 
     ExpmPath path_ = ExpmPath::Nilpotent;
-    // Indices the flow moves (nilpotent: by level, deepest first; block: all
-    // the pattern touches), local -> global.
-    std::vector<std::uint32_t> moved_;
-    // Nilpotent path: entries by row, and in a row by the level of their
-    // column, deepest first. Term k (k = 1..depth) is nonzero on the first
-    // rows_used_[k] moved indices only; in row v it sums the entries
-    // row_begin_[v] .. row_end_[k * moved + v] - 1 (columns of level >= k - 1).
-    std::vector<SeriesEntry> series_;
-    std::vector<std::size_t> row_begin_, row_end_, rows_used_;
-    std::vector<double> inverse_;  // 1/k
     std::size_t depth_ = 0;
-    std::vector<BlockEntry> block_;
-    // The terms by distinct position: position j sums terms
-    // term_begin_[j] .. term_begin_[j + 1] - 1.
-    std::vector<SparseTerm> terms_;
-    std::vector<std::size_t> term_begin_;
-    std::vector<double> scaled_, term_, next_, increment_, dense_, exp_, pade_scratch_;
+    // The increments' indices, local -> global (nilpotent: the nodes; block:
+    // every index the pattern touches).
+    std::vector<std::uint32_t> moved_;
+    // Each distinct position of A sums its first term and the further ones.
+    std::vector<SparseTerm> first_terms_;
+    std::vector<Term> further_terms_;
+    // Nilpotent path. Node v keeps the Taylor coefficients of its component,
+    // c_v[k] = ((tA)^k x / k!)_v for k < lanes_, in coefficients_[v * lanes_ +
+    // k]; c_v[k] = (1/k) sum_u (tA)_vu c_u[k - 1] over the entries of its row.
+    // lanes_ >= depth_ (rounded up to a width the compiler unrolls).
+    std::vector<SeriesNode> nodes_;
+    std::vector<std::uint32_t> columns_;  // per position: global index or earlier node
+    std::size_t lanes_ = 1;
+    std::vector<double> inverse_;  // 1 / (k + 1), k < lanes_
+    std::vector<double> coefficients_, accumulator_;
+    std::vector<BlockEntry> block_;  // per position, block paths
+    std::vector<double> scaled_, increment_, dense_, exp_, pade_scratch_;
 };
 
 }  // namespace lpi
