@@ -70,47 +70,58 @@ int casimir_K(std::size_t, const double *x, double *out, void *) {
     return 0;
 }
 
-// y <- Sym^4(F) y for the fourth moments y = (<q^4>, <q^3 p>, ..., <p^4>)
-// under the plane map F = I + D: row r of Sym^4(F) holds the coefficients
-// on q^(4-k) p^k of (a q + b p)^(4-r) (c q + d p)^r, F = [[a, b], [c, d]].
-// Every coefficient is a sum of products with a factor b or c, except the
-// one term a^(4-r) d^r of the diagonal, which enters as a^(4-r) d^r - 1 from
-// a^n - 1 = (a - 1)(1 + a + ... + a^(n-1)): the increment is accurate
-// relative to itself, and y is rounded once.
-void apply_fourth_power(const double D[2][2], double *y) {
-    static constexpr double kBinomial[5][5] = {
-        {1, 0, 0, 0, 0}, {1, 1, 0, 0, 0}, {1, 2, 1, 0, 0}, {1, 3, 3, 1, 0}, {1, 4, 6, 4, 1}};
-    const double a = 1.0 + D[0][0], b = D[0][1], c = D[1][0], d = 1.0 + D[1][1];
-    double pa[5], pb[5], pc[5], pd[5];  // powers 0..4
-    double a_minus_1[5], d_minus_1[5];  // a^n - 1, d^n - 1
-    pa[0] = pb[0] = pc[0] = pd[0] = 1.0;
-    a_minus_1[0] = d_minus_1[0] = 0.0;
-    for (int n = 1; n < 5; ++n) {
-        pa[n] = pa[n - 1] * a;
-        pb[n] = pb[n - 1] * b;
-        pc[n] = pc[n - 1] * c;
-        pd[n] = pd[n - 1] * d;
-        a_minus_1[n] = a_minus_1[n - 1] * a + D[0][0];
-        d_minus_1[n] = d_minus_1[n - 1] * d + D[1][1];
-    }
-    double increment[5];
-    for (int r = 0; r < 5; ++r) {
-        const int n = 4 - r;
-        double row[5] = {0, 0, 0, 0, 0};
-        // (a q + b p)^n: C(n, j) a^(n-j) b^j on q^(n-j) p^j; (c q + d p)^r:
-        // C(r, i) c^(r-i) d^i on q^(r-i) p^i.
-        for (int j = 0; j <= n; ++j) {
-            const double first = kBinomial[n][j] * pa[n - j] * pb[j];
-            for (int i = 0; i <= r; ++i) {
-                if (j == 0 && i == r) continue;  // the diagonal's a^n d^r, below
-                row[j + i] += first * kBinomial[r][i] * pc[r - i] * pd[i];
-            }
+// Powers 0..4 of the entries of a plane map F = I + D = [[a, b], [c, d]],
+// and a^n - 1, d^n - 1 from a^n - 1 = (a - 1)(1 + a + ... + a^(n-1)).
+struct PlanePowers {
+    double a[5], b[5], c[5], d[5], a_minus_1[5], d_minus_1[5];
+    explicit PlanePowers(const double D[2][2]) {
+        const double fa = 1.0 + D[0][0], fb = D[0][1], fc = D[1][0], fd = 1.0 + D[1][1];
+        a[0] = b[0] = c[0] = d[0] = 1.0;
+        a_minus_1[0] = d_minus_1[0] = 0.0;
+        for (int n = 1; n < 5; ++n) {
+            a[n] = a[n - 1] * fa;
+            b[n] = b[n - 1] * fb;
+            c[n] = c[n - 1] * fc;
+            d[n] = d[n - 1] * fd;
+            a_minus_1[n] = a_minus_1[n - 1] * fa + D[0][0];
+            d_minus_1[n] = d_minus_1[n - 1] * fd + D[1][1];
         }
-        row[r] += a_minus_1[n] + d_minus_1[r] + a_minus_1[n] * d_minus_1[r];  // a^n d^r - 1
-        double sum = 0.0;
-        for (int k = 0; k < 5; ++k) sum += row[k] * y[k];
-        increment[r] = sum;
     }
+};
+
+constexpr double kBinomial[5][5] = {
+    {1, 0, 0, 0, 0}, {1, 1, 0, 0, 0}, {1, 2, 1, 0, 0}, {1, 3, 3, 1, 0}, {1, 4, 6, 4, 1}};
+
+// Row R of Sym^4(F) - I applied to the fourth moments y = (<q^4>, <q^3 p>,
+// ..., <p^4>): the coefficients on q^(4-k) p^k of (a q + b p)^(4-R)
+// (c q + d p)^R, less the identity. Every coefficient is a sum of products
+// with a factor b or c, except the one term a^(4-R) d^R of the diagonal,
+// which enters as a^(4-R) d^R - 1: the increment is accurate relative to
+// itself. (A template: the loops have fixed bounds and unroll.)
+template <int R>
+double fourth_power_increment(const PlanePowers &p, const double *y) {
+    constexpr int N = 4 - R;
+    double row[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+    // (a q + b p)^N: C(N, j) a^(N-j) b^j on q^(N-j) p^j; (c q + d p)^R:
+    // C(R, i) c^(R-i) d^i on q^(R-i) p^i.
+    for (int j = 0; j <= N; ++j) {
+        const double first = kBinomial[N][j] * p.a[N - j] * p.b[j];
+        for (int i = 0; i <= R; ++i)
+            if (j > 0 || i < R) row[j + i] += first * kBinomial[R][i] * p.c[R - i] * p.d[i];
+    }
+    row[R] += p.a_minus_1[N] + p.d_minus_1[R] + p.a_minus_1[N] * p.d_minus_1[R];
+    double sum = 0.0;
+    for (int k = 0; k < 5; ++k) sum += row[k] * y[k];
+    return sum;
+}
+
+// y <- Sym^4(F) y, rounded once.
+void apply_fourth_power(const double D[2][2], double *y) {
+    const PlanePowers powers(D);
+    const double increment[5] = {
+        fourth_power_increment<0>(powers, y), fourth_power_increment<1>(powers, y),
+        fourth_power_increment<2>(powers, y), fourth_power_increment<3>(powers, y),
+        fourth_power_increment<4>(powers, y)};
     for (int r = 0; r < 5; ++r) y[r] += increment[r];
 }
 
