@@ -460,8 +460,12 @@ bool SparseExponential::sweep(double *x) {
 
 void SparseExponential::apply(const double *g, double t, double *x) {
     scale_entries(g, t);
-    if (path_ != ExpmPath::Nilpotent) {
-        apply_block(t, x);
+    if (path_ == ExpmPath::Plane) {
+        apply_plane(t, x);
+        return;
+    }
+    if (path_ == ExpmPath::Pade) {
+        apply_pade(t, x);
         return;
     }
     bool finite = true;
@@ -475,40 +479,42 @@ void SparseExponential::apply(const double *g, double t, double *x) {
     if (!finite) fail_nonfinite();
 }
 
-void SparseExponential::apply_block(double t, double *x) {
+void SparseExponential::apply_plane(double t, double *x) {
+    double A[4] = {0.0, 0.0, 0.0, 0.0};
+    for (std::size_t j = 0; j < block_.size(); ++j) A[block_[j].row * 2 + block_[j].col] = scaled_[j];
+    check_norm(std::max(std::fabs(A[0]) + std::fabs(A[2]), std::fabs(A[1]) + std::fabs(A[3])), t);
+    const bool pair = moved_.size() == 2;
+    const double x0 = x[moved_[0]], x1 = pair ? x[moved_[1]] : 0.0;
+    double W[4] = {0.0, 0.0, 0.0, 0.0};
+    if (pair)
+        plane_expm1(A[0], A[1], A[2], A[3], W);
+    else
+        W[0] = std::expm1(A[0]);
+    // x += (exp(tA) - I) x, rounded once; untouched when not representable.
+    increment_[0] = W[0] * x0 + W[1] * x1;
+    if (pair) increment_[1] = W[2] * x0 + W[3] * x1;
+    if (!std::isfinite(increment_[0]) || (pair && !std::isfinite(increment_[1]))) fail_nonfinite();
+    x[moved_[0]] = x0 + increment_[0];
+    if (pair) x[moved_[1]] = x1 + increment_[1];
+}
+
+void SparseExponential::apply_pade(double t, double *x) {
     const std::size_t m = moved_.size();
-    if (m <= 2) {
-        double A[4] = {0.0, 0.0, 0.0, 0.0};
-        for (std::size_t j = 0; j < block_.size(); ++j)
-            A[block_[j].row * 2 + block_[j].col] = scaled_[j];
-        check_norm(std::max(std::fabs(A[0]) + std::fabs(A[2]), std::fabs(A[1]) + std::fabs(A[3])),
-                   t);
-        const double x0 = x[moved_[0]], x1 = m == 2 ? x[moved_[1]] : 0.0;
-        double W[4];
-        if (m == 1)
-            W[0] = std::expm1(A[0]), W[1] = W[2] = W[3] = 0.0;
-        else
-            plane_expm1(A[0], A[1], A[2], A[3], W);
-        increment_[0] = W[0] * x0 + W[1] * x1;
-        if (m == 2) increment_[1] = W[2] * x0 + W[3] * x1;
-    } else {
-        dense_.assign(square_entries(m, "exponential's matrix"), 0.0);
-        for (std::size_t j = 0; j < block_.size(); ++j)
-            dense_[block_[j].row * m + block_[j].col] = scaled_[j];
-        check_norm(norm1(m, dense_.data()), t);
-        exp_.resize(dense_.size());
-        expm1_with(m, dense_.data(), exp_.data(), pade_scratch_);
-        for (std::size_t r = 0; r < m; ++r) {
-            double s = 0.0;
-            for (std::size_t c = 0; c < m; ++c) s += exp_[r * m + c] * x[moved_[c]];
-            increment_[r] = s;
-        }
-    }
+    dense_.assign(square_entries(m, "exponential's matrix"), 0.0);
+    for (std::size_t j = 0; j < block_.size(); ++j) dense_[block_[j].row * m + block_[j].col] = scaled_[j];
+    check_norm(norm1(m, dense_.data()), t);
+    exp_.resize(dense_.size());
+    expm1_with(m, dense_.data(), exp_.data(), pade_scratch_);
     // x += (exp(tA) - I) x: the increment carries its own small rounding
-    // errors, and x is rounded once (as in the nilpotent branch). x is left
+    // errors, and x is rounded once (as on the other paths). x is left
     // untouched when the exact flow is not representable.
     bool finite = true;
-    for (std::size_t r = 0; r < m; ++r) finite &= std::isfinite(increment_[r]);
+    for (std::size_t r = 0; r < m; ++r) {
+        double s = 0.0;
+        for (std::size_t c = 0; c < m; ++c) s += exp_[r * m + c] * x[moved_[c]];
+        increment_[r] = s;
+        finite &= std::isfinite(s);
+    }
     if (!finite) fail_nonfinite();
     for (std::size_t r = 0; r < m; ++r) x[moved_[r]] += increment_[r];
 }

@@ -98,7 +98,8 @@ private:
     void scale_entries(const double *g, double t);  // scaled_ = entries of t A
     template <std::size_t Lanes>
     bool sweep(double *x);
-    void apply_block(double t, double *x);
+    void apply_plane(double t, double *x);  // a block of order 1 or 2
+    void apply_pade(double t, double *x);
     void check_norm(double norm, double t) const;
     // Throws LPI_ERR_NONFINITE naming the first non-finite increment.
     [[noreturn]] void fail_nonfinite() const;
