@@ -2,7 +2,7 @@
 // Self-contained (no LAPACK): the matrices of generic systems are small.
 //  - A structurally nilpotent (its nonzero pattern is an acyclic graph, which
 //    covers the triangular-after-permutation systems of the paper) is applied
-//    as the finite series sum_k (tA)^k x / k!, exactly, with work at most
+//    as the finite series sum_k (tA)^k x / k!, exactly, with work
 //    O(nnz * depth) where depth is the longest path in the pattern;
 //  - a 1x1 or 2x2 block (the rotations of so(3) and e(2)) in closed form;
 //  - otherwise a dense scaling-and-squaring Pade exponential (N. J. Higham,
@@ -52,9 +52,10 @@ constexpr int kMaxSquarings = 32;
 // gradient. What the pattern of A alone decides is worked out once, at
 // construction:
 //  - an acyclic pattern (A nilpotent, A^(depth+1) = 0, depth the longest
-//    path): the finite series sum_k (tA)^k x / k!, its k-th term computed
-//    only on the indices at the end of a path of length k, from the entries
-//    that feed them; work O(nnz) per term, nothing dense;
+//    path): the finite series sum_k (tA)^k x / k!, in one sweep over the
+//    indices it moves in topological order, each index's terms k = 1..depth
+//    at once from those of the indices its row reads; work O(nnz * depth),
+//    nothing dense;
 //  - otherwise the block of the indices the pattern touches: of order 1 or 2
 //    in closed form (A = tau I + N with N^2 = delta I: exponentials,
 //    sines or hyperbolic sines), larger ones by the Pade exponential.
