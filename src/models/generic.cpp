@@ -186,15 +186,8 @@ public:
                  std::vector<std::uint32_t> sigma, lpi_gradient_fn grad, lpi_energy_fn energy,
                  void *user)
         : Piece(std::move(label)), constants_(constants), sigma_(std::move(sigma)), grad_(grad),
-          energy_(energy), user_(user), x_sigma_(sigma_.size()), g_(sigma_.size()) {
-        // A_il = sum_p c_{i sigma_p}^l g_p: its terms depend only on the
-        // constants and sigma, so its exponential is planned here, once.
-        std::vector<SparseTerm> terms;
-        for (std::size_t p = 0; p < sigma_.size(); ++p)
-            for (const StructureConstants::Term &t : constants_.column(sigma_[p]))
-                terms.push_back({t.i, t.l, static_cast<std::uint32_t>(p), t.c});
-        exponential_ = SparseExponential(constants_.dim(), std::move(terms));
-    }
+          energy_(energy), user_(user), x_sigma_(sigma_.size()), g_(sigma_.size()),
+          exponential_(constants_.dim(), flow_terms(constants_, sigma_)) {}
 
     void flow(double t, double *x) override {
         gradient(x);
@@ -223,6 +216,17 @@ public:
     }
 
 private:
+    // A_il = sum_p c_{i sigma_p}^l g_p: its terms depend only on the
+    // constants and sigma, so the exponential is planned once, at add_piece.
+    static std::vector<SparseTerm> flow_terms(const StructureConstants &constants,
+                                              const std::vector<std::uint32_t> &sigma) {
+        std::vector<SparseTerm> terms;
+        for (std::size_t p = 0; p < sigma.size(); ++p)
+            for (const StructureConstants::Term &t : constants.column(sigma[p]))
+                terms.push_back({t.i, t.l, static_cast<std::uint32_t>(p), t.c});
+        return terms;
+    }
+
     void gather(const double *x) const {
         for (std::size_t p = 0; p < sigma_.size(); ++p) x_sigma_[p] = x[sigma_[p]];
     }
@@ -245,7 +249,7 @@ private:
     lpi_energy_fn energy_;
     void *user_;
     mutable std::vector<double> x_sigma_, g_;
-    SparseExponential exponential_{0, {}};
+    SparseExponential exponential_;
 };
 
 }  // namespace
