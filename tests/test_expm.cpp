@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -81,18 +82,30 @@ std::vector<double> random_matrix(std::size_t n, double norm, std::mt19937_64 &r
     return A;
 }
 
+// The terms of A (its nonzeros, each its own parameter, g = its value).
+std::vector<lpi::SparseTerm> terms_of(std::size_t n, const std::vector<double> &A,
+                                      std::vector<double> *g) {
+    std::vector<lpi::SparseTerm> terms;
+    g->clear();
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < n; ++j)
+            if (A[i * n + j] != 0.0) {
+                terms.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j),
+                                 static_cast<std::uint32_t>(g->size()), 1.0});
+                g->push_back(A[i * n + j]);
+            }
+    return terms;
+}
+
 // y = E x for the sparse path, to compare against a dense exponential.
 std::vector<double> apply_sparse(std::size_t n, const std::vector<double> &A, const std::vector<double> &x,
                                  lpi::ExpmPath *path, long *depth) {
-    std::vector<lpi::SparseEntry> entries;
-    for (std::size_t i = 0; i < n; ++i)
-        for (std::size_t j = 0; j < n; ++j)
-            if (A[i * n + j] != 0.0)
-                entries.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j), A[i * n + j]});
-    lpi::ExpmWorkspace workspace;
+    std::vector<double> g;
+    lpi::SparseExponential exponential(n, terms_of(n, A, &g));
     std::vector<double> y = x;
-    *path = workspace.apply(n, entries, 1.0, y.data());
-    *depth = workspace.last_depth();
+    exponential.apply(g.data(), 1.0, y.data());
+    *path = exponential.path();
+    *depth = exponential.depth();
     return y;
 }
 
@@ -219,12 +232,15 @@ void test_nilpotent_matrices(void **) {
     apply_sparse(n, A, x, &path, &depth);
     assert_int_equal(static_cast<int>(path), static_cast<int>(lpi::ExpmPath::Pade));
     assert_int_equal(depth, -1);
-    // An explicit zero does not close a cycle.
-    std::vector<lpi::SparseEntry> cycle = {{0, 1, 2.0}, {1, 0, 0.0}};
-    lpi::ExpmWorkspace workspace;
+    // The pattern decides the path, not the values of a call: a cycle whose
+    // entry is zero in this call is the closed-form 2x2 path, exact here.
+    const std::vector<lpi::SparseTerm> cycle = {{0, 1, 0, 2.0}, {1, 0, 1, 1.0}};
+    lpi::SparseExponential exponential(2, cycle);
+    assert_int_equal(static_cast<int>(exponential.path()), static_cast<int>(lpi::ExpmPath::Plane));
+    assert_int_equal(exponential.depth(), -1);
+    const double g[2] = {1.0, 0.0};
     double z[2] = {3.0, 5.0};
-    assert_int_equal(static_cast<int>(workspace.apply(2, cycle, 0.5, z)),
-                     static_cast<int>(lpi::ExpmPath::Nilpotent));
+    exponential.apply(g, 0.5, z);
     assert_true(z[0] == 3.0 + 0.5 * 2.0 * 5.0 && z[1] == 5.0);
 }
 
@@ -233,20 +249,27 @@ void test_sparse_nilpotent_scales_with_nonzeros(void **) {
     // depth 2. A dense exponential of this size (n = 300000) could not even be
     // stored; the series touches only the nonzeros.
     const std::uint32_t layer = 100000, n = 3 * layer;
-    std::vector<lpi::SparseEntry> entries;
+    struct Entry {
+        std::uint32_t row, col;
+        double value;
+    };
+    std::vector<Entry> entries;
     for (std::uint32_t i = 0; i < 2 * layer; ++i) {
         const std::uint32_t base = (i / layer + 1) * layer, offset = i % layer;
         entries.push_back({base + offset, i, 0.5});
         entries.push_back({base + (offset + 1) % layer, i, -0.25});
     }
+    // One parameter: A = g C with g = 1.
+    std::vector<lpi::SparseTerm> terms;
+    for (const Entry &e : entries) terms.push_back({e.row, e.col, 0, e.value});
     std::vector<double> x(n), y(n);
     for (std::uint32_t i = 0; i < n; ++i) x[i] = std::sin(0.001 * i) + 1.0;
     y = x;
-    const double t = 0.7;
-    lpi::ExpmWorkspace workspace;
-    assert_int_equal(static_cast<int>(workspace.apply(n, entries, t, y.data())),
-                     static_cast<int>(lpi::ExpmPath::Nilpotent));
-    assert_int_equal(workspace.last_depth(), 2);
+    const double t = 0.7, g = 1.0;
+    lpi::SparseExponential exponential(n, terms);
+    assert_int_equal(static_cast<int>(exponential.path()), static_cast<int>(lpi::ExpmPath::Nilpotent));
+    assert_int_equal(exponential.depth(), 2);
+    exponential.apply(&g, t, y.data());
     // Reference: x + t A x + t^2 A^2 x / 2 with plain loops.
     std::vector<double> Ax(n, 0.0), AAx(n, 0.0);
     for (const auto &e : entries) Ax[e.row] += e.value * x[e.col];
@@ -255,6 +278,137 @@ void test_sparse_nilpotent_scales_with_nonzeros(void **) {
     for (std::uint32_t i = 0; i < n; ++i)
         worst = std::max(worst, std::fabs(y[i] - (x[i] + t * Ax[i] + 0.5 * t * t * AAx[i])));
     assert_true(worst < 1e-14);
+}
+
+// The closed form of 1x1 and 2x2 blocks against the long-double Taylor
+// reference: rotation generators (with and without a trace), elliptic,
+// hyperbolic and parabolic (delta = 0, a Jordan block) planes, a self-loop.
+// An index the pattern does not touch is left alone.
+void test_plane_closed_form(void **) {
+    const std::vector<std::vector<double>> planes = {
+        {0.0, 0.3, -0.3, 0.0},      // rotation by 0.3
+        {0.0, -2.5, 2.5, 0.0},      // rotation by -2.5
+        {0.2, 1.1, -1.1, 0.2},      // rotation times e^0.2
+        {0.4, 1.5, -0.7, -0.1},     // elliptic, p != 0
+        {0.3, 0.8, 0.9, -0.5},      // hyperbolic
+        {1.0, 1.0, -1.0, -1.0},     // parabolic: N^2 = 0
+        {1e-9, 3e-9, -2e-9, 4e-9},  // near the identity
+        {0.0, 7.0, -7.0, 0.0},      // rotation past 2 pi
+    };
+    const std::vector<double> x = {0.7, -1.3, 2.0};
+    for (const std::vector<double> &plane : planes) {
+        // Embedded in n = 3 on indices {2, 0}: index 1 is untouched.
+        const std::uint32_t index[2] = {2, 0};
+        std::vector<lpi::SparseTerm> terms;
+        std::vector<double> g;
+        for (std::uint32_t r = 0; r < 2; ++r)
+            for (std::uint32_t c = 0; c < 2; ++c)
+                if (plane[r * 2 + c] != 0.0) {
+                    terms.push_back({index[r], index[c], static_cast<std::uint32_t>(g.size()), 1.0});
+                    g.push_back(plane[r * 2 + c]);
+                }
+        lpi::SparseExponential exponential(3, terms);
+        assert_int_equal(static_cast<int>(exponential.path()), static_cast<int>(lpi::ExpmPath::Plane));
+        std::vector<double> y = x;
+        exponential.apply(g.data(), 1.0, y.data());
+        const LongMatrix W = reference_expm1(2, plane);
+        const std::vector<double> local = {x[2], x[0]};
+        const std::vector<long double> exact = long_apply(2, W, local, true);
+        const double error = vector_error({y[2], y[0]}, exact);
+        double norm = 0.0;
+        for (double a : plane) norm = std::max(norm, std::fabs(a));
+        std::printf("plane [[%g, %g], [%g, %g]]: closed form rel. error %.2e\n", plane[0], plane[1],
+                    plane[2], plane[3], error);
+        assert_true(error < 16 * 2.2e-16 * std::max(1.0, norm));
+        assert_true(y[1] == x[1]);
+    }
+    // A self-loop alone: x' = a x, exp = e^a.
+    const std::vector<lpi::SparseTerm> loop = {{1, 1, 0, -0.75}};
+    lpi::SparseExponential exponential(2, loop);
+    assert_int_equal(static_cast<int>(exponential.path()), static_cast<int>(lpi::ExpmPath::Plane));
+    double z[2] = {4.0, 3.0};
+    const double g = 2.0;
+    exponential.apply(&g, 0.5, z);
+    assert_true(z[0] == 4.0);
+    assert_true(std::fabs(z[1] - 3.0 * std::exp(-0.75)) < 4 * 2.2e-16 * 3.0);
+}
+
+// Every path refuses, x unchanged bit for bit: a flow whose result is not
+// finite (LPI_ERR_NONFINITE, naming the component), and off the nilpotent
+// path a step beyond kMaxSquarings squarings (LPI_ERR_INVALID).
+void expect_refusal(lpi::SparseExponential &exponential, const double *g, double t,
+                    std::vector<double> x, int status, const char *words) {
+    const std::vector<double> before = x;
+    try {
+        exponential.apply(g, t, x.data());
+        fail_msg("apply did not refuse (%s)", words);
+    } catch (const lpi::Error &e) {
+        assert_int_equal(e.status(), status);
+        assert_non_null(std::strstr(e.what(), words));
+    }
+    for (std::size_t i = 0; i < x.size(); ++i) assert_true(x[i] == before[i]);
+}
+
+void test_refusals_leave_x_unchanged(void **) {
+    const std::vector<double> x = {0.5, -2.0, 1.5, 3.0};
+    // Nilpotent chain 0 -> 1 -> 2: node 1 is written before node 2 overflows.
+    const std::vector<lpi::SparseTerm> chain = {{1, 0, 0, 1.0}, {2, 1, 1, 1.0}};
+    lpi::SparseExponential series(4, chain);
+    assert_int_equal(static_cast<int>(series.path()), static_cast<int>(lpi::ExpmPath::Nilpotent));
+    const double huge[2] = {1.0, 1e300};
+    expect_refusal(series, huge, 1e10, x, LPI_ERR_NONFINITE, "component 2");
+    // A rotation generator beyond 2^32 squarings, and a hyperbolic plane whose
+    // exponential overflows.
+    const std::vector<lpi::SparseTerm> plane = {{0, 3, 0, 1.0}, {3, 0, 1, 1.0}};
+    lpi::SparseExponential closed(4, plane);
+    const double rotation[2] = {1e11, -1e11}, hyperbolic[2] = {800.0, 800.0};
+    expect_refusal(closed, rotation, 1.0, x, LPI_ERR_INVALID, "squarings");
+    expect_refusal(closed, hyperbolic, 1.0, x, LPI_ERR_NONFINITE, "overflows");
+    // The Pade path (a 3-cycle) alike.
+    const std::vector<lpi::SparseTerm> cycle = {{1, 0, 0, 1.0}, {2, 1, 0, 1.0}, {0, 2, 0, 1.0}};
+    lpi::SparseExponential pade(4, cycle);
+    assert_int_equal(static_cast<int>(pade.path()), static_cast<int>(lpi::ExpmPath::Pade));
+    const double large = 1e11;
+    expect_refusal(pade, &large, 1.0, x, LPI_ERR_INVALID, "squarings");
+}
+
+// Deep nilpotent patterns (depth above the unrolled widths: lanes at run
+// time) and positions summing several parameters, against the long-double
+// finite series of the matrix they make.
+void test_deep_series_and_summed_terms(void **) {
+    const std::size_t n = 13;  // a chain 0 -> 1 -> ... -> 12 with shortcuts
+    std::vector<lpi::SparseTerm> terms;
+    std::vector<double> A(n * n, 0.0);
+    const double g[3] = {0.6, -0.35, 0.2};
+    for (std::uint32_t i = 1; i < n; ++i) {
+        terms.push_back({i, i - 1, 0, 1.0 + 0.1 * i});
+        terms.push_back({i, i - 1, 1, 0.5});  // the same position, another parameter
+        A[i * n + i - 1] = (1.0 + 0.1 * i) * g[0] + 0.5 * g[1];
+        if (i >= 3) {
+            terms.push_back({i, i - 3, 2, -1.0});
+            A[i * n + i - 3] = -g[2];
+        }
+    }
+    lpi::SparseExponential exponential(n, terms);
+    assert_int_equal(static_cast<int>(exponential.path()), static_cast<int>(lpi::ExpmPath::Nilpotent));
+    assert_int_equal(exponential.depth(), static_cast<long>(n - 1));
+    std::vector<double> x(n), y;
+    for (std::size_t i = 0; i < n; ++i) x[i] = std::cos(1.0 + i);
+    y = x;
+    const double t = 0.9;
+    exponential.apply(g, t, y.data());
+    LongMatrix tA(n * n), power(n * n, 0.0L), exact(n * n, 0.0L);
+    for (std::size_t e = 0; e < n * n; ++e) tA[e] = t * static_cast<long double>(A[e]);
+    for (std::size_t i = 0; i < n; ++i) power[i * n + i] = 1.0L;
+    long double factorial = 1.0L;
+    for (std::size_t k = 0; k < n; ++k) {
+        if (k > 0) factorial *= k;
+        for (std::size_t e = 0; e < n * n; ++e) exact[e] += power[e] / factorial;
+        power = long_multiply(n, power, tA);
+    }
+    const double error = vector_error(y, long_apply(n, exact, x, false));
+    std::printf("nilpotent chain n=13 (depth 12, summed terms): rel. error %.2e\n", error);
+    assert_true(error < 1e-14);
 }
 
 // The size of an n x n matrix is counted without wrapping: a dimension whose
@@ -285,6 +439,9 @@ int main() {
         cmocka_unit_test(test_skew_matrices),
         cmocka_unit_test(test_nilpotent_matrices),
         cmocka_unit_test(test_sparse_nilpotent_scales_with_nonzeros),
+        cmocka_unit_test(test_plane_closed_form),
+        cmocka_unit_test(test_refusals_leave_x_unchanged),
+        cmocka_unit_test(test_deep_series_and_summed_terms),
         cmocka_unit_test(test_square_entries_refuse_overflow),
     };
     return lpi_run_tests(tests);

@@ -4,6 +4,7 @@
 //    covers the triangular-after-permutation systems of the paper) is applied
 //    as the finite series sum_k (tA)^k x / k!, exactly, with work
 //    O(nnz * depth) where depth is the longest path in the pattern;
+//  - a 1x1 or 2x2 block (the rotations of so(3) and e(2)) in closed form;
 //  - otherwise a dense scaling-and-squaring Pade exponential (N. J. Higham,
 //    "The scaling and squaring method for the matrix exponential revisited",
 //    SIAM J. Matrix Anal. Appl. 26 (2005) 1179-1193, Algorithm 2.3) of the
@@ -28,45 +29,101 @@ void expm_dense(std::size_t n, const double *A, double *E);
 // when exp(A) is close to I (what the increment form of a flow needs).
 void expm1_dense(std::size_t n, const double *A, double *W);
 
-// A sparse n x n matrix in coordinate form; repeated (row, col) pairs add.
-struct SparseEntry {
+// One term of a matrix A = sum_p g_p C_p with fixed sparse C_p: the
+// coefficient of C_parameter at (row, col).
+struct SparseTerm {
     std::uint32_t row;
     std::uint32_t col;
-    double value;
+    std::uint32_t parameter;
+    double coefficient;
 };
 
-enum class ExpmPath { Nilpotent, Pade };
+enum class ExpmPath { Nilpotent, Plane, Pade };
 
 // Most squarings a flow may take (||t A||_1 <= 5.37 * 2^32 ~ 2.3e10): the
-// Casimir error of the Pade path grows like 2^squarings unit round-offs.
+// Casimir error of the Pade path grows like 2^squarings unit round-offs. The
+// closed form of the plane path is held to the same bound, so whether a step
+// is refused does not depend on the path.
 constexpr int kMaxSquarings = 32;
 
-// Scratch space reused between calls, so a flow allocates nothing once warm.
-class ExpmWorkspace {
+// x <- exp(t A) x for the matrices A = sum_p g_p C_p of fixed sparse C_p,
+// the parameters g changing from call to call: a piece flow, whose C_p
+// depend only on the structure constants and the index set, its g on the
+// gradient. What the pattern of A alone decides is worked out once, at
+// construction:
+//  - an acyclic pattern (A nilpotent, A^(depth+1) = 0, depth the longest
+//    path): the finite series sum_k (tA)^k x / k!, in one sweep over the
+//    indices it moves in topological order, each index's terms k = 1..depth
+//    at once from those of the indices its row reads; work O(nnz * depth),
+//    nothing dense;
+//  - otherwise the block of the indices the pattern touches: of order 1 or 2
+//    in closed form (A = tau I + N with N^2 = delta I: exponentials,
+//    sines or hyperbolic sines), larger ones by the Pade exponential.
+// apply() allocates nothing.
+class SparseExponential {
 public:
-    // Applies x <- exp(t A) x in place for A given by `entries` (dimension n).
-    // Exact zeros in entries are ignored. Returns the path taken. Throws
-    // lpi::Error, x unchanged, when the result is not finite
-    // (LPI_ERR_NONFINITE) or ||t A||_1 needs more than kMaxSquarings
-    // squarings (LPI_ERR_INVALID).
-    ExpmPath apply(std::size_t n, const std::vector<SparseEntry> &entries, double t, double *x);
+    // Indices < n; terms at the same position add (in the order of their
+    // parameters).
+    SparseExponential(std::size_t n, std::vector<SparseTerm> terms);
 
-    // Longest path in the nonzero pattern of the last apply() when it was
-    // nilpotent (A^(depth+1) = 0), otherwise -1. For tests and diagnostics.
-    long last_depth() const { return last_depth_; }
+    ExpmPath path() const { return path_; }
+    // The longest path of a nilpotent pattern (A^(depth+1) = 0), else -1.
+    long depth() const { return path_ == ExpmPath::Nilpotent ? static_cast<long>(depth_) : -1; }
+
+    // Applies x <- exp(t A) x in place for A = sum_p g[p] C_p.
+    // Throws lpi::Error, x unchanged, when the result is not finite
+    // (LPI_ERR_NONFINITE) or, off the nilpotent path, ||t A||_1 needs more
+    // than kMaxSquarings squarings (LPI_ERR_INVALID).
+    void apply(const double *g, double t, double *x);
 
 private:
-    long topological_depth();  // on local_ (active indices); -1 if cyclic
-    void check_finite(std::size_t m) const;  // of increment_, before x changes
+    // A moved index of the nilpotent path. The nodes are in topological
+    // order (by level); the positions of A follow in the same order, each
+    // node's own first: those whose column is a fixed index, then those whose
+    // column is an earlier node.
+    struct SeriesNode {
+        std::uint32_t global;
+        std::uint32_t fixed_columns;
+        std::uint32_t moved_columns;
+    };
+    struct BlockEntry {  // where a position lies in the block (local indices)
+        std::uint32_t row;
+        std::uint32_t col;
+    };
+    struct Term {  // a further term of a position with several
+        std::uint32_t position;
+        std::uint32_t parameter;
+        double coefficient;
+    };
 
-    std::vector<std::int64_t> local_of_;  // global index -> local, -1 if inactive
-    std::vector<std::uint32_t> active_;   // local -> global
-    std::vector<SparseEntry> local_;      // nonzero entries in local indices
-    std::vector<std::size_t> start_, cursor_;  // offsets into adjacency_ (nnz)
-    std::vector<std::uint32_t> adjacency_, indegree_, queue_;
-    std::vector<long> depth_;
-    std::vector<double> term_, next_, increment_, dense_, exp_;
-    long last_depth_ = -1;
+    void scale_entries(const double *g, double t);  // scaled_ = entries of t A
+    template <std::size_t Lanes>
+    bool sweep(double *x);
+    void apply_plane(double t, double *x);  // a block of order 1 or 2
+    void apply_pade(double t, double *x);
+    void check_norm(double norm, double t) const;
+    // Throws LPI_ERR_NONFINITE naming the first non-finite increment.
+    [[noreturn]] void fail_nonfinite() const;
+
+    ExpmPath path_ = ExpmPath::Nilpotent;
+    std::size_t depth_ = 0;
+    // The increments' indices, local -> global (nilpotent: the nodes; block:
+    // every index the pattern touches).
+    std::vector<std::uint32_t> moved_;
+    // Each distinct position of A sums its first term and the further ones.
+    std::vector<SparseTerm> first_terms_;
+    std::vector<Term> further_terms_;
+    // Nilpotent path. Node v keeps the Taylor coefficients of its component,
+    // c_v[k] = ((tA)^k x / k!)_v for k < lanes_, in coefficients_[v * lanes_ +
+    // k]; c_v[k] = (1/k) sum_u (tA)_vu c_u[k - 1] over the entries of its row.
+    // lanes_ >= depth_ (rounded up to a width the compiler unrolls).
+    std::vector<SeriesNode> nodes_;
+    std::vector<std::uint32_t> columns_;  // per position: global index or earlier node
+    std::size_t lanes_ = 1;
+    std::vector<double> inverse_;  // 1 / (k + 1), k < lanes_
+    std::vector<double> coefficients_, accumulator_;
+    std::vector<BlockEntry> block_;  // per position, block paths
+    std::vector<double> scaled_, increment_, dense_, exp_, pade_scratch_;
 };
 
 }  // namespace lpi

@@ -186,34 +186,13 @@ public:
                  std::vector<std::uint32_t> sigma, lpi_gradient_fn grad, lpi_energy_fn energy,
                  void *user)
         : Piece(std::move(label)), constants_(constants), sigma_(std::move(sigma)), grad_(grad),
-          energy_(energy), user_(user), x_sigma_(sigma_.size()), g_(sigma_.size()) {
-        // A_il = sum_p c_{i sigma_p}^l g_p: one matrix entry per distinct
-        // (i, l), fed by the contributions (p, c) that land on it.
-        struct Raw {
-            std::uint32_t row, col;
-            std::size_t p;
-            double c;
-        };
-        std::vector<Raw> raw;
-        for (std::size_t p = 0; p < sigma_.size(); ++p)
-            for (const StructureConstants::Term &t : constants_.column(sigma_[p]))
-                raw.push_back({t.i, t.l, p, t.c});
-        std::sort(raw.begin(), raw.end(), [](const Raw &a, const Raw &b) {
-            return std::tie(a.row, a.col, a.p) < std::tie(b.row, b.col, b.p);
-        });
-        for (const Raw &r : raw) {
-            if (entries_.empty() || entries_.back().row != r.row || entries_.back().col != r.col)
-                entries_.push_back({r.row, r.col, 0.0});
-            contributions_.push_back({entries_.size() - 1, r.p, r.c});
-        }
-    }
+          energy_(energy), user_(user), x_sigma_(sigma_.size()), g_(sigma_.size()),
+          exponential_(constants_.dim(), flow_terms(constants_, sigma_)) {}
 
     void flow(double t, double *x) override {
         gradient(x);
-        for (SparseEntry &e : entries_) e.value = 0.0;
-        for (const Contribution &k : contributions_) entries_[k.entry].value += k.c * g_[k.p];
         try {
-            workspace_.apply(constants_.dim(), entries_, t, x);
+            exponential_.apply(g_.data(), t, x);
         } catch (const Error &e) {
             fail(e.status(), label() + ": " + e.what());
         }
@@ -237,11 +216,16 @@ public:
     }
 
 private:
-    struct Contribution {
-        std::size_t entry;
-        std::size_t p;
-        double c;
-    };
+    // A_il = sum_p c_{i sigma_p}^l g_p: its terms depend only on the
+    // constants and sigma, so the exponential is planned once, at add_piece.
+    static std::vector<SparseTerm> flow_terms(const StructureConstants &constants,
+                                              const std::vector<std::uint32_t> &sigma) {
+        std::vector<SparseTerm> terms;
+        for (std::size_t p = 0; p < sigma.size(); ++p)
+            for (const StructureConstants::Term &t : constants.column(sigma[p]))
+                terms.push_back({t.i, t.l, static_cast<std::uint32_t>(p), t.c});
+        return terms;
+    }
 
     void gather(const double *x) const {
         for (std::size_t p = 0; p < sigma_.size(); ++p) x_sigma_[p] = x[sigma_[p]];
@@ -265,9 +249,7 @@ private:
     lpi_energy_fn energy_;
     void *user_;
     mutable std::vector<double> x_sigma_, g_;
-    std::vector<SparseEntry> entries_;
-    std::vector<Contribution> contributions_;
-    ExpmWorkspace workspace_;
+    SparseExponential exponential_;
 };
 
 }  // namespace

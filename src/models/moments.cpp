@@ -70,6 +70,61 @@ int casimir_K(std::size_t, const double *x, double *out, void *) {
     return 0;
 }
 
+// Powers 0..4 of the entries of a plane map F = I + D = [[a, b], [c, d]],
+// and a^n - 1, d^n - 1 from a^n - 1 = (a - 1)(1 + a + ... + a^(n-1)).
+struct PlanePowers {
+    double a[5], b[5], c[5], d[5], a_minus_1[5], d_minus_1[5];
+    explicit PlanePowers(const double D[2][2]) {
+        const double fa = 1.0 + D[0][0], fb = D[0][1], fc = D[1][0], fd = 1.0 + D[1][1];
+        a[0] = b[0] = c[0] = d[0] = 1.0;
+        a_minus_1[0] = d_minus_1[0] = 0.0;
+        for (int n = 1; n < 5; ++n) {
+            a[n] = a[n - 1] * fa;
+            b[n] = b[n - 1] * fb;
+            c[n] = c[n - 1] * fc;
+            d[n] = d[n - 1] * fd;
+            a_minus_1[n] = a_minus_1[n - 1] * fa + D[0][0];
+            d_minus_1[n] = d_minus_1[n - 1] * fd + D[1][1];
+        }
+    }
+};
+
+constexpr double kBinomial[5][5] = {
+    {1, 0, 0, 0, 0}, {1, 1, 0, 0, 0}, {1, 2, 1, 0, 0}, {1, 3, 3, 1, 0}, {1, 4, 6, 4, 1}};
+
+// Row R of Sym^4(F) - I applied to the fourth moments y = (<q^4>, <q^3 p>,
+// ..., <p^4>): the coefficients on q^(4-k) p^k of (a q + b p)^(4-R)
+// (c q + d p)^R, less the identity. Every coefficient is a sum of products
+// with a factor b or c, except the one term a^(4-R) d^R of the diagonal,
+// which enters as a^(4-R) d^R - 1: the increment is accurate relative to
+// itself. (A template: the loops have fixed bounds and unroll.)
+template <int R>
+double fourth_power_increment(const PlanePowers &p, const double *y) {
+    constexpr int N = 4 - R;
+    double row[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+    // (a q + b p)^N: C(N, j) a^(N-j) b^j on q^(N-j) p^j; (c q + d p)^R:
+    // C(R, i) c^(R-i) d^i on q^(R-i) p^i.
+    for (int j = 0; j <= N; ++j) {
+        const double first = kBinomial[N][j] * p.a[N - j] * p.b[j];
+        for (int i = 0; i <= R; ++i)
+            if (j > 0 || i < R) row[j + i] += first * kBinomial[R][i] * p.c[R - i] * p.d[i];
+    }
+    row[R] += p.a_minus_1[N] + p.d_minus_1[R] + p.a_minus_1[N] * p.d_minus_1[R];
+    double sum = 0.0;
+    for (int k = 0; k < 5; ++k) sum += row[k] * y[k];
+    return sum;
+}
+
+// y <- Sym^4(F) y, rounded once.
+void apply_fourth_power(const double D[2][2], double *y) {
+    const PlanePowers powers(D);
+    const double increment[5] = {
+        fourth_power_increment<0>(powers, y), fourth_power_increment<1>(powers, y),
+        fourth_power_increment<2>(powers, y), fourth_power_increment<3>(powers, y),
+        fourth_power_increment<4>(powers, y)};
+    for (int r = 0; r < 5; ++r) y[r] += increment[r];
+}
+
 class ProductPiece final : public Piece {
 public:
     ProductPiece(std::string label, const StructureConstants &constants, lpi_scalar_fn h,
@@ -95,47 +150,24 @@ public:
         if (delta > 0.0) {
             const double r = std::sqrt(delta), h = std::sinh(0.5 * r * t);
             c_minus_1 = 2.0 * h * h;
-            s = std::sinh(r * t) / r;
+            s = 2.0 * h * std::sqrt(1.0 + h * h) / r;  // sinh(r t) / r
         } else if (delta < 0.0) {
             const double r = std::sqrt(-delta), h = std::sin(0.5 * r * t);
             c_minus_1 = -2.0 * h * h;
-            s = std::sin(r * t) / r;
+            s = 2.0 * h * std::cos(0.5 * r * t) / r;  // sin(r t) / r
         }
+        // e^{lambda t/2} - 1 and e^{-lambda t/2} - 1 = -g / (1 + g) from one expm1.
         const double grow_minus_1 = std::expm1(0.5 * lambda * t);
-        const double shrink_minus_1 = std::expm1(-0.5 * lambda * t);
+        const double shrink_minus_1 = -grow_minus_1 / (1.0 + grow_minus_1);
         // D = F - I, F = diag(e^{lambda t/2}, e^{-lambda t/2}) (c I + s M).
         const double D[2][2] = {
             {grow_minus_1 + (1.0 + grow_minus_1) * (c_minus_1 - 0.5 * s * lambda),
              (1.0 + grow_minus_1) * s * 2.0 * mu * b},
             {(1.0 + shrink_minus_1) * s * (-2.0 * mu * a),
              shrink_minus_1 + (1.0 + shrink_minus_1) * (c_minus_1 + 0.5 * s * lambda)}};
-
-        // Row r of Sym^4(F) - I: coefficients on q^(4-k) p^k of
-        // (q + D0.(q,p))^(4-r) (p + D1.(q,p))^r minus the monomial q^(4-r) p^r,
-        // expanded as (monomial + E)(unit + d) = monomial*unit + (monomial*d + E*unit + E*d).
-        double increment[5];
-        for (int r = 0; r < 5; ++r) {
-            double E[6] = {0, 0, 0, 0, 0, 0}, next[6];
-            int exponent = 0;  // of p in the exact monomial part
-            for (int f = 0; f < 4; ++f) {
-                const bool unit_p = f >= 4 - r;
-                const double *d = D[unit_p ? 1 : 0];
-                for (int k = 0; k < 6; ++k) {
-                    const double shifted = k > 0 ? E[k - 1] : 0.0;
-                    next[k] = (unit_p ? shifted : E[k]) + E[k] * d[0] + shifted * d[1];
-                }
-                next[exponent] += d[0];
-                next[exponent + 1] += d[1];
-                exponent += unit_p ? 1 : 0;
-                std::copy(next, next + 6, E);
-            }
-            double sum = 0.0;
-            for (int k = 0; k < 5; ++k) sum += E[k] * x[3 + k];
-            increment[r] = sum;
-        }
-        for (int r = 0; r < 5; ++r) x[3 + r] += increment[r];
-        x[0] = b + b * std::expm1(lambda * t);
-        x[2] = a + a * std::expm1(-lambda * t);
+        apply_fourth_power(D, x + 3);
+        x[0] = b + b * (grow_minus_1 * (2.0 + grow_minus_1));     // e^{lambda t} - 1
+        x[2] = a + a * (shrink_minus_1 * (2.0 + shrink_minus_1));  // e^{-lambda t} - 1
     }
 
     double energy(const double *x) const override {
