@@ -64,7 +64,7 @@ void run_figure2(const std::string &out_dir) {
     std::printf("   %.2f CPU seconds (diagnostics included); wrote %s\n", cpu, csv.c_str());
     const std::string script = out_dir + "/figure2.gp";
     FILE *g = std::fopen(script.c_str(), "w");
-    if (!g || std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    if (!g || !have_gnuplot()) {
         if (g) std::fclose(g);
         std::printf("   gnuplot not found: no PNG\n");
         return;

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "plots.hpp"
 #include "run_data.hpp"
 #include "run_options.hpp"
 #include "run_watch.hpp"
@@ -377,7 +378,7 @@ int run_command(int argc, char **argv) {
                 cpu_seconds() - t0, (H - H0) / std::fabs(H0), csv.c_str(), data_path(o).c_str());
 
     if (data.vorticity && !data.snapshot_step.empty()) {
-        if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+        if (!have_gnuplot()) {
             std::printf("gnuplot not found: no vorticity images (the snapshots are in %s)\n",
                         data_path(o).c_str());
             return 0;
