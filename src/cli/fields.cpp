@@ -75,4 +75,23 @@ std::vector<double> figure2_field() {
     return w;
 }
 
+std::vector<double> uniform_random_field(int N, unsigned seed, const std::function<bool(int, int)> &keep) {
+    std::vector<double> w(2 * static_cast<std::size_t>(N) * N, 0.0);
+    unsigned state = seed;
+    auto draw = [&] {
+        state = state * 1664525u + 1013904223u;
+        return static_cast<double>(state >> 8) / 16777216.0 - 0.5;
+    };
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const int ma = (N - a) % N, mb = (N - b) % N;
+            if (a * N + b >= ma * N + mb) continue;  // set each pair once
+            if (!keep(centred(a, N), centred(b, N))) continue;
+            const double re = draw(), im = draw();
+            w[2 * (a * N + b)] = re, w[2 * (a * N + b) + 1] = im;
+            w[2 * (ma * N + mb)] = re, w[2 * (ma * N + mb) + 1] = -im;
+        }
+    return w;
+}
+
 }  // namespace lpi_cli

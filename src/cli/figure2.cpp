@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "fields.hpp"
 #include "plots.hpp"
 #include "scenes.hpp"
+#include "systems.hpp"
 
 namespace lpi_cli {
 
@@ -18,10 +18,7 @@ void run_figure2(const std::string &out_dir) {
     const int N = 7;
     const double dt = 0.05;
     const int64_t steps = 100000, every = 100;
-    Handle h;
-    check(lpi_sine_euler_create(h.out(), N), nullptr, "create sine-Euler");
-    const std::vector<double> w = figure2_field();
-    check(lpi_sine_euler_set_modes(h.get(), w.data(), w.size()), h.get(), "set modes");
+    Handle h = figure2_system();
     check(lpi_set_method(h.get(), "leapfrog"), h.get(), "set method");
     const double H0 = energy_of(h.get());
     double traces0[2], traces[2];
