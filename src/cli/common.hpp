@@ -47,6 +47,15 @@ public:
     // The next argument (an option name or an operand).
     std::string next() { return argv_[next_++]; }
 
+    // Whether `arg` asks for the command's usage.
+    static bool is_help(const std::string &arg) { return arg == "--help" || arg == "-h"; }
+
+    // Stops the command when `arg`, which matched none of its options, looks
+    // like an option ("-x"): it is then no operand either.
+    void refuse_unknown_option(const std::string &arg) const {
+        if (!arg.empty() && arg[0] == '-') fail("unknown option '" + arg + "' (" + command_ + " --help lists them)");
+    }
+
     [[noreturn]] void fail(const std::string &message) const {
         std::fprintf(stderr, "%s: %s\n", command_.c_str(), message.c_str());
         std::exit(2);

@@ -77,15 +77,13 @@ void parse_run_options(int argc, char **argv, RunOptions &o) {
         else if (arg == "--inertia") {
             const std::vector<double> I = args.positives(arg, 3);
             std::copy(I.begin(), I.end(), o.scene_options.inertia);
-        } else if (arg == "--help" || arg == "-h") {
+        } else if (Arguments::is_help(arg)) {
             run_usage(stdout);
             std::exit(0);
-        } else if (!arg.empty() && arg[0] == '-') {
-            args.fail("unknown option '" + arg + "' (lpi run --help lists them)");
-        } else if (o.scene.empty()) {
-            o.scene = arg;
         } else {
-            args.fail("one scene only ('" + o.scene + "' and '" + arg + "')");
+            args.refuse_unknown_option(arg);
+            if (!o.scene.empty()) args.fail("one scene only ('" + o.scene + "' and '" + arg + "')");
+            o.scene = arg;
         }
     }
     if (o.scene.empty()) args.fail("which scene? (lpi --help lists them)");

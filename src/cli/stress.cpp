@@ -1,7 +1,7 @@
 // lpi stress: the stiff and extreme cases of every system against every
 // applicable method. Per case, step and method it prints whether the run stayed
 // bounded, the largest relative energy error and Casimir drift seen at the
-// checkpoints, and the outcome status; a failed lpi_step is checked to have
+// samples, and the outcome status; a failed lpi_step is checked to have
 // left the state as it was, bit for bit.
 //
 // What must hold (the exit status is 1 otherwise):
@@ -15,7 +15,7 @@
 //    converging) is a documented status with the state rolled back bit for bit.
 //
 // Casimir drift is |C(t) - C(0)| / max S, where S is the magnitude of C's
-// terms (the scale of its round-off), maximised over the checkpoints so far
+// terms (the scale of its round-off), maximised over the samples so far
 // (round-off made while the terms were large stays in the state): C itself for sums of squares (|m|^2, x1^2 + x2^2), the largest
 // |eigenvalue| for the sine-Euler spectrum, and for the moment invariants I, K
 // the sum of the absolute values of their monomials. The latter are evaluated
@@ -99,7 +99,7 @@ Outcome run_case(const Case &k, const std::string &method, double dt) {
     };
     measure(x0, c0, &s0);
 
-    const int chunks = static_cast<int>(std::min<std::int64_t>(k.checkpoints, k.steps));
+    const int chunks = static_cast<int>(std::min<std::int64_t>(k.samples, k.steps));
     std::int64_t done = 0;
     for (int chunk = 0; chunk < chunks; ++chunk) {
         const std::int64_t target = k.steps * (chunk + 1) / chunks;
@@ -154,14 +154,12 @@ int stress_command(int argc, char **argv) {
         const std::string arg = args.next();
         if (arg == "--quick") {
             quick = true;
-        } else if (arg == "--help" || arg == "-h") {
+        } else if (Arguments::is_help(arg)) {
             print_usage(stdout);
             return 0;
-        } else if (!arg.empty() && arg[0] == '-') {
-            args.fail("unknown option '" + arg + "'");
-        } else if (!filter.empty()) {
-            args.fail("one FILTER only ('" + filter + "' and '" + arg + "')");
         } else {
+            args.refuse_unknown_option(arg);
+            if (!filter.empty()) args.fail("one FILTER only ('" + filter + "' and '" + arg + "')");
             filter = arg;
         }
     }
@@ -169,7 +167,7 @@ int stress_command(int argc, char **argv) {
     if (std::none_of(cases.begin(), cases.end(), [&](const Case &k) { return k.name.find(filter) != std::string::npos; }))
         args.fail("no case name contains '" + filter + "'");
     std::printf("liepoisson %s: stress cases (%s)\n", lpi_version_string(), quick ? "quick" : "full");
-    std::printf("energy error and Casimir drift are relative maxima over the checkpoints;\n"
+    std::printf("energy error and Casimir drift are relative maxima over the samples;\n"
                 "bounded: finite and max|x| <= 1e3 max|x(0)|; must-hold failures are marked '!!'\n");
     int violations = 0, runs = 0;
     for (const Case &k : cases) {
@@ -200,7 +198,7 @@ int stress_command(int argc, char **argv) {
                                         static_cast<double>(o.steps_done);
                 // An unbounded run (an unstable composition of the moment
                 // algebra's shears) meets larger terms inside its steps than
-                // the checkpoints show: its drift is printed, not judged.
+                // the samples show: its drift is printed, not judged.
                 if (poisson && o.bounded && !(o.casimir_drift <= tolerance))
                     verdict += " !! Casimir drift";
                 if (!verdict.empty()) ++violations;

@@ -132,7 +132,7 @@ std::vector<Case> build_cases(bool quick) {
         Case k = rigid_case("rigid-body long run", 1.0, 2.0, 3.0, {1.0, 0.5, -0.3}, {0.01},
                             quick ? 100000 : 10000000);
         k.methods = {"leapfrog"};
-        k.checkpoints = 100;
+        k.samples = 100;
         cases.push_back(k);
     }
     {
@@ -157,9 +157,9 @@ std::vector<Case> build_cases(bool quick) {
         k.steps = quick ? 100 : n;
         k.measure = moment_invariants;
         // Round-off made while the ensemble is turned by 45 degrees (all
-        // entries ~ 1e150) stays in the state: checkpoints must see those
+        // entries ~ 1e150) stays in the state: samples must see those
         // phases, so their spacing is not commensurate with the period.
-        k.checkpoints = 97;
+        k.samples = 97;
         // Kick-drift splitting of the oscillator is linearly unstable for
         // substeps beyond 2 (dt = 1 period, or less for compositions with
         // large substeps): the numerical map itself grows until it
@@ -213,7 +213,7 @@ std::vector<Case> build_cases(bool quick) {
             k.methods = std::move(methods);
             k.spectrum_scale = true;
             k.drift_floor = 1e-15 * N;  // eigenvalues of an N x N matrix
-            k.checkpoints = static_cast<int>(std::min<std::int64_t>(steps, 10));
+            k.samples = static_cast<int>(std::min<std::int64_t>(steps, 10));
             cases.push_back(k);
         };
         auto any = [](int, int) { return true; };
@@ -232,7 +232,7 @@ std::vector<Case> build_cases(bool quick) {
                 {"leapfrog"});
         add("sine-Euler N = 7, dt = 0.05 as in the paper, long run", 7, uniform_random_field(7, 2024, any), {0.05},
             quick ? 10000 : 1000000, {"leapfrog"});
-        cases.back().checkpoints = 10;
+        cases.back().samples = 10;
     }
     return cases;
 }

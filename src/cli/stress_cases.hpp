@@ -27,7 +27,7 @@ struct Case {
     std::vector<std::string> methods;  // empty: every method
     CasimirMeasure measure;            // empty: lpi_casimirs, scale from kind below
     bool spectrum_scale = false;       // scale = max |C_k(0)| (eigenvalues)
-    int checkpoints = 20;
+    int samples = 20;                  // times the state is measured (equal chunks of steps)
     // Casimir round-off allowed to a Poisson method: floor (the measurement's
     // own round-off) + per_flow * flows * growth(factor), growth = 1 except
     // for the generic Pade path (each squaring doubles its error).
