@@ -19,6 +19,8 @@
 
 namespace lpi_cli {
 
+constexpr double kPi = 3.14159265358979323846;
+
 inline double cpu_seconds() {
     timespec ts;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);

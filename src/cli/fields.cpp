@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "common.hpp"
+
 namespace lpi_cli {
 
 namespace {
@@ -30,7 +32,7 @@ std::vector<double> smooth_random_field(int N, double k0, std::uint64_t seed) {
             if (!(m1 > 0 || (m1 == 0 && m2 > 0))) continue;
             const double amplitude = std::exp(-(m1 * m1 + m2 * m2) / (2.0 * k0 * k0)) *
                                      (0.5 + uniform(seed));
-            const double phase = 2.0 * 3.14159265358979323846 * uniform(seed);
+            const double phase = 2.0 * kPi * uniform(seed);
             const std::size_t i = static_cast<std::size_t>(a) * N + b;
             const std::size_t j = static_cast<std::size_t>((N - a) % N) * N + (N - b) % N;
             w[2 * i] = amplitude * std::cos(phase);

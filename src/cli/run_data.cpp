@@ -47,7 +47,7 @@ std::vector<Dataset> datasets_of(const RunData &d) {
     shape.insert(shape.end(), d.snapshot_shape.begin(), d.snapshot_shape.end());
     if (d.vorticity) {
         const std::size_t N = d.snapshot_shape[0];
-        const std::vector<double> x = indices(N, 2.0 * 3.14159265358979323846 / static_cast<double>(N));
+        const std::vector<double> x = indices(N, 2.0 * kPi / static_cast<double>(N));
         sets.push_back({"x", array_of({N}, x), {}, true});
         sets.push_back({"y", array_of({N}, x), {}, true});
         sets.push_back({"vorticity", array_of(shape, d.snapshots), {"snapshot_time", "x", "y"}, false});

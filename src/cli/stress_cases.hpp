@@ -11,8 +11,6 @@
 
 namespace lpi_cli {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // Extra measured quantities a case may compute itself (moments).
 // Extra measured quantities a case may compute itself (moments).
 using CasimirMeasure = std::function<void(const std::vector<double> &x, std::vector<long double> &c,
