@@ -84,7 +84,7 @@ void run_figure2(const std::string &out_dir) {
                csv.c_str(), csv.c_str());
     emit_figure(g, out_dir + "/figure2", 1000, 700, commands);
     std::fclose(g);
-    if (std::system(("gnuplot '" + script + "' 2>/dev/null").c_str()) == 0)
+    if (run_gnuplot(script))
         std::printf("   wrote %s/figure2.png and .svg\n", out_dir.c_str());
 }
 

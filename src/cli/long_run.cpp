@@ -190,7 +190,7 @@ bool plot_long(const std::string &base, const LongRunScene &scene, const std::ve
     }
     emit_figure(f, base + "_history", 1000, 900, commands + "unset multiplot\n");
     std::fclose(f);
-    return std::system(("gnuplot '" + base + ".gp' 2>/dev/null").c_str()) == 0;
+    return run_gnuplot(base + ".gp");
 }
 
 }  // namespace

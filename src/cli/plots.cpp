@@ -17,6 +17,10 @@ bool is_poisson(const std::string &method) { return lpi_method_is_poisson(method
 
 bool have_gnuplot() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
 
+bool run_gnuplot(const std::string &script) {
+    return std::system(("gnuplot '" + script + "' 2>/dev/null").c_str()) == 0;
+}
+
 // The i-th method's colour in a plot: twenty that read apart on white
 // (Okabe and Ito's, then Kelly's colours of maximum contrast).
 std::string plot_colour(std::size_t i) {

@@ -66,6 +66,8 @@ int method_index(const std::string &method);
 bool is_poisson(const std::string &method);
 // Whether gnuplot is on the PATH: without it the figures are left out.
 bool have_gnuplot();
+// Runs a gnuplot script (its messages silenced); whether it succeeded.
+bool run_gnuplot(const std::string &script);
 
 // The i-th method's colour in a plot: twenty that read apart on white
 // (Okabe and Ito's, then Kelly's colours of maximum contrast).

@@ -225,7 +225,7 @@ bool plot(const std::string &dir, const Scene &scene, const std::vector<std::str
     }
     emit_figure(f, base + "_energy", 1000, 820, commands + "\n");
     std::fclose(f);
-    return std::system(("gnuplot '" + script + "' 2>/dev/null").c_str()) == 0;
+    return run_gnuplot(script);
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "plots.hpp"
+
 namespace lpi_cli {
 
 namespace {
@@ -224,7 +226,7 @@ std::size_t plot_vorticity(const RunOptions &o, const RunData &d, const Snapshot
     }
     std::fprintf(g, "set output\n");
     std::fclose(g);
-    if (std::system(("gnuplot '" + script + "' 2>/dev/null").c_str()) != 0) return 0;
+    if (!run_gnuplot(script)) return 0;
     return shots;
 }
 
