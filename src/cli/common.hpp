@@ -19,6 +19,8 @@
 
 namespace lpi_cli {
 
+constexpr double kPi = 3.14159265358979323846;
+
 inline double cpu_seconds() {
     timespec ts;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
@@ -46,6 +48,15 @@ public:
     bool done() const { return next_ >= argc_; }
     // The next argument (an option name or an operand).
     std::string next() { return argv_[next_++]; }
+
+    // Whether `arg` asks for the command's usage.
+    static bool is_help(const std::string &arg) { return arg == "--help" || arg == "-h"; }
+
+    // Stops the command when `arg`, which matched none of its options, looks
+    // like an option ("-x"): it is then no operand either.
+    void refuse_unknown_option(const std::string &arg) const {
+        if (!arg.empty() && arg[0] == '-') fail("unknown option '" + arg + "' (" + command_ + " --help lists them)");
+    }
 
     [[noreturn]] void fail(const std::string &message) const {
         std::fprintf(stderr, "%s: %s\n", command_.c_str(), message.c_str());

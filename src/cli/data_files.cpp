@@ -379,33 +379,9 @@ std::string read_hdf5(const std::string &path, const std::string &name, Array &a
     return "";
 }
 
-std::string read_hdf5_text(const std::string &path, const std::string &name, std::string &text) {
-    quiet_hdf5();
-    if (!is_hdf5_file(path)) return "not an HDF5 file";
-    Id file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
-    if (!file.ok()) return "HDF5 cannot open it (damaged?)";
-    if (H5Aexists(file.get(), name.c_str()) <= 0) return "no attribute " + name;
-    Id attr(H5Aopen(file.get(), name.c_str(), H5P_DEFAULT), H5Aclose);
-    Id type(H5Aget_type(attr.get()), H5Tclose);
-    if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) <= 0)
-        return "attribute " + name + " is not a text";
-    Id memory(H5Tcopy(H5T_C_S1), H5Tclose);
-    H5Tset_size(memory.get(), H5T_VARIABLE);
-    H5Tset_cset(memory.get(), H5Tget_cset(type.get()));
-    char *value = nullptr;
-    if (H5Aread(attr.get(), memory.get(), &value) < 0 || !value) return "HDF5 cannot read attribute " + name;
-    text = value;
-    H5free_memory(value);
-    return "";
-}
-
 #else
 
 bool have_hdf5() { return false; }
-
-std::string read_hdf5_text(const std::string &, const std::string &, std::string &) {
-    return "this lpi is built without HDF5";
-}
 
 std::string write_hdf5(const std::string &, const std::vector<Dataset> &, const std::vector<Attribute> &,
                        std::vector<std::uint64_t> *) {

@@ -67,7 +67,4 @@ bool is_hdf5_file(const std::string &path);
 // missing dataset apart from an unreadable file. Returns "" or the reason.
 std::string read_hdf5(const std::string &path, const std::string &name, Array &a, bool *found);
 
-// Reads the text attribute `name` of an HDF5 file's root group; "" or the reason.
-std::string read_hdf5_text(const std::string &path, const std::string &name, std::string &text);
-
 }  // namespace lpi_cli

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "common.hpp"
+
 namespace lpi_cli {
 
 namespace {
@@ -30,7 +32,7 @@ std::vector<double> smooth_random_field(int N, double k0, std::uint64_t seed) {
             if (!(m1 > 0 || (m1 == 0 && m2 > 0))) continue;
             const double amplitude = std::exp(-(m1 * m1 + m2 * m2) / (2.0 * k0 * k0)) *
                                      (0.5 + uniform(seed));
-            const double phase = 2.0 * 3.14159265358979323846 * uniform(seed);
+            const double phase = 2.0 * kPi * uniform(seed);
             const std::size_t i = static_cast<std::size_t>(a) * N + b;
             const std::size_t j = static_cast<std::size_t>((N - a) % N) * N + (N - b) % N;
             w[2 * i] = amplitude * std::cos(phase);
@@ -71,6 +73,25 @@ std::vector<double> figure2_field() {
             const double f = n2 == 1 ? alpha : beta;
             w[2 * i] *= f;
             w[2 * i + 1] *= f;
+        }
+    return w;
+}
+
+std::vector<double> uniform_random_field(int N, unsigned seed, const std::function<bool(int, int)> &keep) {
+    std::vector<double> w(2 * static_cast<std::size_t>(N) * N, 0.0);
+    unsigned state = seed;
+    auto draw = [&] {
+        state = state * 1664525u + 1013904223u;
+        return static_cast<double>(state >> 8) / 16777216.0 - 0.5;
+    };
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const int ma = (N - a) % N, mb = (N - b) % N;
+            if (a * N + b >= ma * N + mb) continue;  // set each pair once
+            if (!keep(centred(a, N), centred(b, N))) continue;
+            const double re = draw(), im = draw();
+            w[2 * (a * N + b)] = re, w[2 * (a * N + b) + 1] = im;
+            w[2 * (ma * N + mb)] = re, w[2 * (ma * N + mb) + 1] = -im;
         }
     return w;
 }

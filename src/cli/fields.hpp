@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace lpi_cli {
@@ -15,5 +16,11 @@ std::vector<double> smooth_random_field(int N, double k0, std::uint64_t seed);
 // (sum over all modes = 2) and H(0) = 0.75 exactly, by mixing the |m| = 1
 // modes of a random field with the others in the right proportion.
 std::vector<double> figure2_field();
+
+// A rough field for the stress cases: the modes m = (m1, m2) (centred, in
+// -N/2..N/2) with keep(m1, m2) get real and imaginary parts uniform in
+// [-0.5, 0.5) from a linear congruential generator seeded with `seed`,
+// Hermitian, w_0 = 0; the others are 0.
+std::vector<double> uniform_random_field(int N, unsigned seed, const std::function<bool(int, int)> &keep);
 
 }  // namespace lpi_cli

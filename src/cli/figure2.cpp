@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "fields.hpp"
 #include "plots.hpp"
 #include "scenes.hpp"
+#include "systems.hpp"
 
 namespace lpi_cli {
 
@@ -18,10 +18,7 @@ void run_figure2(const std::string &out_dir) {
     const int N = 7;
     const double dt = 0.05;
     const int64_t steps = 100000, every = 100;
-    Handle h;
-    check(lpi_sine_euler_create(h.out(), N), nullptr, "create sine-Euler");
-    const std::vector<double> w = figure2_field();
-    check(lpi_sine_euler_set_modes(h.get(), w.data(), w.size()), h.get(), "set modes");
+    Handle h = figure2_system();
     check(lpi_set_method(h.get(), "leapfrog"), h.get(), "set method");
     const double H0 = energy_of(h.get());
     double traces0[2], traces[2];
@@ -64,7 +61,7 @@ void run_figure2(const std::string &out_dir) {
     std::printf("   %.2f CPU seconds (diagnostics included); wrote %s\n", cpu, csv.c_str());
     const std::string script = out_dir + "/figure2.gp";
     FILE *g = std::fopen(script.c_str(), "w");
-    if (!g || std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    if (!g || !have_gnuplot()) {
         if (g) std::fclose(g);
         std::printf("   gnuplot not found: no PNG\n");
         return;
@@ -87,7 +84,7 @@ void run_figure2(const std::string &out_dir) {
                csv.c_str(), csv.c_str());
     emit_figure(g, out_dir + "/figure2", 1000, 700, commands);
     std::fclose(g);
-    if (std::system(("gnuplot '" + script + "' 2>/dev/null").c_str()) == 0)
+    if (run_gnuplot(script))
         std::printf("   wrote %s/figure2.png and .svg\n", out_dir.c_str());
 }
 

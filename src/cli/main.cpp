@@ -68,12 +68,11 @@ int report_command(int argc, char **argv) {
             if (scene_options.sine_euler_n % 2 == 0) args.fail("--N must be odd");
         } else if (arg == "--T") {
             scene_options.long_run_time = args.positive(arg);
-        } else if (arg == "--help" || arg == "-h") {
+        } else if (Arguments::is_help(arg)) {
             print_report_usage(stdout);
             return 0;
-        } else if (!arg.empty() && arg[0] == '-') {
-            args.fail("unknown option '" + arg + "' (lpi report --help lists them)");
         } else {
+            args.refuse_unknown_option(arg);
             names.push_back(arg);
         }
     }
@@ -98,7 +97,7 @@ int methods_command(int argc, char **argv) {
     Arguments args("lpi methods", argc, argv);
     while (!args.done()) {
         const std::string arg = args.next();
-        if (arg == "--help" || arg == "-h") {
+        if (Arguments::is_help(arg)) {
             std::printf("usage: lpi methods\n  the integration methods (lpi run --method NAME): name, order,\n"
                         "  stages (leapfrog-equivalent cost), Poisson (keeps Casimirs to round-off),\n"
                         "  reference\n");

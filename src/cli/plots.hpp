@@ -1,5 +1,5 @@
-// Helpers for the gnuplot figures of lpi: log axes over whole decades, and
-// every figure written as PNG and as SVG beside it.
+// Helpers for the gnuplot figures of lpi: log axes over whole decades, every
+// figure written as PNG and as SVG beside it, and each method's style.
 #pragma once
 
 #include <algorithm>
@@ -59,5 +59,33 @@ inline std::string format(const char *pattern, ...) {
     text.resize(static_cast<std::size_t>(std::max(n, 0)));
     return text;
 }
+
+// Index of a registered method, -1 if none has that name.
+int method_index(const std::string &method);
+// Whether the registered method of that name is a Poisson map.
+bool is_poisson(const std::string &method);
+// Whether gnuplot is on the PATH: without it the figures are left out.
+bool have_gnuplot();
+// Runs a gnuplot script (its messages silenced); whether it succeeded.
+bool run_gnuplot(const std::string &script);
+
+// The i-th method's colour in a plot: twenty that read apart on white
+// (Okabe and Ito's, then Kelly's colours of maximum contrast).
+std::string plot_colour(std::size_t i);
+
+// The i-th method's marker: gnuplot's fifteen shapes (filled ones first),
+// then five glyphs; twenty in all, as many as the colours.
+std::string plot_marker(std::size_t i);
+
+// The i-th method of a plot: its own colour and marker; the baselines (not
+// Poisson maps) dashed, so the two families read apart at a glance.
+std::string plot_style(std::size_t i, const std::string &method);
+
+// A method's legend entry: its order and stages (a step's cost in leapfrog
+// steps), which is what tells the curves apart.
+std::string method_label(const std::string &method);
+
+// Starts a gnuplot script: CSV input, a grid, the key outside.
+FILE *open_plot_script(const std::string &path);
 
 }  // namespace lpi_cli

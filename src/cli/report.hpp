@@ -16,4 +16,13 @@ struct ReportOptions {
 
 void run_report(const Scene &scene, const ReportOptions &options);
 
+// One diagnostic sample of a run: the relative energy error and Casimir drift
+// at a time.
+struct Sample {
+    double time, energy_error, casimir_drift;
+};
+
+// Keeps the BLAS on the calling thread, so CPU times are those of one core.
+void measure_on_one_core();
+
 }  // namespace lpi_cli

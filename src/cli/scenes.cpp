@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "fields.hpp"
+#include "systems.hpp"
 
 namespace lpi_cli {
 
@@ -12,7 +13,7 @@ namespace {
 // The moment scene's Hamiltonian, split as in the paper: a nearly harmonic
 // ensemble with weak quartic coupling,
 // H = V(x1, x4) + T(x3, x8) + P(x1 x3) with V = x1/2 + x1^2/100 + x4/100,
-// T = x3/2 + x3^2/100 + x8/100 and P(u) = u/50 + u^2/100.
+// T = x3/2 + x3^2/100 + x8/100 and P(u) = u/50 + u^2/100 (systems.hpp).
 int potential_gradient(size_t, const double *x, double *g, void *) {
     g[0] = 0.5 + 0.02 * x[0];
     g[1] = 0.01;
@@ -22,13 +23,20 @@ int potential_energy(size_t, const double *x, double *h, void *) {
     *h = 0.5 * x[0] + 0.01 * x[0] * x[0] + 0.01 * x[1];
     return 0;
 }
-int product_h(double u, double *out, void *) {
-    *out = 0.02 * u + 0.01 * u * u;
-    return 0;
-}
-int product_dh(double u, double *out, void *) {
-    *out = 0.02 + 0.02 * u;
-    return 0;
+
+Handle coupled_moments() {
+    Handle h;
+    check(lpi_moments_create(h.out()), nullptr, "create moments");
+    const int32_t potential[2] = {0, 3}, kinetic[2] = {2, 7};
+    check(lpi_add_piece(h.get(), 2, potential, potential_gradient, potential_energy, nullptr), h.get(),
+          "add piece");
+    check(lpi_add_piece(h.get(), 2, kinetic, potential_gradient, potential_energy, nullptr), h.get(),
+          "add piece");
+    check(lpi_moments_add_product_piece(h.get(), product_energy, product_derivative, nullptr), h.get(),
+          "add product piece");
+    const std::vector<double> x = {1.0, 0.2, 0.5, 2.5, 0.6, 0.6, 0.3, 0.8};
+    check(lpi_set_state(h.get(), x.data(), x.size()), h.get(), "set state");
+    return h;
 }
 
 std::string format_number(double v) {
@@ -37,98 +45,57 @@ std::string format_number(double v) {
     return text;
 }
 
-std::string sine_euler_unavailable() {
-    lpi_system *probe = nullptr;
-    if (lpi_sine_euler_create(&probe, 3) == LPI_OK) {
-        lpi_destroy(probe);
-        return "";
-    }
-    return lpi_last_error(nullptr);
-}
-
 // The spectrum of W (lpi_casimirs) is computed with LAPACK.
 std::string sine_euler_spectrum_unavailable() {
     const std::string no_sine_euler = sine_euler_unavailable();
     if (!no_sine_euler.empty()) return no_sine_euler;
-    lpi_system *probe = nullptr;
-    check(lpi_sine_euler_create(&probe, 3), nullptr, "create sine-Euler");
+    Handle probe = sine_euler(3, std::vector<double>(18, 0.0));
     double spectrum[3];
-    const bool ok = lpi_casimirs(probe, spectrum, 3) == LPI_OK;
-    const std::string why = ok ? "" : lpi_last_error(probe);
-    lpi_destroy(probe);
-    return why;
+    const int status = lpi_casimirs(probe.get(), spectrum, 3);
+    return status == LPI_OK ? "" : lpi_last_error(probe.get());
 }
 
-Handle sine_euler_smooth_field(int N) {
-    Handle h;
-    check(lpi_sine_euler_create(h.out(), N), nullptr, "create sine-Euler");
-    const std::vector<double> w = smooth_random_field(N, 3.0, 7);
-    check(lpi_sine_euler_set_modes(h.get(), w.data(), w.size()), h.get(), "set modes");
-    return h;
-}
+Handle sine_euler_smooth_field(int N) { return sine_euler(N, smooth_random_field(N, 3.0, 7)); }
 
-Handle with_state(Handle h, const std::vector<double> &x) {
-    check(lpi_set_state(h.get(), x.data(), x.size()), h.get(), "set state");
-    return h;
+// A work-precision scene: its system, final time and sweep of step sizes
+// (the reference solution is set by the caller).
+Scene sweep_scene(const std::string &name, const std::string &description, std::function<Handle()> create,
+                  double final_time, std::vector<double> steps) {
+    Scene s;
+    s.name = name;
+    s.description = description;
+    s.create = std::move(create);
+    s.final_time = final_time;
+    s.steps = std::move(steps);
+    return s;
 }
 
 }  // namespace
 
 std::vector<Scene> builtin_scenes(const SceneOptions &options) {
     std::vector<Scene> scenes;
-    {
-        Scene s;
-        s.name = "rigid-body";
-        const double I1 = options.inertia[0], I2 = options.inertia[1], I3 = options.inertia[2];
-        s.description = "free rigid body, I = (" + format_number(I1) + ", " + format_number(I2) + ", " +
-                        format_number(I3) + "), m(0) = (1, 0.5, -0.3)";
-        s.create = [I1, I2, I3] {
-            Handle h;
-            check(lpi_rigid_body_create(h.out(), I1, I2, I3), nullptr, "create rigid body");
-            return with_state(std::move(h), {1.0, 0.5, -0.3});
-        };
-        s.final_time = 100.0;
-        s.steps = {0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625};
-        s.exact_reference = true;
-        scenes.push_back(s);
-    }
-    {
-        Scene s;
-        s.name = "pendulum";
-        s.description = "planar pendulum H = x3^2/2 + x2, x(0) = (sin 2, -cos 2, 0.3)";
-        s.create = [] {
-            Handle h;
-            check(lpi_pendulum_create(h.out()), nullptr, "create pendulum");
-            return with_state(std::move(h), {std::sin(2.0), -std::cos(2.0), 0.3});
-        };
-        s.final_time = 100.0;
-        s.steps = {0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625};
-        s.reference_method = "rk4";
-        s.reference_step = 2e-4;
-        scenes.push_back(s);
-    }
-    {
-        Scene s;
-        s.name = "moments";
-        s.description = "moment algebra (8-dim), pieces V(x1,x4) + T(x3,x8) + P(x1 x3)";
-        s.create = [] {
-            Handle h;
-            check(lpi_moments_create(h.out()), nullptr, "create moments");
-            const int32_t potential[2] = {0, 3}, kinetic[2] = {2, 7};
-            check(lpi_add_piece(h.get(), 2, potential, potential_gradient, potential_energy, nullptr),
-                  h.get(), "add piece");
-            check(lpi_add_piece(h.get(), 2, kinetic, potential_gradient, potential_energy, nullptr),
-                  h.get(), "add piece");
-            check(lpi_moments_add_product_piece(h.get(), product_h, product_dh, nullptr), h.get(),
-                  "add product piece");
-            return with_state(std::move(h), {1.0, 0.2, 0.5, 2.5, 0.6, 0.6, 0.3, 0.8});
-        };
-        s.final_time = 20.0;
-        s.steps = {0.05, 0.025, 0.0125, 0.00625, 0.003125};
-        s.reference_method = "kahan-li-8";
-        s.reference_step = 5e-4;
-        scenes.push_back(s);
-    }
+    const double I1 = options.inertia[0], I2 = options.inertia[1], I3 = options.inertia[2];
+    Scene rigid = sweep_scene("rigid-body",
+                              "free rigid body, I = (" + format_number(I1) + ", " + format_number(I2) + ", " +
+                                  format_number(I3) + "), m(0) = (1, 0.5, -0.3)",
+                              [I1, I2, I3] { return rigid_body(I1, I2, I3, {1.0, 0.5, -0.3}); }, 100.0,
+                              {0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625});
+    rigid.exact_reference = true;
+    scenes.push_back(rigid);
+
+    Scene pendulum_scene = sweep_scene(
+        "pendulum", "planar pendulum H = x3^2/2 + x2, x(0) = (sin 2, -cos 2, 0.3)",
+        [] { return pendulum({std::sin(2.0), -std::cos(2.0), 0.3}); }, 100.0,
+        {0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625});
+    pendulum_scene.reference_method = "rk4";
+    pendulum_scene.reference_step = 2e-4;
+    scenes.push_back(pendulum_scene);
+
+    Scene moments = sweep_scene("moments", "moment algebra (8-dim), pieces V(x1,x4) + T(x3,x8) + P(x1 x3)",
+                                coupled_moments, 20.0, {0.05, 0.025, 0.0125, 0.00625, 0.003125});
+    moments.reference_method = "kahan-li-8";
+    moments.reference_step = 5e-4;
+    scenes.push_back(moments);
     {
         Scene s;
         const int N = options.sine_euler_n;
@@ -138,7 +105,7 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         s.create = [N] { return sine_euler_smooth_field(N); };
         s.unavailable = sine_euler_unavailable;
         s.excluded_methods = {"direct-eq5"};
-        s.exclusion_reason = "direct-eq5 (O(N^4), a correctness reference) is left out";
+        s.exclusion_reason = "direct-eq5 (eq. 5 summed term by term, O(N^4): a cross-check of the fast methods) is left out";
         s.final_time = 10.0;
         s.steps = {0.4, 0.2, 0.1, 0.05, 0.025};
         s.reference_method = "kahan-li-8";
@@ -184,13 +151,7 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         s.name = "figure2";
         s.description = "the paper's Figure 2: sine-Euler N = 7, leapfrog, dt = 0.05, 10^5 steps, "
                         "|w| = 1, H(0) = 0.75";
-        s.create = [] {
-            Handle h;
-            check(lpi_sine_euler_create(h.out(), 7), nullptr, "create sine-Euler");
-            const std::vector<double> w = figure2_field();
-            check(lpi_sine_euler_set_modes(h.get(), w.data(), w.size()), h.get(), "set modes");
-            return h;
-        };
+        s.create = figure2_system;
         s.final_time = 5000.0;
         s.run_step = 0.05;
         s.unavailable = sine_euler_unavailable;

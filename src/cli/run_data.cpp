@@ -1,0 +1,233 @@
+#include "run_data.hpp"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+#include "plots.hpp"
+
+namespace lpi_cli {
+
+namespace {
+
+Array array_of(std::vector<std::size_t> shape, const std::vector<double> &values, bool integer = false) {
+    Array a;
+    a.shape = std::move(shape);
+    a.values = values;
+    a.integer = integer;
+    return a;
+}
+
+std::vector<double> indices(std::size_t n, double scale) {
+    std::vector<double> v(n);
+    for (std::size_t i = 0; i < n; ++i) v[i] = scale * static_cast<double>(i);
+    return v;
+}
+
+// The datasets of a run's data, with their dimensions named for xarray:
+// rows along "time", snapshots along "snapshot_time", the grid along x and y
+// (2 pi a / N), the Casimirs and state components by index.
+std::vector<Dataset> datasets_of(const RunData &d) {
+    const std::size_t rows = d.step.size(), shots = d.snapshot_step.size();
+    std::vector<Dataset> sets = {
+        {"time", array_of({rows}, d.time), {}, true},
+        {"step", array_of({rows}, d.step, true), {"time"}, false},
+        {"energy", array_of({rows}, d.energy), {"time"}, false},
+        {"energy_error", array_of({rows}, d.energy_error), {"time"}, false},
+        {"casimir", array_of({d.casimir_count}, indices(d.casimir_count, 1.0), true), {}, true},
+        {"casimirs", array_of({rows, d.casimir_count}, d.casimirs), {"time", "casimir"}, false},
+        {"casimir_drift", array_of({rows}, d.casimir_drift), {"time"}, false},
+        {"snapshot_time", array_of({shots}, d.snapshot_time), {}, true},
+        {"snapshot_step", array_of({shots}, d.snapshot_step, true), {"snapshot_time"}, false},
+    };
+    std::vector<std::size_t> shape = {shots};
+    shape.insert(shape.end(), d.snapshot_shape.begin(), d.snapshot_shape.end());
+    if (d.vorticity) {
+        const std::size_t N = d.snapshot_shape[0];
+        const std::vector<double> x = indices(N, 2.0 * kPi / static_cast<double>(N));
+        sets.push_back({"x", array_of({N}, x), {}, true});
+        sets.push_back({"y", array_of({N}, x), {}, true});
+        sets.push_back({"vorticity", array_of(shape, d.snapshots), {"snapshot_time", "x", "y"}, false});
+    } else {
+        sets.push_back({"component", array_of({d.snapshot_shape[0]}, indices(d.snapshot_shape[0], 1.0), true),
+                        {}, true});
+        sets.push_back({"state", array_of(shape, d.snapshots), {"snapshot_time", "component"}, false});
+    }
+    return sets;
+}
+
+
+// One array of a run's earlier data, in this run's format.
+std::string read_data_array(const RunOptions &o, const std::string &name, Array &a) {
+    const std::string path = data_path(o);
+    if (o.format == "npy") return read_npy(path + "/" + name + ".npy", a);
+    bool found = false;
+    return read_hdf5(path, name, a, &found);
+}
+
+}  // namespace
+
+// Where a run's data lives: DIR/SCENE.h5, or the folder DIR/SCENE of .npy files.
+std::string data_path(const RunOptions &o) {
+    return o.out_dir + "/" + o.scene + (o.format == "h5" ? ".h5" : "");
+}
+
+
+// Writes the data atomically (each .npy file on its own); "" or the reason.
+std::string write_data(const RunOptions &o, const RunData &d, const std::vector<Attribute> &attributes,
+                       SnapshotBytes &bytes) {
+    const std::vector<Dataset> sets = datasets_of(d);
+    const std::string path = data_path(o);
+    if (o.format == "h5") {
+        std::vector<std::uint64_t> offsets;
+        const std::string why = write_hdf5(path, sets, attributes, &offsets);
+        if (!why.empty()) return why;
+        bytes = {path, offsets.back()};
+        return "";
+    }
+    if (mkdir(path.c_str(), 0777) != 0 && errno != EEXIST) return std::strerror(errno);
+    for (const Dataset &set : sets) {
+        const std::string why = write_npy(path + "/" + set.name + ".npy", set.array);
+        if (!why.empty()) return set.name + ".npy: " + why;
+    }
+    // The attributes as JSON (json.load reads them).
+    auto quoted = [](const std::string &text) {
+        std::string q = "\"";
+        for (char c : text) q += c == '"' || c == '\\' ? std::string("\\") + c : std::string(1, c);
+        return q + "\"";
+    };
+    std::string json = "{";
+    for (const Attribute &a : attributes) {
+        char number[40];
+        std::snprintf(number, sizeof number, "%.17g", a.number);
+        if (a.integer) std::snprintf(number, sizeof number, "%lld", static_cast<long long>(a.number));
+        json += (json.size() > 1 ? ", \"" : "\"") + a.name + "\": " + (a.is_text ? quoted(a.text) : number);
+    }
+    FILE *f = std::fopen((path + "/attributes.json").c_str(), "w");
+    if (!f || std::fprintf(f, "%s}\n", json.c_str()) < 0 || std::fclose(f) != 0) return "attributes.json";
+    bytes = {path + "/" + sets.back().name + ".npy", npy_header(sets.back().array).size()};
+    return "";
+}
+
+// The snapshots of the interrupted run up to `start`, from its data; a note
+// on stdout (not an error) when they cannot be read.
+void keep_snapshots(const RunOptions &o, int64_t start, RunData &d) {
+    Array steps, times, shots;
+    std::string why = read_data_array(o, "snapshot_step", steps);
+    if (why.empty()) why = read_data_array(o, "snapshot_time", times);
+    if (why.empty()) why = read_data_array(o, d.vorticity ? "vorticity" : "state", shots);
+    const std::size_t n = steps.values.size();
+    if (why.empty() && (times.values.size() != n || shots.values.size() != n * d.snapshot_size()))
+        why = "its snapshot arrays do not match this run";
+    if (!why.empty()) {
+        std::printf("%s: %s; the data keeps the snapshots from step %lld on\n", data_path(o).c_str(),
+                    why.c_str(), static_cast<long long>(start));
+        return;
+    }
+    d.snapshot_step = steps.values;
+    d.snapshot_time = times.values;
+    d.snapshots = shots.values;
+    d.keep_up_to(start);
+}
+
+
+// The initial grid of --init, checked against the system's N. Exits 1 when
+// the file cannot be read, 2 when it holds no N x N grid for this run.
+std::vector<double> initial_grid(const std::string &path, int *N) {
+    Array a;
+    std::string why;
+    if (is_hdf5_file(path)) {
+        bool found = false;
+        why = read_hdf5(path, "init", a, &found);
+        if (!found && why.rfind("no dataset", 0) == 0) why = read_hdf5(path, "vorticity", a, &found);
+        if (!why.empty() && found) {
+            std::fprintf(stderr, "lpi run: --init %s: %s\n", path.c_str(), why.c_str());
+            std::exit(2);
+        }
+        if (!why.empty() && why.rfind("no dataset", 0) == 0) {
+            std::fprintf(stderr, "lpi run: --init %s: no dataset /init or /vorticity\n", path.c_str());
+            std::exit(2);
+        }
+        // A run's /vorticity holds snapshots (S, N, N): start from the last.
+        if (why.empty() && a.shape.size() == 3 && a.shape[0] > 0) {
+            const std::size_t size = a.shape[1] * a.shape[2];
+            a.values.erase(a.values.begin(), a.values.end() - static_cast<std::ptrdiff_t>(size));
+            a.shape.erase(a.shape.begin());
+        }
+    } else {
+        why = read_npy(path, a);
+    }
+    if (!why.empty()) {
+        std::fprintf(stderr, "lpi run: --init %s: %s\n", path.c_str(), why.c_str());
+        std::exit(1);
+    }
+    std::string shape;
+    for (std::size_t d : a.shape) shape += (shape.empty() ? "" : ", ") + std::to_string(d);
+    if (a.shape.size() != 2 || a.shape[0] != a.shape[1] || a.shape[0] < 3 || a.shape[0] % 2 == 0 ||
+        a.shape[0] > 2147483647u) {
+        std::fprintf(stderr, "lpi run: --init %s: the array has shape (%s), not (N, N) with N odd >= 3\n",
+                     path.c_str(), shape.c_str());
+        std::exit(2);
+    }
+    if (*N > 0 && static_cast<std::size_t>(*N) != a.shape[0]) {
+        std::fprintf(stderr, "lpi run: --init %s: the grid is %s x %s, but --N is %d\n", path.c_str(),
+                     std::to_string(a.shape[0]).c_str(), std::to_string(a.shape[0]).c_str(), *N);
+        std::exit(2);
+    }
+    *N = static_cast<int>(a.shape[0]);
+    return a.values;
+}
+
+
+// Draws every vorticity snapshot of the data as PNG and SVG with gnuplot,
+// which reads the doubles straight from the data file (nothing is copied
+// and nothing deleted). Returns how many were drawn.
+std::size_t plot_vorticity(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
+                           const std::string &method) {
+    const std::size_t N = d.snapshot_shape[0], shots = d.snapshot_step.size();
+    if (shots == 0 || bytes.offset == UINT64_MAX) return 0;
+    double scale = 0.0;  // one symmetric colour range for every snapshot
+    for (double v : d.snapshots) scale = std::max(scale, std::fabs(v));
+    if (!(scale > 0.0)) scale = 1.0;
+    const std::string script = o.out_dir + "/vorticity.gp";
+    FILE *g = std::fopen(script.c_str(), "w");
+    if (!g) return 0;
+    // Grid point (a, b) is x = 2 pi a / N, y = 2 pi b / N: the axes count
+    // x / 2 pi, each pixel centred on its point. The array is [a][b], b
+    // fastest: gnuplot reads it with x and y swapped back (transpose).
+    std::fprintf(g,
+                 "set size ratio -1\nset palette defined (0 '#2166ac', 0.5 'white', 1 '#b2182b')\n"
+                 "unset key\nset xrange [%.17g:%.17g]\nset yrange [%.17g:%.17g]\n"
+                 "set xtics 0.25 out nomirror\nset ytics 0.25 out nomirror\nset format x '%%g'\n"
+                 "set format y '%%g'\nset cbrange [%.6g:%.6g]\nset cbtics out\n"
+                 "set xlabel 'x / 2{/Symbol p}'\nset ylabel 'y / 2{/Symbol p}'\n"
+                 "set cblabel 'vorticity {/Symbol w}(x, y)'\n",
+                 -0.5 / N, 1.0 - 0.5 / N, -0.5 / N, 1.0 - 0.5 / N, -scale, scale);
+    const char *terminals[][2] = {{"pngcairo size 720,640 enhanced font ',12'", "png"},
+                                  {"svg size 720,640 enhanced font 'Helvetica,12' background '#ffffff'", "svg"}};
+    for (std::size_t k = 0; k < shots; ++k) {
+        char name[64];
+        const int64_t row = static_cast<int64_t>(d.snapshot_step[k]);
+        std::snprintf(name, sizeof name, "vorticity_%06lld", static_cast<long long>(row));
+        std::fprintf(g, "set title '%s, N = %zu, %s, dt = %g: t = %.6g (step %lld)' noenhanced\n",
+                     o.scene.c_str(), N, method.c_str(), dt, d.snapshot_time[k], static_cast<long long>(row));
+        for (const auto &terminal : terminals)
+            std::fprintf(g,
+                         "set terminal %s\nset output '%s/%s.%s'\n"
+                         "plot '%s' binary array=(%zu,%zu) format='%%float64' endian=little skip=%llu "
+                         "transpose dx=%.17g dy=%.17g origin=(0,0) with image\n",
+                         terminal[0], o.out_dir.c_str(), name, terminal[1], bytes.file.c_str(), N, N,
+                         static_cast<unsigned long long>(bytes.offset + 8 * k * N * N), 1.0 / N, 1.0 / N);
+    }
+    std::fprintf(g, "set output\n");
+    std::fclose(g);
+    if (!run_gnuplot(script)) return 0;
+    return shots;
+}
+
+}  // namespace lpi_cli

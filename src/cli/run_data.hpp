@@ -1,0 +1,72 @@
+// lpi run's output: the data it keeps (rows and snapshots) written as HDF5 or
+// .npy, read back when a run is resumed, the --init grid, and the vorticity
+// snapshots drawn with gnuplot.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "data_files.hpp"
+#include "run_options.hpp"
+
+namespace lpi_cli {
+
+// What lpi run keeps as data: every row of the CSV (full precision, the
+// Casimir drift added) and a snapshot of the state every --snapshots rows.
+struct RunData {
+    std::vector<double> step, time, energy, energy_error, casimir_drift;
+    std::vector<double> casimirs;  // rows x casimir_count
+    std::size_t casimir_count = 0;
+    std::vector<double> snapshot_step, snapshot_time;
+    std::vector<double> snapshots;            // snapshots x snapshot_shape
+    std::vector<std::size_t> snapshot_shape;  // (N, N) vorticity, else (dim) state
+    bool vorticity = false;
+
+    std::size_t snapshot_size() const {
+        std::size_t n = 1;
+        for (std::size_t d : snapshot_shape) n *= d;
+        return n;
+    }
+    // Drops the rows and snapshots after `step` (a resumed run's start).
+    void keep_up_to(int64_t last) {
+        std::size_t rows = 0, shots = 0;
+        while (rows < step.size() && step[rows] <= static_cast<double>(last)) ++rows;
+        while (shots < snapshot_step.size() && snapshot_step[shots] <= static_cast<double>(last)) ++shots;
+        for (auto *v : {&step, &time, &energy, &energy_error, &casimir_drift}) v->resize(rows);
+        casimirs.resize(rows * casimir_count);
+        snapshot_step.resize(shots);
+        snapshot_time.resize(shots);
+        snapshots.resize(shots * snapshot_size());
+    }
+};
+
+// Where the snapshots' raw doubles start in the written data (for gnuplot).
+struct SnapshotBytes {
+    std::string file;
+    std::uint64_t offset = UINT64_MAX;
+};
+
+
+// Where a run's data lives: DIR/SCENE.h5, or the folder DIR/SCENE of .npy files.
+std::string data_path(const RunOptions &o);
+
+// Writes the data atomically (each .npy file on its own); "" or the reason.
+std::string write_data(const RunOptions &o, const RunData &d, const std::vector<Attribute> &attributes,
+                       SnapshotBytes &bytes);
+
+// The snapshots of the interrupted run up to `start`, from its data; a note
+// on stdout (not an error) when they cannot be read.
+void keep_snapshots(const RunOptions &o, int64_t start, RunData &d);
+
+// The initial grid of --init, checked against the system's N. Exits 1 when
+// the file cannot be read, 2 when it holds no N x N grid for this run.
+std::vector<double> initial_grid(const std::string &path, int *N);
+
+// Draws every vorticity snapshot of the data as PNG and SVG with gnuplot,
+// which reads the doubles straight from the data file (nothing is copied
+// and nothing deleted). Returns how many were drawn.
+std::size_t plot_vorticity(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
+                           const std::string &method);
+
+}  // namespace lpi_cli
