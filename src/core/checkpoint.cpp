@@ -166,8 +166,11 @@ std::unique_ptr<Model> make_model_for_checkpoint(const std::string &kind,
                                      std::to_string(expected));
         return entry->build(p);
     } catch (const Error &e) {
-        // A build without FFTW cannot load sine-Euler: that is not a bad file.
-        if (e.status() == LPI_ERR_UNSUPPORTED || e.status() == LPI_ERR_FORMAT) throw;
+        // Neither is a bad file: a build without FFTW cannot load sine-Euler, and
+        // a system too large for this machine's memory may load on a larger one.
+        if (e.status() == LPI_ERR_UNSUPPORTED || e.status() == LPI_ERR_FORMAT ||
+            e.status() == LPI_ERR_NO_MEMORY)
+            throw;
         fail(LPI_ERR_FORMAT, std::string("invalid ") + kind + " parameters: " + e.what());
     }
 }
