@@ -19,6 +19,7 @@
 
 #include "../core/error.hpp"
 #include "../models/sine_euler.hpp"
+#include "../models/sine_euler/indexing.hpp"
 #include "fixed_point.hpp"
 #include "runge_kutta4.hpp"
 #include "lpi_config.h"
@@ -33,8 +34,6 @@ namespace {
 
 using cplx = std::complex<double>;
 
-int rep(int a, int N) { return a > N / 2 ? a - N : a; }
-
 // ---- direct-eq5: RK4 on the modes with eq. 5 summed term by term ------------
 
 class DirectEq5 final : public Integrator {
@@ -47,8 +46,8 @@ public:
         for (int j = 0; j < N; ++j) sine_[j] = std::sin(two_pi * j / N) / eps;
         for (int a = 0; a < N; ++a)
             for (int b = 0; b < N; ++b) {
-                const int ra = rep(a, N), rb = rep(b, N), norm2 = ra * ra + rb * rb;
-                weight_[static_cast<std::size_t>(a) * N + b] = norm2 ? 1.0 / norm2 : 0.0;
+                const double norm2 = sine_euler::norm2(a, b, N);
+                weight_[static_cast<std::size_t>(a) * N + b] = norm2 != 0 ? 1.0 / norm2 : 0.0;
             }
     }
 
@@ -140,10 +139,10 @@ public:
             }
         for (std::size_t m2 = 0; m2 < n; ++m2)
             for (std::size_t m1 = 0; m1 < n; ++m1) {
-                const long r1 = rep(static_cast<int>(m1), N), r2 = rep(static_cast<int>(m2), N);
-                const long norm2 = r1 * r1 + r2 * r2;
+                const double norm2 =
+                    sine_euler::norm2(static_cast<int>(m1), static_cast<int>(m2), N);
                 inverse_laplacian_[m2 * n + m1] =
-                    norm2 ? 1.0 / (static_cast<double>(N) * static_cast<double>(norm2)) : 0.0;
+                    norm2 != 0 ? 1.0 / (static_cast<double>(N) * norm2) : 0.0;
             }
         std::lock_guard<std::mutex> lock(fftw_planner_mutex());
         buffer_ = fftw_alloc_complex(index_.size());
@@ -381,7 +380,7 @@ int sine_euler_order(const Method &method, const Model &model) {
         fail(LPI_ERR_UNSUPPORTED, "method '" + method.name + "' integrates the matrix form of "
                                   "sine-Euler and applies to sine-Euler systems only (this "
                                   "system is " + model.kind() + ")");
-    return sine_euler->order();
+    return sine_euler->truncation();
 }
 
 std::unique_ptr<Integrator> make_direct_eq5(const Method &method, const Model &model,

@@ -1,10 +1,10 @@
-// The matrix form of sine-Euler (design notes, section 1): with q = exp(4 pi i/N),
+// The matrix form of sine-Euler (Zeitlin's su(N) basis): with q = exp(4 pi i/N),
 // g = diag(q^a), h e_a = e_{a-1}, J_m = exp(2 pi i m1 m2 / N) g^m1 h^m2, the entry
 // (a, b) of J_m is exp(2 pi i m1 (a + b) / N) when b - a = m2 (mod N), else 0.
 // So W = sum_m w_m J_m has W_{a,a+m2} = sum_m1 w_(m1,m2) exp(2 pi i m1 (2a + m2) / N),
 // and w_m = tr(W J_m^dagger) / N inverts it. Eq. 5 is dW/dt = (i/(2 eps)) [P, W]
 // with P = sum_{n != 0} w_n / |n|^2 J_n. These serve diagnostics and the
-// reference methods, never the splitting's hot path.
+// baseline methods, never the splitting's hot path.
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -15,6 +15,7 @@
 #include "../core/error.hpp"
 #include "lpi_config.h"
 #include "sine_euler.hpp"
+#include "sine_euler/indexing.hpp"
 
 namespace lpi {
 
@@ -29,7 +30,6 @@ std::vector<cplx> roots_of_unity(int N) {
     return root;
 }
 
-int rep(int a, int N) { return a > N / 2 ? a - N : a; }
 // Entry (a, b) of an N x N array; a N + b overflows an int past N = 46340.
 std::size_t at(int a, int b, int N) { return static_cast<std::size_t>(a) * N + b; }
 
@@ -86,9 +86,8 @@ void sine_euler_matrix_vector_field(int N, const double *modes, double *rate) {
     const cplx *w = reinterpret_cast<const cplx *>(modes);
     for (int a = 0; a < N; ++a)
         for (int b = 0; b < N; ++b) {
-            const std::int64_t ra = rep(a, N), rb = rep(b, N);
-            const std::int64_t norm2 = ra * ra + rb * rb;
-            p[at(a, b, N)] = norm2 ? w[at(a, b, N)] / static_cast<double>(norm2) : 0.0;
+            const double norm2 = sine_euler::norm2(a, b, N);
+            p[at(a, b, N)] = norm2 != 0 ? w[at(a, b, N)] / norm2 : 0.0;
         }
     sine_euler_modes_to_matrix(N, modes, reinterpret_cast<double *>(W.data()));
     sine_euler_modes_to_matrix(N, reinterpret_cast<const double *>(p.data()),
@@ -99,6 +98,18 @@ void sine_euler_matrix_vector_field(int N, const double *modes, double *rate) {
     const cplx factor(0.0, 1.0 / (2.0 * eps));
     for (std::size_t i = 0; i < n2; ++i) PW[i] = factor * (PW[i] - WP[i]);
     sine_euler_matrix_to_modes(N, reinterpret_cast<const double *>(PW.data()), rate);
+    // Round-off leaves the two halves slightly unequal, and that difference
+    // grows in an integrator (the field is not tangent to the Hermitian modes
+    // off them). The mirror half is set to the exact conjugate, so a linear
+    // combination with real coefficients (rk4, the midpoint rule) keeps a
+    // Hermitian state Hermitian to the bit; w_0 (J_0 = I) is inert.
+    cplx *r = reinterpret_cast<cplx *>(rate);
+    r[0] = 0.0;
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const std::size_t m = at(a, b, N), minus = sine_euler::mirror_index(a, b, N);
+            if (minus < m) r[m] = std::conj(r[minus]);
+        }
 }
 
 void sine_euler_traces(int N, const double *modes, int kmax, double *out) {
@@ -127,6 +138,12 @@ void sine_euler_spectrum(int N, const double *modes, double *out) {
     // Row-major W is column-major W^T = conj(W): the same real spectrum.
     std::vector<cplx> W(static_cast<std::size_t>(N) * N);
     sine_euler_modes_to_matrix(N, modes, reinterpret_cast<double *>(W.data()));
+    // zheevd on a matrix holding Inf or NaN returns garbage or never ends.
+    for (std::size_t i = 0; i < W.size(); ++i)
+        if (!std::isfinite(W[i].real()) || !std::isfinite(W[i].imag()))
+            fail(LPI_ERR_OVERFLOW, "the matrix W of this state overflows a double at entry (" +
+                                       std::to_string(i / N) + ", " + std::to_string(i % N) +
+                                       "): its spectrum cannot be computed");
     const char jobz = 'N', uplo = 'U';
     int info = 0, lwork = -1, lrwork = -1, liwork = -1, iwork_query = 0;
     cplx work_query;
