@@ -58,11 +58,9 @@ std::unique_ptr<Model> make_sine_euler(int N);
 // wisdom operation in the library holds this lock.
 std::mutex &fftw_planner_mutex();
 
-// ---- matrix form (sine_euler_matrix.cpp; no FFTW needed) ------------------
-// J_m = exp(2 pi i m1 m2 / N) g^m1 h^m2, W = sum_m w_m J_m. Both arrays are
-// N x N complex, interleaved; W row-major. O(N^3), used only on request.
-void sine_euler_modes_to_matrix(int N, const double *modes, double *W);
-void sine_euler_matrix_to_modes(int N, const double *W, double *modes);
+// ---- matrix form (sine_euler_matrix.cpp) ----------------------------------
+// W = sum_m w_m J_m, J_m = exp(2 pi i m1 m2 / N) g^m1 h^m2 (the transforms:
+// sine_euler/matrix_form.hpp). O(N^3) products, used only on request.
 // The vector field of eq. 5 through dW/dt = (i / (2 eps)) [P, W], exactly
 // Hermitian: the half plane is computed, the other half is its conjugate
 // and the inert mode w_0 does not move.

@@ -2,9 +2,10 @@
 // g = diag(q^a), h e_a = e_{a-1}, J_m = exp(2 pi i m1 m2 / N) g^m1 h^m2, the entry
 // (a, b) of J_m is exp(2 pi i m1 (a + b) / N) when b - a = m2 (mod N), else 0.
 // So W = sum_m w_m J_m has W_{a,a+m2} = sum_m1 w_(m1,m2) exp(2 pi i m1 (2a + m2) / N),
-// and w_m = tr(W J_m^dagger) / N inverts it. Eq. 5 is dW/dt = (i/(2 eps)) [P, W]
-// with P = sum_{n != 0} w_n / |n|^2 J_n. These serve diagnostics and the
-// baseline methods, never the splitting's hot path.
+// and w_m = tr(W J_m^dagger) / N inverts it (the transforms are
+// sine_euler::MatrixForm's, by FFT). Eq. 5 is dW/dt = (i/(2 eps)) [P, W] with
+// P = sum_{n != 0} w_n / |n|^2 J_n. These serve diagnostics and the baseline
+// methods, never the splitting's hot path; like the model, they need FFTW3.
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -16,19 +17,15 @@
 #include "lpi_config.h"
 #include "sine_euler.hpp"
 #include "sine_euler/indexing.hpp"
+#include "sine_euler/matrix_form.hpp"
+
+#if LPI_HAVE_FFTW
 
 namespace lpi {
 
 namespace {
 
 using cplx = std::complex<double>;
-
-std::vector<cplx> roots_of_unity(int N) {
-    std::vector<cplx> root(N);
-    const double two_pi = 2.0 * std::acos(-1.0);
-    for (int k = 0; k < N; ++k) root[k] = std::polar(1.0, two_pi * k / N);
-    return root;
-}
 
 // Entry (a, b) of an N x N array; a N + b overflows an int past N = 46340.
 std::size_t at(int a, int b, int N) { return static_cast<std::size_t>(a) * N + b; }
@@ -47,57 +44,18 @@ void multiply(int N, const cplx *A, const cplx *B, cplx *C) {
 
 }  // namespace
 
-void sine_euler_modes_to_matrix(int N, const double *modes, double *W_out) {
-    const auto root = roots_of_unity(N);
-    const cplx *w = reinterpret_cast<const cplx *>(modes);
-    cplx *W = reinterpret_cast<cplx *>(W_out);
-    for (int a = 0; a < N; ++a)
-        for (int m2 = 0; m2 < N; ++m2) {
-            const int step = (2 * a + m2) % N;
-            cplx sum = 0.0;
-            int phase = 0;
-            for (int m1 = 0; m1 < N; ++m1) {
-                sum += w[at(m1, m2, N)] * root[phase];
-                phase += step;
-                if (phase >= N) phase -= N;
-            }
-            W[at(a, (a + m2) % N, N)] = sum;
-        }
-}
-
-void sine_euler_matrix_to_modes(int N, const double *W_in, double *modes) {
-    const auto root = roots_of_unity(N);
-    const cplx *W = reinterpret_cast<const cplx *>(W_in);
-    cplx *w = reinterpret_cast<cplx *>(modes);
-    for (int m1 = 0; m1 < N; ++m1)
-        for (int m2 = 0; m2 < N; ++m2) {
-            cplx sum = 0.0;
-            for (int a = 0; a < N; ++a) {
-                const int phase = static_cast<int>((static_cast<std::int64_t>(m1) * (2 * a + m2)) % N);
-                sum += W[at(a, (a + m2) % N, N)] * std::conj(root[phase]);
-            }
-            w[at(m1, m2, N)] = sum / static_cast<double>(N);
-        }
-}
-
 void sine_euler_matrix_vector_field(int N, const double *modes, double *rate) {
     const std::size_t n2 = static_cast<std::size_t>(N) * N;
-    std::vector<cplx> p(n2), W(n2), P(n2), PW(n2), WP(n2);
-    const cplx *w = reinterpret_cast<const cplx *>(modes);
-    for (int a = 0; a < N; ++a)
-        for (int b = 0; b < N; ++b) {
-            const double norm2 = sine_euler::norm2(a, b, N);
-            p[at(a, b, N)] = norm2 != 0 ? w[at(a, b, N)] / norm2 : 0.0;
-        }
-    sine_euler_modes_to_matrix(N, modes, reinterpret_cast<double *>(W.data()));
-    sine_euler_modes_to_matrix(N, reinterpret_cast<const double *>(p.data()),
-                               reinterpret_cast<double *>(P.data()));
+    std::vector<cplx> W(n2), P(n2), PW(n2), WP(n2);
+    sine_euler::MatrixForm form(N, sine_euler::MatrixForm::RowMajor);
+    form.to_matrix(modes, W.data());
+    form.stream(W.data(), P.data());
     multiply(N, P.data(), W.data(), PW.data());
     multiply(N, W.data(), P.data(), WP.data());
     const double eps = 2.0 * std::acos(-1.0) / N;
     const cplx factor(0.0, 1.0 / (2.0 * eps));
     for (std::size_t i = 0; i < n2; ++i) PW[i] = factor * (PW[i] - WP[i]);
-    sine_euler_matrix_to_modes(N, reinterpret_cast<const double *>(PW.data()), rate);
+    form.to_modes(PW.data(), rate);
     // Round-off leaves the two halves slightly unequal, and that difference
     // grows in an integrator (the field is not tangent to the Hermitian modes
     // off them). The mirror half is set to the exact conjugate, so a linear
@@ -115,7 +73,7 @@ void sine_euler_matrix_vector_field(int N, const double *modes, double *rate) {
 void sine_euler_traces(int N, const double *modes, int kmax, double *out) {
     const std::size_t n2 = static_cast<std::size_t>(N) * N;
     std::vector<cplx> W(n2), power(n2), next(n2);
-    sine_euler_modes_to_matrix(N, modes, reinterpret_cast<double *>(W.data()));
+    sine_euler::MatrixForm(N, sine_euler::MatrixForm::RowMajor).to_matrix(modes, W.data());
     power = W;
     for (int k = 1; k <= kmax; ++k) {
         if (k > 1) {
@@ -137,7 +95,7 @@ extern "C" void zheevd_(const char *jobz, const char *uplo, const int *n, cplx *
 void sine_euler_spectrum(int N, const double *modes, double *out) {
     // Row-major W is column-major W^T = conj(W): the same real spectrum.
     std::vector<cplx> W(static_cast<std::size_t>(N) * N);
-    sine_euler_modes_to_matrix(N, modes, reinterpret_cast<double *>(W.data()));
+    sine_euler::MatrixForm(N, sine_euler::MatrixForm::RowMajor).to_matrix(modes, W.data());
     // zheevd on a matrix holding Inf or NaN returns garbage or never ends.
     for (std::size_t i = 0; i < W.size(); ++i)
         if (!std::isfinite(W[i].real()) || !std::isfinite(W[i].imag()))
@@ -170,3 +128,5 @@ void sine_euler_spectrum(int, const double *, double *) {
 #endif
 
 }  // namespace lpi
+
+#endif  // LPI_HAVE_FFTW
