@@ -21,7 +21,6 @@
 #include "runge_kutta4.hpp"
 #include "lpi_config.h"
 
-
 namespace lpi {
 
 namespace {

@@ -27,11 +27,19 @@ lpi::SineEulerModel &sine_euler(const lpi_system *sys) {
 
 std::size_t squared(int N) { return static_cast<std::size_t>(N) * static_cast<std::size_t>(N); }
 
-// Stores public coordinates converted from modes or a grid: the input was
-// finite, so a coordinate that is not has overflowed in the conversion.
-void set_converted(lpi_system *sys, const std::vector<double> &x, const char *from) {
-    lpi::require_no_overflow(x.data(), x.size(), [from](std::size_t i) {
-        return std::string("coordinate ") + std::to_string(i) + " of the field from these " + from;
+// Sets the state from modes (2 N^2 doubles) or a grid (N^2): checks the
+// length, converts to public coordinates, and, as the input was finite,
+// reports a coordinate that is not as an overflow of the conversion.
+template <class Convert>
+void set_converted(lpi_system *sys, const double *data, std::size_t n, const char *what,
+                   std::size_t per_mode, Convert &&convert) {
+    const auto &model = sine_euler(sys);
+    require(data, what);
+    lpi::require_length(what, n, per_mode * squared(model.truncation()));
+    std::vector<double> x(squared(model.truncation()));
+    convert(model, x.data());
+    lpi::require_no_overflow(x.data(), x.size(), [what](std::size_t i) {
+        return std::string("coordinate ") + std::to_string(i) + " of the field converted from the " + what;
     });
     sys->system.set_state(x.data(), x.size());
 }
@@ -60,12 +68,9 @@ LPI_API int lpi_sine_euler_size(const lpi_system *sys, int32_t *N) {
 
 LPI_API int lpi_sine_euler_set_modes(lpi_system *sys, const double *re_im, size_t n) {
     return guarded(sys, "lpi_sine_euler_set_modes", [&] {
-        const auto &model = sine_euler(sys);
-        require(re_im, "modes");
-        lpi::require_length("modes", n, 2 * squared(model.truncation()));
-        std::vector<double> x(squared(model.truncation()));
-        model.public_from_modes(re_im, x.data());
-        set_converted(sys, x, "modes");
+        set_converted(sys, re_im, n, "modes", 2, [&](const lpi::SineEulerModel &model, double *x) {
+            model.public_from_modes(re_im, x);
+        });
     });
 }
 
@@ -81,12 +86,9 @@ LPI_API int lpi_sine_euler_get_modes(const lpi_system *sys, double *re_im, size_
 
 LPI_API int lpi_sine_euler_set_grid(lpi_system *sys, const double *w, size_t n) {
     return guarded(sys, "lpi_sine_euler_set_grid", [&] {
-        const auto &model = sine_euler(sys);
-        require(w, "grid");
-        lpi::require_length("grid", n, squared(model.truncation()));
-        std::vector<double> x(squared(model.truncation()));
-        model.public_from_grid(w, x.data());
-        set_converted(sys, x, "grid values");
+        set_converted(sys, w, n, "grid", 1, [&](const lpi::SineEulerModel &model, double *x) {
+            model.public_from_grid(w, x);
+        });
     });
 }
 
