@@ -205,8 +205,15 @@ std::string fftw_wisdom_export_string() {
 #else  // !LPI_HAVE_FFTW
 
 namespace {
-[[noreturn]] void no_fftw() { fail(LPI_ERR_UNSUPPORTED, "FFTW wisdom needs FFTW3; this build has none"); }
+[[noreturn]] void no_fftw(const char *what = "FFTW wisdom") {
+    fail(LPI_ERR_UNSUPPORTED, std::string(what) + " needs FFTW3; this build has none");
+}
 }  // namespace
+
+namespace sine_euler {
+void grid_from_modes(int, const double *, double *) { no_fftw("the sine-Euler grid"); }
+void modes_from_grid(int, const double *, double *) { no_fftw("the sine-Euler grid"); }
+}  // namespace sine_euler
 
 void fftw_wisdom_import_file(const char *) { no_fftw(); }
 void fftw_wisdom_export_file(const char *) { no_fftw(); }
