@@ -1,7 +1,6 @@
 // The C ABI of sine-Euler and FFTW wisdom.
 #include <algorithm>
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
 #include <vector>
 
