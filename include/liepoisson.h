@@ -310,8 +310,10 @@ LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, d
 /* Measures the FFT floor: FFTW executing, with this system's plans, buffers
  * and thread count, the transforms that nsteps steps of the current method
  * execute (and nothing else). Gives seconds per step and transforms per step.
- * A benchmark diagnostic; the state is not touched. LPI_ERR_OVERFLOW when the
- * flow count nsteps x flows per step overflows. */
+ * A diagnostic: the time per step over this floor is what the library adds to
+ * FFTW on this machine and thread count, the figure to judge its overhead by
+ * (and to compare thread counts or wisdom). The state is not touched.
+ * LPI_ERR_OVERFLOW when the flow count nsteps x flows per step overflows. */
 LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *seconds_per_step,
                                      double *transforms_per_step);
 
@@ -330,7 +332,9 @@ LPI_API int lpi_set_threads(lpi_system *sys, int32_t n);
 /* FFTW wisdom (shared by the whole process; planning is serialised inside the
  * library). Built without FFTW3: LPI_ERR_UNSUPPORTED. export_string writes at
  * most size bytes including the NUL and sets *length to the length without
- * it; LPI_ERR_SIZE when size <= *length (buf may then be NULL with size 0). */
+ * it; LPI_ERR_SIZE when size <= *length (buf may then be NULL with size 0).
+ * A file that cannot be opened, read or written: LPI_ERR_IO (the message
+ * gives the path and the reason); text that is not wisdom: LPI_ERR_INVALID. */
 LPI_API int lpi_fftw_wisdom_import_file(const char *path);
 LPI_API int lpi_fftw_wisdom_export_file(const char *path);
 LPI_API int lpi_fftw_wisdom_import_string(const char *wisdom);

@@ -3,6 +3,7 @@
  * The references here are written from the mathematics (DESIGN.md section 1)
  * and share no code with the library. */
 #include <complex.h>
+#include <float.h>
 #include <pthread.h>
 #include <time.h>
 #include <unistd.h>
@@ -632,8 +633,19 @@ static void test_wisdom(void **state) {
     free(text);
     LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_string("not wisdom"), LPI_ERR_INVALID,
                      "lpi_fftw_wisdom_import_string");
-    LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_file("/nonexistent/wisdom"), LPI_ERR_INVALID,
+    LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_file("/nonexistent/wisdom"), LPI_ERR_IO,
                      "lpi_fftw_wisdom_import_file");
+    LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_export_file("/nonexistent/wisdom"), LPI_ERR_IO,
+                     "lpi_fftw_wisdom_export_file");
+    /* A file that can be read but holds no wisdom is invalid input, not I/O. */
+    char path[] = "/tmp/lpi_not_wisdom_XXXXXX";
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    assert_int_equal(write(fd, "not wisdom\n", 11), 11);
+    close(fd);
+    LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_file(path), LPI_ERR_INVALID,
+                     "lpi_fftw_wisdom_import_file");
+    unlink(path);
     LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_file(NULL), LPI_ERR_NULL,
                      "lpi_fftw_wisdom_import_file");
 }
@@ -692,6 +704,12 @@ static void test_bad_input(void **state) {
     grid[5] = NAN;
     LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_grid(sys, grid, n), LPI_ERR_NONFINITE,
                      "lpi_sine_euler_set_grid");
+    /* Finite values whose Fourier transform overflows: an overflow, not a
+     * non-finite input, and the state is left as it was. */
+    for (size_t i = 0; i < n; ++i) grid[i] = DBL_MAX;
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_grid(sys, grid, n), LPI_ERR_OVERFLOW,
+                     "lpi_sine_euler_set_grid");
+    assert_non_null(strstr(lpi_last_error(sys), "overflows"));
     LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_grid(sys, grid, n + 1), LPI_ERR_SIZE,
                      "lpi_sine_euler_set_grid");
     LPI_ASSERT_FAILS(sys, lpi_sine_euler_get_grid(sys, grid, 2 * n), LPI_ERR_SIZE,

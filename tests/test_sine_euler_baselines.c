@@ -5,6 +5,8 @@
  * it is summed); isomp keeps the spectrum to its iteration tolerance where
  * rk4-matrix drifts; non-convergence is reported and rolled back; other
  * systems refuse these methods. */
+#include <float.h>
+
 #include "lpi_test.h"
 
 /* What this build has (set in main): sine-Euler needs FFTW; isomp and
@@ -204,6 +206,52 @@ static double spectrum_drift(int N, const double *w0, const char *method, double
     return max_abs_diff(before, after, (size_t)N) / max_abs(before, (size_t)N);
 }
 
+/* rk4 and the midpoint rule on the modes combine the field's values with real
+ * coefficients, so a field that is exactly Hermitian keeps a Hermitian state
+ * Hermitian to the bit; one that is only Hermitian to round-off lets the
+ * non-Hermitian part grow. After many steps every mode is still the exact
+ * conjugate of its mirror and w_0 is still real. */
+static void test_modes_stay_exactly_hermitian(void **state) {
+    (void)state;
+    require_fftw();
+    const int N = 9;
+    const size_t n = (size_t)N * N;
+    double w[2 * 81], out[2 * 81];
+    random_field(N, 11, w);
+    const char *methods[] = {"rk4", "implicit-midpoint"};
+    for (int k = 0; k < 2; ++k) {
+        run(N, w, methods[k], 20.0, 2000, out);
+        assert_true(out[1] == 0.0);
+        size_t broken = 0;
+        for (int a = 0; a < N; ++a)
+            for (int b = 0; b < N; ++b) {
+                const size_t m = (size_t)a * N + b, minus = (size_t)((N - a) % N) * N + (N - b) % N;
+                broken += out[2 * m] != out[2 * minus] || out[2 * m + 1] != -out[2 * minus + 1];
+            }
+        printf("%-18s 2000 steps, N = %d: %zu of %zu modes not the exact conjugate of their mirror\n",
+               methods[k], N, broken, n);
+        assert_int_equal(broken, 0);
+        assert_true(max_abs_diff(out, w, 2 * n) > 1e-3); /* the field did move */
+    }
+}
+
+/* The Casimir spectrum of a state whose matrix W overflows is refused as an
+ * overflow before LAPACK sees it. */
+static void test_spectrum_of_overflowing_matrix(void **state) {
+    (void)state;
+    require_blas();
+    const int N = 5;
+    const size_t n = (size_t)N * N;
+    double w[2 * 25] = {0};
+    /* Modes (a, 0), a != 0, real and equal: Hermitian, and W_00 is their sum. */
+    for (int a = 1; a < N; ++a) w[2 * a * N] = 0.45 * DBL_MAX;
+    lpi_system *sys = sine_euler(N, w);
+    double c[5];
+    LPI_ASSERT_FAILS(sys, lpi_casimirs(sys, c, n / N), LPI_ERR_OVERFLOW, "lpi_casimirs");
+    assert_non_null(strstr(lpi_last_error(sys), "matrix W of this state overflows"));
+    lpi_destroy(sys);
+}
+
 static void test_isomp_isospectral(void **state) {
     (void)state;
     require_blas();
@@ -312,6 +360,8 @@ int main(void) {
         cmocka_unit_test(test_direct_eq5_size_limit),
         cmocka_unit_test(test_rk4_forms_agree),
         cmocka_unit_test(test_orders),
+        cmocka_unit_test(test_modes_stay_exactly_hermitian),
+        cmocka_unit_test(test_spectrum_of_overflowing_matrix),
         cmocka_unit_test(test_isomp_isospectral),
         cmocka_unit_test(test_isomp_non_convergence_rolls_back),
         cmocka_unit_test(test_switching),

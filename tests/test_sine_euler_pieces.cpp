@@ -9,6 +9,7 @@
 #include "lpi_config.h"
 #include "lpi_test.h"
 #include "models/sine_euler.hpp"
+#include "models/sine_euler/projective_line.hpp"
 
 namespace {
 
@@ -45,7 +46,7 @@ void test_each_mode_has_one_owner(void **) {
 #else
     for (int N : kSizes) {
         auto model = lpi::make_sine_euler(N);
-        auto &se = dynamic_cast<lpi::SineEulerModel &>(*model);
+        const auto line = lpi::sine_euler::projective_line(N);
         std::vector<double> state(2 * N * N, 0.0);
         for (int i = 1; i < N * N; ++i) {
             const int a = i / N, b = i % N;
@@ -55,7 +56,7 @@ void test_each_mode_has_one_owner(void **) {
             state[2 * minus] = 1.0;
             int owners = 0;
             for (std::size_t k = 0; k < model->piece_count(); ++k)
-                owners += se.piece_energy(k, state.data()) != 0.0;
+                owners += lpi::sine_euler::piece_energy(line.at(k), N, state.data()) != 0.0;
             if (owners != 1) fail_msg("N = %d, mode %d: %d pieces own it", N, i, owners);
         }
     }
@@ -69,7 +70,7 @@ void test_piece_energies_sum_to_h(void **) {
 #else
     for (int N : kSizes) {
         auto model = lpi::make_sine_euler(N);
-        auto &se = dynamic_cast<lpi::SineEulerModel &>(*model);
+        const auto line = lpi::sine_euler::projective_line(N);
         std::vector<double> state(2 * N * N);
         unsigned seed = 1;
         for (int i = 0; i < 2 * N * N; ++i) {
@@ -80,7 +81,7 @@ void test_piece_energies_sum_to_h(void **) {
         model->to_public(state.data(), x.data());
         model->from_public(x.data(), state.data());  // make it Hermitian
         double sum = 0.0;
-        for (std::size_t k = 0; k < model->piece_count(); ++k) sum += se.piece_energy(k, state.data());
+        for (std::size_t k = 0; k < model->piece_count(); ++k) sum += lpi::sine_euler::piece_energy(line.at(k), N, state.data());
         const double H = model->energy(state.data());
         std::printf("N = %2d: %3zu pieces, sum of piece energies - H = %.1e\n", N,
                     model->piece_count(), sum - H);
@@ -91,7 +92,7 @@ void test_piece_energies_sum_to_h(void **) {
     // so a mode owned twice or by no piece moves the sum by at least 1/4.
     for (int N : {81, 121, 135, 147, 243, 343, 1155, 4097}) {
         auto model = lpi::make_sine_euler(N);
-        auto &se = dynamic_cast<lpi::SineEulerModel &>(*model);
+        const auto line = lpi::sine_euler::projective_line(N);
         assert_true(model->piece_count() == projective_line_size(N));
         std::vector<double> x(static_cast<std::size_t>(N) * N), state(2 * x.size());
         unsigned seed = 7;
@@ -114,7 +115,7 @@ void test_piece_energies_sum_to_h(void **) {
                 state[2 * (static_cast<std::size_t>(a) * N + b) + 1] *= norm;
             }
         double sum = 0.0;
-        for (std::size_t k = 0; k < model->piece_count(); ++k) sum += se.piece_energy(k, state.data());
+        for (std::size_t k = 0; k < model->piece_count(); ++k) sum += lpi::sine_euler::piece_energy(line.at(k), N, state.data());
         const double H = model->energy(state.data());
         assert_true(std::fabs(sum - H) < 0.1);
         assert_true(H > 0.25 * 0.5 * (static_cast<double>(N) * N - 1));

@@ -3,37 +3,29 @@
 // Conventions: W = sum_m w_m J_m is Hermitian,
 // eq. 5 is dW/dt = [B, W] with B = i f P, f = 1/(2 eps), eps = 2 pi/N and
 // P = sum_{n != 0} w_n / |n|^2 J_n (Hermitian, so B is anti-Hermitian).
-// Entry (a, a + m2) of W is sum_m1 w_(m1,m2) exp(2 pi i m1 k / N) with
-// k = 2a + m2 (mod N): each cyclic diagonal m2 of W, indexed by k, is a DFT of
-// the modes with that m2. So modes <-> matrix is 2N FFTs of length N, and
-// P(W) is, diagonal by diagonal, a DFT, a division by |m|^2 and a DFT back.
-// Matrices are stored column-major, as BLAS wants them.
+// The transforms are sine_euler::MatrixForm's. Matrices are stored
+// column-major, as BLAS wants them.
 #include "sine_euler_matrix_methods.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <complex>
-#include <mutex>
 #include <string>
 #include <vector>
 
 #include "../core/error.hpp"
 #include "../models/sine_euler.hpp"
+#include "../models/sine_euler/indexing.hpp"
+#include "../models/sine_euler/matrix_form.hpp"
 #include "fixed_point.hpp"
 #include "runge_kutta4.hpp"
 #include "lpi_config.h"
-
-#if LPI_HAVE_FFTW
-#include <fftw3.h>
-#endif
 
 namespace lpi {
 
 namespace {
 
 using cplx = std::complex<double>;
-
-int rep(int a, int N) { return a > N / 2 ? a - N : a; }
 
 // ---- direct-eq5: RK4 on the modes with eq. 5 summed term by term ------------
 
@@ -47,8 +39,8 @@ public:
         for (int j = 0; j < N; ++j) sine_[j] = std::sin(two_pi * j / N) / eps;
         for (int a = 0; a < N; ++a)
             for (int b = 0; b < N; ++b) {
-                const int ra = rep(a, N), rb = rep(b, N), norm2 = ra * ra + rb * rb;
-                weight_[static_cast<std::size_t>(a) * N + b] = norm2 ? 1.0 / norm2 : 0.0;
+                const double norm2 = sine_euler::norm2(a, b, N);
+                weight_[static_cast<std::size_t>(a) * N + b] = norm2 != 0 ? 1.0 / norm2 : 0.0;
             }
     }
 
@@ -126,100 +118,6 @@ void multiply(int N, const cplx *A, const cplx *B, cplx *C) {
     zgemm_(&no, &no, &N, &N, &N, &one, A, &N, B, &N, &zero, C, &N, 1, 1);
 }
 
-// The transforms between modes and the matrix W, and W -> P(W).
-class MatrixForm {
-public:
-    explicit MatrixForm(int N)
-        : N_(N), index_(static_cast<std::size_t>(N) * N), inverse_laplacian_(index_.size()) {
-        const std::size_t n = static_cast<std::size_t>(N);
-        const std::size_t half = (n + 1) / 2;  // the inverse of 2 mod N (N odd)
-        for (std::size_t m2 = 0; m2 < n; ++m2)
-            for (std::size_t k = 0; k < n; ++k) {
-                const std::size_t a = (k + n - m2) * half % n, b = (a + m2) % n;
-                index_[m2 * n + k] = a + b * n;
-            }
-        for (std::size_t m2 = 0; m2 < n; ++m2)
-            for (std::size_t m1 = 0; m1 < n; ++m1) {
-                const long r1 = rep(static_cast<int>(m1), N), r2 = rep(static_cast<int>(m2), N);
-                const long norm2 = r1 * r1 + r2 * r2;
-                inverse_laplacian_[m2 * n + m1] =
-                    norm2 ? 1.0 / (static_cast<double>(N) * static_cast<double>(norm2)) : 0.0;
-            }
-        std::lock_guard<std::mutex> lock(fftw_planner_mutex());
-        buffer_ = fftw_alloc_complex(index_.size());
-        if (!buffer_) fail(LPI_ERR_NO_MEMORY, "cannot allocate the matrix-form FFT buffer");
-        // N transforms of length N over the rows of buffer_ (one per diagonal).
-        forward_ = fftw_plan_many_dft(1, &N_, N_, buffer_, nullptr, 1, N_, buffer_, nullptr, 1, N_,
-                                      FFTW_FORWARD, FFTW_ESTIMATE);
-        backward_ = fftw_plan_many_dft(1, &N_, N_, buffer_, nullptr, 1, N_, buffer_, nullptr, 1,
-                                       N_, FFTW_BACKWARD, FFTW_ESTIMATE);
-        if (!forward_ || !backward_) {
-            release();
-            fail(LPI_ERR_INTERNAL, "FFTW could not plan the matrix-form transforms");
-        }
-    }
-    ~MatrixForm() {
-        std::lock_guard<std::mutex> lock(fftw_planner_mutex());
-        release();
-    }
-    MatrixForm(const MatrixForm &) = delete;
-    MatrixForm &operator=(const MatrixForm &) = delete;
-
-    void to_matrix(const double *modes, cplx *W) {
-        const std::size_t N = static_cast<std::size_t>(N_);
-        const cplx *w = reinterpret_cast<const cplx *>(modes);
-        cplx *x = reinterpret_cast<cplx *>(buffer_);
-        for (std::size_t m1 = 0; m1 < N; ++m1)
-            for (std::size_t m2 = 0; m2 < N; ++m2) x[m2 * N + m1] = w[m1 * N + m2];
-        fftw_execute(backward_);
-        scatter(W);
-    }
-
-    void to_modes(const cplx *W, double *modes) {
-        const std::size_t N = static_cast<std::size_t>(N_);
-        gather(W);
-        fftw_execute(forward_);
-        const cplx *x = reinterpret_cast<const cplx *>(buffer_);
-        cplx *w = reinterpret_cast<cplx *>(modes);
-        const double scale = 1.0 / N_;
-        for (std::size_t m1 = 0; m1 < N; ++m1)
-            for (std::size_t m2 = 0; m2 < N; ++m2) w[m1 * N + m2] = scale * x[m2 * N + m1];
-    }
-
-    // P = sum_{n != 0} w_n / |n|^2 J_n for W = sum_n w_n J_n.
-    void stream(const cplx *W, cplx *P) {
-        gather(W);
-        fftw_execute(forward_);
-        cplx *x = reinterpret_cast<cplx *>(buffer_);
-        for (std::size_t i = 0; i < index_.size(); ++i) x[i] *= inverse_laplacian_[i];
-        fftw_execute(backward_);
-        scatter(P);
-    }
-
-private:
-    void gather(const cplx *W) {
-        cplx *x = reinterpret_cast<cplx *>(buffer_);
-        for (std::size_t i = 0; i < index_.size(); ++i) x[i] = W[index_[i]];
-    }
-    void scatter(cplx *W) const {
-        const cplx *x = reinterpret_cast<const cplx *>(buffer_);
-        for (std::size_t i = 0; i < index_.size(); ++i) W[index_[i]] = x[i];
-    }
-    void release() {
-        if (forward_) fftw_destroy_plan(forward_);
-        if (backward_) fftw_destroy_plan(backward_);
-        if (buffer_) fftw_free(buffer_);
-        forward_ = backward_ = nullptr;
-        buffer_ = nullptr;
-    }
-
-    int N_;
-    std::vector<std::size_t> index_;        // [m2 * N + k] -> entry (a, a + m2) of W
-    std::vector<double> inverse_laplacian_;  // [m2 * N + m1] = 1 / (N |m|^2), 0 at m = 0
-    fftw_complex *buffer_ = nullptr;
-    fftw_plan forward_ = nullptr, backward_ = nullptr;
-};
-
 bool matrix_finite(const std::vector<cplx> &W) {
     return all_finite(reinterpret_cast<const double *>(W.data()), 2 * W.size());
 }
@@ -230,7 +128,7 @@ bool matrix_finite(const std::vector<cplx> &W) {
 class MatrixIntegrator : public Integrator {
 protected:
     explicit MatrixIntegrator(int N)
-        : N_(N), size_(static_cast<std::size_t>(N) * N), form_(N), W_(size_), P_(size_),
+        : N_(N), size_(static_cast<std::size_t>(N) * N), form_(N, sine_euler::MatrixForm::ColumnMajor), W_(size_), P_(size_),
           X_(size_), f_(N / (4.0 * std::acos(-1.0))) {}
 
     // One step of size dt on W_ (s: its index within the run).
@@ -259,7 +157,7 @@ protected:
 
     int N_;
     std::size_t size_;
-    MatrixForm form_;
+    sine_euler::MatrixForm form_;
     std::vector<cplx> W_, P_, X_;
     double f_;  // 1 / (2 eps) = N / (4 pi)
 };
@@ -381,7 +279,7 @@ int sine_euler_order(const Method &method, const Model &model) {
         fail(LPI_ERR_UNSUPPORTED, "method '" + method.name + "' integrates the matrix form of "
                                   "sine-Euler and applies to sine-Euler systems only (this "
                                   "system is " + model.kind() + ")");
-    return sine_euler->order();
+    return sine_euler->truncation();
 }
 
 std::unique_ptr<Integrator> make_direct_eq5(const Method &method, const Model &model,

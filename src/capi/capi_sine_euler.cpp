@@ -1,19 +1,13 @@
 // The C ABI of sine-Euler and FFTW wisdom.
 #include <algorithm>
-#include <chrono>
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
 #include <vector>
 
 #include "../core/methods.hpp"
 #include "../models/sine_euler.hpp"
+#include "../models/sine_euler/transforms.hpp"
 #include "handle.hpp"
-#include "lpi_config.h"
-
-#if LPI_HAVE_FFTW
-#include <fftw3.h>
-#endif
 
 using lpi::capi::create;
 using lpi::capi::guarded;
@@ -32,11 +26,19 @@ lpi::SineEulerModel &sine_euler(const lpi_system *sys) {
 
 std::size_t squared(int N) { return static_cast<std::size_t>(N) * static_cast<std::size_t>(N); }
 
-// Stores public coordinates converted from modes or a grid: the input was
-// finite, so a coordinate that is not has overflowed in the conversion.
-void set_converted(lpi_system *sys, const std::vector<double> &x, const char *from) {
-    lpi::require_no_overflow(x.data(), x.size(), [from](std::size_t i) {
-        return std::string("coordinate ") + std::to_string(i) + " of the field from these " + from;
+// Sets the state from modes (2 N^2 doubles) or a grid (N^2): checks the
+// length, converts to public coordinates, and, as the input was finite,
+// reports a coordinate that is not as an overflow of the conversion.
+template <class Convert>
+void set_converted(lpi_system *sys, const double *data, std::size_t n, const char *what,
+                   std::size_t per_mode, Convert &&convert) {
+    const auto &model = sine_euler(sys);
+    require(data, what);
+    lpi::require_length(what, n, per_mode * squared(model.truncation()));
+    std::vector<double> x(squared(model.truncation()));
+    convert(model, x.data());
+    lpi::require_no_overflow(x.data(), x.size(), [what](std::size_t i) {
+        return std::string("coordinate ") + std::to_string(i) + " of the field converted from the " + what;
     });
     sys->system.set_state(x.data(), x.size());
 }
@@ -45,10 +47,6 @@ void set_converted(lpi_system *sys, const std::vector<double> &x, const char *fr
 std::string entry_name(const char *what, std::size_t i, int N) {
     return std::string(what) + " (" + std::to_string(i / static_cast<std::size_t>(N)) + ", " +
            std::to_string(i % static_cast<std::size_t>(N)) + ")";
-}
-
-[[maybe_unused]] void no_fftw() {
-    lpi::fail(LPI_ERR_UNSUPPORTED, "FFTW wisdom needs FFTW3; this build has none");
 }
 
 }  // namespace
@@ -63,18 +61,15 @@ LPI_API int lpi_sine_euler_size(const lpi_system *sys, int32_t *N) {
     return guarded(sys, "lpi_sine_euler_size", [&] {
         const auto &model = sine_euler(sys);
         require(N, "N");
-        *N = model.order();
+        *N = model.truncation();
     });
 }
 
 LPI_API int lpi_sine_euler_set_modes(lpi_system *sys, const double *re_im, size_t n) {
     return guarded(sys, "lpi_sine_euler_set_modes", [&] {
-        const auto &model = sine_euler(sys);
-        require(re_im, "modes");
-        lpi::require_length("modes", n, 2 * squared(model.order()));
-        std::vector<double> x(squared(model.order()));
-        model.public_from_modes(re_im, x.data());
-        set_converted(sys, x, "modes");
+        set_converted(sys, re_im, n, "modes", 2, [&](const lpi::SineEulerModel &model, double *x) {
+            model.public_from_modes(re_im, x);
+        });
     });
 }
 
@@ -82,7 +77,7 @@ LPI_API int lpi_sine_euler_get_modes(const lpi_system *sys, double *re_im, size_
     return guarded(sys, "lpi_sine_euler_get_modes", [&] {
         const auto &model = sine_euler(sys);
         require(re_im, "modes buffer");
-        lpi::require_length("modes buffer", n, 2 * squared(model.order()));
+        lpi::require_length("modes buffer", n, 2 * squared(model.truncation()));
         const std::vector<double> &state = sys->system.working_state();
         std::memcpy(re_im, state.data(), sizeof(double) * n);
     });
@@ -90,12 +85,9 @@ LPI_API int lpi_sine_euler_get_modes(const lpi_system *sys, double *re_im, size_
 
 LPI_API int lpi_sine_euler_set_grid(lpi_system *sys, const double *w, size_t n) {
     return guarded(sys, "lpi_sine_euler_set_grid", [&] {
-        const auto &model = sine_euler(sys);
-        require(w, "grid");
-        lpi::require_length("grid", n, squared(model.order()));
-        std::vector<double> x(squared(model.order()));
-        model.public_from_grid(w, x.data());
-        set_converted(sys, x, "grid values");
+        set_converted(sys, w, n, "grid", 1, [&](const lpi::SineEulerModel &model, double *x) {
+            model.public_from_grid(w, x);
+        });
     });
 }
 
@@ -103,11 +95,11 @@ LPI_API int lpi_sine_euler_get_grid(const lpi_system *sys, double *w, size_t n) 
     return guarded(sys, "lpi_sine_euler_get_grid", [&] {
         const auto &model = sine_euler(sys);
         require(w, "grid buffer");
-        lpi::require_length("grid buffer", n, squared(model.order()));
+        lpi::require_length("grid buffer", n, squared(model.truncation()));
         std::vector<double> grid(n);
         model.grid(sys->system.working_state().data(), grid.data());
         lpi::require_no_overflow(grid.data(), n, [&](std::size_t i) {
-            return entry_name("grid value", i, model.order()) + " of this state";
+            return entry_name("grid value", i, model.truncation()) + " of this state";
         });
         std::memcpy(w, grid.data(), sizeof(double) * n);
     });
@@ -145,66 +137,38 @@ LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *se
         require(transforms_per_step, "transforms_per_step");
         if (nsteps < 1) lpi::fail(LPI_ERR_INVALID, "nsteps must be >= 1, got " + std::to_string(nsteps));
         const lpi::Method &method = sys->system.method();
-        // Only splittings have a flow program; every other kind is refused.
+        // Only splittings step by line flows; every other kind is refused.
         const bool splitting = method.kind == lpi::MethodKind::Sequence ||
                                method.kind == lpi::MethodKind::SequenceAdjoint ||
                                method.kind == lpi::MethodKind::SymmetricComposition;
         if (!splitting)
             lpi::fail(LPI_ERR_INVALID, "the FFT floor is defined for splitting methods, not '" +
                                            method.name + "'");
-        // Flows per step in a long run, as the splitting integrator counts them.
-        const auto program = lpi::build_flow_program(method, model.piece_count());
-        const bool seam = program.size() > 1 && program.front().piece == program.back().piece;
-        const std::size_t flows = program.size() - (seam ? 1 : 0);
-        if (static_cast<std::uint64_t>(nsteps) > SIZE_MAX / flows)
-            lpi::fail(LPI_ERR_OVERFLOW, "nsteps = " + std::to_string(nsteps) + " times " +
-                                            std::to_string(flows) +
-                                            " flows per step overflows the flow count");
         sys->system.prepare_threads();
-        const auto start = std::chrono::steady_clock::now();
-        const double transforms = model.run_fft_floor(flows * static_cast<std::size_t>(nsteps));
-        const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
-        *seconds_per_step = elapsed.count() / static_cast<double>(nsteps);
-        *transforms_per_step = transforms / static_cast<double>(nsteps);
+        const lpi::TransformTiming timing = model.time_transforms(sys->system.flows_per_step(), nsteps);
+        *seconds_per_step = timing.seconds_per_step;
+        *transforms_per_step = timing.transforms_per_step;
     });
 }
 
 LPI_API int lpi_fftw_wisdom_import_file(const char *path) {
     return guarded(nullptr, "lpi_fftw_wisdom_import_file", [&] {
         require(path, "path");
-#if LPI_HAVE_FFTW
-        std::lock_guard<std::mutex> lock(lpi::fftw_planner_mutex());
-        if (!fftw_import_wisdom_from_filename(path))
-            lpi::fail(LPI_ERR_INVALID, std::string("could not read FFTW wisdom from '") + path + "'");
-#else
-        no_fftw();
-#endif
+        lpi::fftw_wisdom_import_file(path);
     });
 }
 
 LPI_API int lpi_fftw_wisdom_export_file(const char *path) {
     return guarded(nullptr, "lpi_fftw_wisdom_export_file", [&] {
         require(path, "path");
-#if LPI_HAVE_FFTW
-        std::lock_guard<std::mutex> lock(lpi::fftw_planner_mutex());
-        if (!fftw_export_wisdom_to_filename(path))
-            lpi::fail(LPI_ERR_INVALID, std::string("could not write FFTW wisdom to '") + path + "'");
-#else
-        no_fftw();
-#endif
+        lpi::fftw_wisdom_export_file(path);
     });
 }
 
 LPI_API int lpi_fftw_wisdom_import_string(const char *wisdom) {
     return guarded(nullptr, "lpi_fftw_wisdom_import_string", [&] {
         require(wisdom, "wisdom");
-#if LPI_HAVE_FFTW
-        std::lock_guard<std::mutex> lock(lpi::fftw_planner_mutex());
-        if (!fftw_import_wisdom_from_string(wisdom))
-            lpi::fail(LPI_ERR_INVALID, "the string is not valid FFTW wisdom");
-#else
-        no_fftw();
-#endif
+        lpi::fftw_wisdom_import_string(wisdom);
     });
 }
 
@@ -212,23 +176,12 @@ LPI_API int lpi_fftw_wisdom_export_string(char *buf, size_t size, size_t *length
     return guarded(nullptr, "lpi_fftw_wisdom_export_string", [&] {
         require(length, "length");
         if (size > 0) require(buf, "buf");
-#if LPI_HAVE_FFTW
-        char *text;
-        {
-            std::lock_guard<std::mutex> lock(lpi::fftw_planner_mutex());
-            text = fftw_export_wisdom_to_string();
-        }
-        if (!text) throw std::bad_alloc();
-        const std::size_t needed = std::strlen(text);
-        *length = needed;
-        if (size > needed) std::memcpy(buf, text, needed + 1);
-        std::free(text);
-        if (size <= needed)
+        const std::string wisdom = lpi::fftw_wisdom_export_string();
+        *length = wisdom.size();
+        if (size <= wisdom.size())
             lpi::fail(LPI_ERR_SIZE, "buffer of " + std::to_string(size) + " bytes is too small; " +
-                                        std::to_string(needed + 1) + " needed");
-#else
-        no_fftw();
-#endif
+                                        std::to_string(wisdom.size() + 1) + " needed");
+        std::memcpy(buf, wisdom.c_str(), wisdom.size() + 1);
     });
 }
 

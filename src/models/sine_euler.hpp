@@ -1,6 +1,9 @@
 // Sine-Euler: Zeitlin's su(N) truncation of 2D Euler on the torus, integrated
 // by McLachlan's explicit splitting (1993, section 3) with one piece per
-// direction of the projective line over Z_N.
+// direction of the projective line over Z_N. The parts are in sine_euler/:
+// indexing and projective_line (the geometry, backend-independent),
+// transforms (FFTW), kernels (gather, phase, scatter), coordinates, and the
+// model that glues them; sine_euler_matrix.cpp holds the matrix form.
 //
 // Working layout: the full N x N complex mode array, 2 N^2 doubles, entry
 // [a*N + b] = mode (a, b) mod N as interleaved re, im (FFT order).
@@ -10,6 +13,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 
@@ -17,23 +21,32 @@
 
 namespace lpi {
 
+// Seconds and FFTs per step of the transforms of a splitting alone.
+struct TransformTiming {
+    double seconds_per_step;
+    double transforms_per_step;
+};
+
 // What the C API needs of a sine-Euler model beyond lpi::Model.
 class SineEulerModel : public Model {
 public:
-    virtual int order() const = 0;  // N
+    // N of su(N): the mode array is N x N.
+    virtual int truncation() const = 0;
     // Validates modes (2 N^2 doubles: finite, Hermitian within tolerance) and
     // writes the public coordinates x (N^2) of the symmetrised field.
     virtual void public_from_modes(const double *re_im, double *x) const = 0;
-    // Validates a real grid (N^2, finite) and writes public coordinates.
+    // Validates a real grid (N^2, finite; LPI_ERR_OVERFLOW when its Fourier
+    // transform overflows) and writes public coordinates.
     virtual void public_from_grid(const double *grid, double *x) const = 0;
     virtual void grid(const double *state, double *out) const = 0;
     virtual double enstrophy(const double *state) const = 0;
     virtual void casimir_traces(const double *state, int kmax, double *out) const = 0;
-    // Energy of one piece, H_k = 1/2 sum over the modes piece k owns.
-    virtual double piece_energy(std::size_t piece, const double *state) const = 0;
-    // Runs the transforms of `flows` piece flows (cycling over the pieces) on
-    // the model's own plans and buffers; returns the number of transforms.
-    virtual double run_fft_floor(std::size_t flows) = 0;
+    // Runs the FFTs of `steps` steps of `flows_per_step` line flows each
+    // (cycling over the pieces) on the model's own plans, buffers and
+    // threads, on zeros, and times them: the floor under a splitting step.
+    // LPI_ERR_INVALID for steps < 1, LPI_ERR_OVERFLOW when the flow count
+    // overflows.
+    virtual TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) = 0;
 };
 
 // Throws LPI_ERR_UNSUPPORTED when built without FFTW3, LPI_ERR_INVALID for
@@ -45,17 +58,18 @@ std::unique_ptr<Model> make_sine_euler(int N);
 // wisdom operation in the library holds this lock.
 std::mutex &fftw_planner_mutex();
 
-// ---- matrix form (sine_euler_matrix.cpp; no FFTW needed) ------------------
-// J_m = exp(2 pi i m1 m2 / N) g^m1 h^m2, W = sum_m w_m J_m. Both arrays are
-// N x N complex, interleaved; W row-major. O(N^3), used only on request.
-void sine_euler_modes_to_matrix(int N, const double *modes, double *W);
-void sine_euler_matrix_to_modes(int N, const double *W, double *modes);
-// The vector field of eq. 5 through dW/dt = (i / (2 eps)) [P, W].
+// ---- matrix form (sine_euler_matrix.cpp) ----------------------------------
+// W = sum_m w_m J_m, J_m = exp(2 pi i m1 m2 / N) g^m1 h^m2 (the transforms:
+// sine_euler/matrix_form.hpp). O(N^3) products, used only on request.
+// The vector field of eq. 5 through dW/dt = (i / (2 eps)) [P, W], exactly
+// Hermitian: the half plane is computed, the other half is its conjugate
+// and the inert mode w_0 does not move.
 void sine_euler_matrix_vector_field(int N, const double *modes, double *rate);
 // (1/N) tr W^k, k = 1 .. kmax.
 void sine_euler_traces(int N, const double *modes, int kmax, double *out);
-// Sorted eigenvalues of the Hermitian W (LAPACK zheevd); LPI_ERR_UNSUPPORTED
-// naming LAPACK when built without it.
+// Sorted eigenvalues of the Hermitian W (LAPACK zheevd); LPI_ERR_OVERFLOW
+// when W has overflowed, LPI_ERR_UNSUPPORTED naming LAPACK when built
+// without it.
 void sine_euler_spectrum(int N, const double *modes, double *out);
 
 }  // namespace lpi

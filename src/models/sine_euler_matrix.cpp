@@ -1,10 +1,11 @@
-// The matrix form of sine-Euler (design notes, section 1): with q = exp(4 pi i/N),
+// The matrix form of sine-Euler (Zeitlin's su(N) basis): with q = exp(4 pi i/N),
 // g = diag(q^a), h e_a = e_{a-1}, J_m = exp(2 pi i m1 m2 / N) g^m1 h^m2, the entry
 // (a, b) of J_m is exp(2 pi i m1 (a + b) / N) when b - a = m2 (mod N), else 0.
 // So W = sum_m w_m J_m has W_{a,a+m2} = sum_m1 w_(m1,m2) exp(2 pi i m1 (2a + m2) / N),
-// and w_m = tr(W J_m^dagger) / N inverts it. Eq. 5 is dW/dt = (i/(2 eps)) [P, W]
-// with P = sum_{n != 0} w_n / |n|^2 J_n. These serve diagnostics and the
-// reference methods, never the splitting's hot path.
+// and w_m = tr(W J_m^dagger) / N inverts it (the transforms are
+// sine_euler::MatrixForm's, by FFT). Eq. 5 is dW/dt = (i/(2 eps)) [P, W] with
+// P = sum_{n != 0} w_n / |n|^2 J_n. These serve diagnostics and the baseline
+// methods, never the splitting's hot path; like the model, they need FFTW3.
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -15,6 +16,10 @@
 #include "../core/error.hpp"
 #include "lpi_config.h"
 #include "sine_euler.hpp"
+#include "sine_euler/indexing.hpp"
+#include "sine_euler/matrix_form.hpp"
+
+#if LPI_HAVE_FFTW
 
 namespace lpi {
 
@@ -22,14 +27,6 @@ namespace {
 
 using cplx = std::complex<double>;
 
-std::vector<cplx> roots_of_unity(int N) {
-    std::vector<cplx> root(N);
-    const double two_pi = 2.0 * std::acos(-1.0);
-    for (int k = 0; k < N; ++k) root[k] = std::polar(1.0, two_pi * k / N);
-    return root;
-}
-
-int rep(int a, int N) { return a > N / 2 ? a - N : a; }
 // Entry (a, b) of an N x N array; a N + b overflows an int past N = 46340.
 std::size_t at(int a, int b, int N) { return static_cast<std::size_t>(a) * N + b; }
 
@@ -47,64 +44,36 @@ void multiply(int N, const cplx *A, const cplx *B, cplx *C) {
 
 }  // namespace
 
-void sine_euler_modes_to_matrix(int N, const double *modes, double *W_out) {
-    const auto root = roots_of_unity(N);
-    const cplx *w = reinterpret_cast<const cplx *>(modes);
-    cplx *W = reinterpret_cast<cplx *>(W_out);
-    for (int a = 0; a < N; ++a)
-        for (int m2 = 0; m2 < N; ++m2) {
-            const int step = (2 * a + m2) % N;
-            cplx sum = 0.0;
-            int phase = 0;
-            for (int m1 = 0; m1 < N; ++m1) {
-                sum += w[at(m1, m2, N)] * root[phase];
-                phase += step;
-                if (phase >= N) phase -= N;
-            }
-            W[at(a, (a + m2) % N, N)] = sum;
-        }
-}
-
-void sine_euler_matrix_to_modes(int N, const double *W_in, double *modes) {
-    const auto root = roots_of_unity(N);
-    const cplx *W = reinterpret_cast<const cplx *>(W_in);
-    cplx *w = reinterpret_cast<cplx *>(modes);
-    for (int m1 = 0; m1 < N; ++m1)
-        for (int m2 = 0; m2 < N; ++m2) {
-            cplx sum = 0.0;
-            for (int a = 0; a < N; ++a) {
-                const int phase = static_cast<int>((static_cast<std::int64_t>(m1) * (2 * a + m2)) % N);
-                sum += W[at(a, (a + m2) % N, N)] * std::conj(root[phase]);
-            }
-            w[at(m1, m2, N)] = sum / static_cast<double>(N);
-        }
-}
-
 void sine_euler_matrix_vector_field(int N, const double *modes, double *rate) {
     const std::size_t n2 = static_cast<std::size_t>(N) * N;
-    std::vector<cplx> p(n2), W(n2), P(n2), PW(n2), WP(n2);
-    const cplx *w = reinterpret_cast<const cplx *>(modes);
-    for (int a = 0; a < N; ++a)
-        for (int b = 0; b < N; ++b) {
-            const std::int64_t ra = rep(a, N), rb = rep(b, N);
-            const std::int64_t norm2 = ra * ra + rb * rb;
-            p[at(a, b, N)] = norm2 ? w[at(a, b, N)] / static_cast<double>(norm2) : 0.0;
-        }
-    sine_euler_modes_to_matrix(N, modes, reinterpret_cast<double *>(W.data()));
-    sine_euler_modes_to_matrix(N, reinterpret_cast<const double *>(p.data()),
-                               reinterpret_cast<double *>(P.data()));
+    std::vector<cplx> W(n2), P(n2), PW(n2), WP(n2);
+    sine_euler::MatrixForm form(N, sine_euler::MatrixForm::RowMajor);
+    form.to_matrix(modes, W.data());
+    form.stream(W.data(), P.data());
     multiply(N, P.data(), W.data(), PW.data());
     multiply(N, W.data(), P.data(), WP.data());
     const double eps = 2.0 * std::acos(-1.0) / N;
     const cplx factor(0.0, 1.0 / (2.0 * eps));
     for (std::size_t i = 0; i < n2; ++i) PW[i] = factor * (PW[i] - WP[i]);
-    sine_euler_matrix_to_modes(N, reinterpret_cast<const double *>(PW.data()), rate);
+    form.to_modes(PW.data(), rate);
+    // Round-off leaves the two halves slightly unequal, and that difference
+    // grows in an integrator (the field is not tangent to the Hermitian modes
+    // off them). The mirror half is set to the exact conjugate, so a linear
+    // combination with real coefficients (rk4, the midpoint rule) keeps a
+    // Hermitian state Hermitian to the bit; w_0 (J_0 = I) is inert.
+    cplx *r = reinterpret_cast<cplx *>(rate);
+    r[0] = 0.0;
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const std::size_t m = at(a, b, N), minus = sine_euler::mirror_index(a, b, N);
+            if (minus < m) r[m] = std::conj(r[minus]);
+        }
 }
 
 void sine_euler_traces(int N, const double *modes, int kmax, double *out) {
     const std::size_t n2 = static_cast<std::size_t>(N) * N;
     std::vector<cplx> W(n2), power(n2), next(n2);
-    sine_euler_modes_to_matrix(N, modes, reinterpret_cast<double *>(W.data()));
+    sine_euler::MatrixForm(N, sine_euler::MatrixForm::RowMajor).to_matrix(modes, W.data());
     power = W;
     for (int k = 1; k <= kmax; ++k) {
         if (k > 1) {
@@ -126,7 +95,13 @@ extern "C" void zheevd_(const char *jobz, const char *uplo, const int *n, cplx *
 void sine_euler_spectrum(int N, const double *modes, double *out) {
     // Row-major W is column-major W^T = conj(W): the same real spectrum.
     std::vector<cplx> W(static_cast<std::size_t>(N) * N);
-    sine_euler_modes_to_matrix(N, modes, reinterpret_cast<double *>(W.data()));
+    sine_euler::MatrixForm(N, sine_euler::MatrixForm::RowMajor).to_matrix(modes, W.data());
+    // zheevd on a matrix holding Inf or NaN returns garbage or never ends.
+    for (std::size_t i = 0; i < W.size(); ++i)
+        if (!std::isfinite(W[i].real()) || !std::isfinite(W[i].imag()))
+            fail(LPI_ERR_OVERFLOW, "the matrix W of this state overflows a double at entry (" +
+                                       std::to_string(i / N) + ", " + std::to_string(i % N) +
+                                       "): its spectrum cannot be computed");
     const char jobz = 'N', uplo = 'U';
     int info = 0, lwork = -1, lrwork = -1, liwork = -1, iwork_query = 0;
     cplx work_query;
@@ -153,3 +128,5 @@ void sine_euler_spectrum(int, const double *, double *) {
 #endif
 
 }  // namespace lpi
+
+#endif  // LPI_HAVE_FFTW

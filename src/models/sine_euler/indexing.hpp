@@ -1,0 +1,33 @@
+// Index arithmetic on the N x N mode array of sine-Euler (N odd): mode
+// (a, b), a, b in Z_N, is entry a N + b, stored as interleaved re, im. Entries
+// pass int past N = 46340, so every offset is a std::size_t, and products of
+// two residues are formed in 64 bits before they are reduced.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace lpi {
+namespace sine_euler {
+
+// a mod N in 0 .. N-1, for any sign of a.
+inline int modulo(std::int64_t a, int N) {
+    const std::int64_t r = a % N;
+    return static_cast<int>(r < 0 ? r + N : r);
+}
+// The representative of a residue in -(N-1)/2 .. (N-1)/2.
+inline int signed_residue(int a, int N) { return a > N / 2 ? a - N : a; }
+inline std::size_t mode_index(int a, int b, int N) { return static_cast<std::size_t>(a) * N + b; }
+// Entry of the conjugate mode -(a, b).
+inline std::size_t mirror_index(int a, int b, int N) {
+    return mode_index(a ? N - a : 0, b ? N - b : 0, N);
+}
+// |m|^2 of the representative of mode (a, b), exact (in 64 bits: an int
+// overflows past N = 65535).
+inline double norm2(int a, int b, int N) {
+    const std::int64_t ra = signed_residue(a, N), rb = signed_residue(b, N);
+    return static_cast<double>(ra * ra + rb * rb);
+}
+
+}  // namespace sine_euler
+}  // namespace lpi

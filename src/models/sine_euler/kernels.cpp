@@ -1,0 +1,211 @@
+// Gather, phase and scatter of a block of lines (see the header).
+#include "kernels.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+
+#include "indexing.hpp"
+
+namespace lpi {
+namespace sine_euler {
+
+namespace {
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__) && \
+    !defined(LPI_NO_SIMD_CLONES)
+#define LPI_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define LPI_SIMD_CLONES
+#endif
+
+// ---- Row and Column directions: runs along lanes --------------------------
+// A Row or Column direction's lines cross each lane (row s, or column s) in a
+// run: element s of line d0 + i is at position (o + i) mod N of lane s, with
+// o = s m + d0 (slope m = k2, or k1), and its conjugate mirror at position
+// -(o + i) mod N of lane -s. Rows: lane s starts at s N and positions step by
+// 1; columns: lane s starts at s and positions step by N.
+// Calls f(s, o) for the N lanes, from first_lane on, cyclically.
+template <class F>
+inline void for_each_lane(int N, int slope, int d0, int first_lane, F &&f) {
+    int o = modulo(d0 + static_cast<std::int64_t>(first_lane) * slope, N);
+    for (int k = 0, s = first_lane; k < N; ++k, s = s + 1 < N ? s + 1 : 0) {
+        f(s, o);
+        o += slope;
+        if (o >= N) o -= N;
+    }
+}
+
+// Count > 0: the block size, known at compile time (full blocks); 0: count.
+template <bool Rows, int Count>
+inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
+                        const double *__restrict w, double *__restrict x) {
+    const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
+    const int n = Count > 0 ? Count : count;
+    for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
+        const double *src = w + 2 * lane * s;
+        double *dst = x + 2 * static_cast<std::size_t>(s) * n;
+        const int first = o <= N - n ? n : N - o;  // the run wraps at most once
+        for (int i = 0; i < first; ++i) {
+            dst[2 * i] = src[2 * step * (o + i)];
+            dst[2 * i + 1] = src[2 * step * (o + i) + 1];
+        }
+        for (int i = first; i < n; ++i) {
+            dst[2 * i] = src[2 * step * (o + i - N)];
+            dst[2 * i + 1] = src[2 * step * (o + i - N) + 1];
+        }
+    });
+}
+
+// Adds n increments to positions p0 .. p0+n-1 (p0 + n <= N) of a lane, keeps
+// the sums in `increment`, and writes their conjugates at positions
+// -(p0 + r) mod N of the mirror lane.
+inline void put_run(int N, std::size_t step, int p0, int n, double *__restrict increment, double *lane,
+                    double *mirror) {
+    if (n <= 0) return;
+    for (int r = 0; r < n; ++r) {
+        double *z = lane + 2 * step * (p0 + r);
+        const double re = z[0] + increment[2 * r], im = z[1] + increment[2 * r + 1];
+        z[0] = increment[2 * r] = re;
+        z[1] = increment[2 * r + 1] = im;
+    }
+    int r0 = 0;
+    if (p0 == 0) {  // position 0 is its own mirror position
+        mirror[0] = increment[0];
+        mirror[1] = -increment[1];
+        r0 = 1;
+    }
+    // Upwards through the mirror lane: position N - p0 - r, r = n-1 .. r0.
+    double *m = mirror + 2 * step * (N - p0 - (n - 1));
+    const double *z = increment + 2 * (n - 1);
+    for (int q = 0; q < n - r0; ++q) {
+        m[2 * step * q] = z[-2 * q];
+        m[2 * step * q + 1] = -z[-2 * q + 1];
+    }
+}
+
+template <bool Rows, int Count>
+inline void scatter_runs(int N, int slope, int d0, int count, int first_lane, double *__restrict x,
+                         double *w) {
+    const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
+    const int n = Count > 0 ? Count : count;
+    for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
+        double *src = x + 2 * static_cast<std::size_t>(s) * n;
+        double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
+        if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
+            put_run(N, step, o, n, src, dst, mirror);
+        } else {
+            const int first = std::min(n, N - o);
+            put_run(N, step, o, first, src, dst, mirror);
+            put_run(N, step, 0, n - first, src + 2 * first, dst, mirror);
+        }
+    });
+}
+
+// ---- General directions: one mode at a time -------------------------------
+// Calls f(x_entry, mode) for element s of line d0 + i, at (d0 + i) j + s k:
+// x_entry = s count + i, mode its index in the mode array.
+template <class F>
+inline void for_each_block_mode(const Direction &D, int N, int d0, int count, F &&f) {
+    int a0 = modulo(static_cast<std::int64_t>(d0) * D.j1, N), b0 = modulo(static_cast<std::int64_t>(d0) * D.j2, N);
+    for (int s = 0; s < N; ++s) {
+        int a = a0, b = b0;
+        const std::size_t row = static_cast<std::size_t>(s) * count;
+        for (int i = 0; i < count; ++i) {
+            f(row + i, a, b);
+            a += D.j1;
+            if (a >= N) a -= N;
+            b += D.j2;
+            if (b >= N) b -= N;
+        }
+        a0 += D.k1;
+        if (a0 >= N) a0 -= N;
+        b0 += D.k2;
+        if (b0 >= N) b0 -= N;
+    }
+}
+
+inline void gather_general(const Direction &D, int N, int d0, int count, const double *w, double *x) {
+    for_each_block_mode(D, N, d0, count, [&](std::size_t e, int a, int b) {
+        const double *src = w + 2 * mode_index(a, b, N);
+        x[2 * e] = src[0];
+        x[2 * e + 1] = src[1];
+    });
+}
+
+inline void scatter_general(const Direction &D, int N, int d0, int count, double *x, double *w) {
+    for_each_block_mode(D, N, d0, count, [&](std::size_t e, int a, int b) {
+        double *dst = w + 2 * mode_index(a, b, N);
+        dst[0] += x[2 * e];
+        dst[1] += x[2 * e + 1];
+        double *mirror = w + 2 * mirror_index(a, b, N);
+        mirror[0] = dst[0];
+        mirror[1] = -dst[1];
+    });
+}
+
+}  // namespace
+
+// These move numbers, negate and add one increment per mode: every clone
+// gives the same bits.
+LPI_SIMD_CLONES
+void gather_block(const Direction &D, int N, int d0, int count, int first_lane, const double *w,
+                  double *x) {
+    switch (D.layout) {
+        case Direction::Row:
+            if (count == kBlock) gather_runs<true, kBlock>(N, D.k2, d0, count, first_lane, w, x);
+            else gather_runs<true, 0>(N, D.k2, d0, count, first_lane, w, x);
+            break;
+        case Direction::Column:
+            if (count == kBlock) gather_runs<false, kBlock>(N, D.k1, d0, count, first_lane, w, x);
+            else gather_runs<false, 0>(N, D.k1, d0, count, first_lane, w, x);
+            break;
+        case Direction::General: gather_general(D, N, d0, count, w, x); break;
+    }
+}
+
+LPI_SIMD_CLONES
+void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, double *x,
+                   double *w) {
+    switch (D.layout) {
+        case Direction::Row:
+            if (count == kBlock) scatter_runs<true, kBlock>(N, D.k2, d0, count, first_lane, x, w);
+            else scatter_runs<true, 0>(N, D.k2, d0, count, first_lane, x, w);
+            break;
+        case Direction::Column:
+            if (count == kBlock) scatter_runs<false, kBlock>(N, D.k1, d0, count, first_lane, x, w);
+            else scatter_runs<false, 0>(N, D.k1, d0, count, first_lane, x, w);
+            break;
+        case Direction::General: scatter_general(D, N, d0, count, x, w); break;
+    }
+}
+
+// Line i of the block (d = d0 + i) has c = sigma d, so exp(t Lambda_l) =
+// u_{l-c} conj(u_{l+c}) is e = u_{l+d} conj(u_{l-d}) for sigma = -1 and
+// conj(e) for sigma = +1: `sign` = -sigma multiplies Im e, an exact negation.
+// With p = v_{l+d}, q = v_{l-d} (v = u - 1), e - 1 = p + conj(q) + p conj(q):
+// no cancellation, each term as small as the angles. With up = &up[N + d0],
+// down = &down[N + d0], v_{l+d} = up[l + i] and v_{l-d} = down[i - l]: both
+// run forwards along a row of x, so the loop vectorises. Dividing by N, not
+// multiplying by a rounded 1/N, which would scale every increment by the
+// same N fl(1/N) != 1.
+LPI_SIMD_CLONES
+void apply_phase(int N, int count, const double *up, const double *down, double sign, double *x) {
+    const double n_real = N;
+    for (int l = 0; l < N; ++l) {
+        double *z = x + 2 * static_cast<std::size_t>(l) * count;
+        const double *p = up + 2 * l;
+        const double *q = down - 2 * l;
+        for (int i = 0; i < count; ++i) {
+            const double pr = p[2 * i], pi = p[2 * i + 1], qr = q[2 * i], qi = q[2 * i + 1];
+            const double er = (pr + qr) + (pr * qr + pi * qi);
+            const double ei = sign * ((pi - qi) + (pi * qr - pr * qi));
+            const double zr = z[2 * i], zi = z[2 * i + 1];
+            z[2 * i] = (er * zr - ei * zi) / n_real;
+            z[2 * i + 1] = (er * zi + ei * zr) / n_real;
+        }
+    }
+}
+
+}  // namespace sine_euler
+}  // namespace lpi

@@ -1,0 +1,110 @@
+// Modes <-> matrix transforms of sine-Euler by FFTW (see the header).
+#include "matrix_form.hpp"
+
+#include <mutex>
+
+#include "../../core/error.hpp"
+#include "../sine_euler.hpp"
+#include "indexing.hpp"
+#include "lpi_config.h"
+
+#if LPI_HAVE_FFTW
+#include <fftw3.h>
+
+namespace lpi {
+namespace sine_euler {
+
+struct MatrixForm::Plans {
+    fftw_plan forward = nullptr, backward = nullptr;
+};
+
+MatrixForm::MatrixForm(int N, Layout layout)
+    : N_(N), index_(static_cast<std::size_t>(N) * N), inverse_laplacian_(index_.size()) {
+    const std::size_t n = static_cast<std::size_t>(N);
+    const std::size_t half = (n + 1) / 2;  // the inverse of 2 mod N (N odd)
+    for (std::size_t m2 = 0; m2 < n; ++m2)
+        for (std::size_t k = 0; k < n; ++k) {
+            const std::size_t a = (k + n - m2) * half % n, b = (a + m2) % n;
+            index_[m2 * n + k] = layout == ColumnMajor ? a + b * n : a * n + b;
+        }
+    for (std::size_t m2 = 0; m2 < n; ++m2)
+        for (std::size_t m1 = 0; m1 < n; ++m1) {
+            const double m_squared = norm2(static_cast<int>(m1), static_cast<int>(m2), N);
+            inverse_laplacian_[m2 * n + m1] =
+                m_squared != 0 ? 1.0 / (static_cast<double>(N) * m_squared) : 0.0;
+        }
+    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    plans_ = new Plans;
+    fftw_complex *buffer = fftw_alloc_complex(index_.size());
+    buffer_ = reinterpret_cast<cplx *>(buffer);
+    if (!buffer) {
+        release();
+        fail(LPI_ERR_NO_MEMORY, "cannot allocate the matrix-form FFT buffer");
+    }
+    // N transforms of length N over the rows of the buffer (one per diagonal).
+    plans_->forward = fftw_plan_many_dft(1, &N_, N_, buffer, nullptr, 1, N_, buffer, nullptr, 1, N_,
+                                         FFTW_FORWARD, FFTW_ESTIMATE);
+    plans_->backward = fftw_plan_many_dft(1, &N_, N_, buffer, nullptr, 1, N_, buffer, nullptr, 1, N_,
+                                          FFTW_BACKWARD, FFTW_ESTIMATE);
+    if (!plans_->forward || !plans_->backward) {
+        release();
+        fail(LPI_ERR_INTERNAL, "FFTW could not plan the matrix-form transforms");
+    }
+}
+
+MatrixForm::~MatrixForm() {
+    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    release();
+}
+
+// Called with the planner lock held.
+void MatrixForm::release() {
+    if (plans_) {
+        if (plans_->forward) fftw_destroy_plan(plans_->forward);
+        if (plans_->backward) fftw_destroy_plan(plans_->backward);
+        delete plans_;
+        plans_ = nullptr;
+    }
+    if (buffer_) fftw_free(buffer_);
+    buffer_ = nullptr;
+}
+
+void MatrixForm::to_matrix(const double *modes, cplx *W) {
+    const std::size_t N = static_cast<std::size_t>(N_);
+    const cplx *w = reinterpret_cast<const cplx *>(modes);
+    for (std::size_t m1 = 0; m1 < N; ++m1)
+        for (std::size_t m2 = 0; m2 < N; ++m2) buffer_[m2 * N + m1] = w[m1 * N + m2];
+    fftw_execute(plans_->backward);
+    scatter(W);
+}
+
+void MatrixForm::to_modes(const cplx *W, double *modes) {
+    const std::size_t N = static_cast<std::size_t>(N_);
+    gather(W);
+    fftw_execute(plans_->forward);
+    cplx *w = reinterpret_cast<cplx *>(modes);
+    const double scale = 1.0 / N_;
+    for (std::size_t m1 = 0; m1 < N; ++m1)
+        for (std::size_t m2 = 0; m2 < N; ++m2) w[m1 * N + m2] = scale * buffer_[m2 * N + m1];
+}
+
+void MatrixForm::stream(const cplx *W, cplx *P) {
+    gather(W);
+    fftw_execute(plans_->forward);
+    for (std::size_t i = 0; i < index_.size(); ++i) buffer_[i] *= inverse_laplacian_[i];
+    fftw_execute(plans_->backward);
+    scatter(P);
+}
+
+void MatrixForm::gather(const cplx *W) {
+    for (std::size_t i = 0; i < index_.size(); ++i) buffer_[i] = W[index_[i]];
+}
+
+void MatrixForm::scatter(cplx *W) const {
+    for (std::size_t i = 0; i < index_.size(); ++i) W[index_[i]] = buffer_[i];
+}
+
+}  // namespace sine_euler
+}  // namespace lpi
+
+#endif  // LPI_HAVE_FFTW

@@ -1,0 +1,350 @@
+// The sine-Euler model: McLachlan's splitting (1993, section 3) with one
+// piece per direction of the projective line over Z_N, glued from the
+// geometry (projective_line), the transforms, the kernels and the
+// coordinates.
+//
+// The line flow. For a direction k, the piece H_k = 1/2 sum |w_sk|^2 / |sk|^2
+// (over the modes it owns) leaves the line sigma_k = {s k} fixed and moves
+// each parallel line {d j + s k}, c = (d j) x k, by the circulant system
+// dz_p/dt = sum_n a_n z_{p-n}, a_n = -sin(eps n c) / (eps |nk|^2) w_nk
+// (eq. 5 restricted to the piece). With b_n = w_nk / |nk|^2 and
+// B_l = sum_n b_n exp(-2 pi i n l / N) (real, as b is Hermitian), the DFT
+// eigenvalues on line c are
+//     Lambda_l = (i / (2 eps)) (B_{l-c} - B_{l+c}),
+// so exp(t Lambda_l) = u_{l-c} conj(u_{l+c}) with u_l = exp(i t B_l / (2 eps)).
+// One FFT gives B; each line costs a forward and a backward FFT, and lines
+// -c are the conjugates of lines c, so M = (N-1)/2 lines are integrated.
+// Every flow is exactly unitary, and it is applied as an increment,
+//     z <- z + F^-1 ((exp(t Lambda) - 1) F z) / N,
+// added to the modes as they are scattered back. Round-off then has no bias:
+// an FFTW forward/backward pair rescales what it transforms by some 1 + tau
+// (a property of each plan: measured -6e-17 per round trip at N = 31, -1e-16
+// at 61, +3.4e-16 at 127), and applied to the whole line it rescaled every
+// mode by 1 + tau in every flow, a drift of the Casimirs linear in time. On
+// the increment D = (U - I) z it changes |z|^2 by 2 tau Re<z + D, D> =
+// tau |D|^2 only (U unitary: 2 Re<z, D> = -|D|^2), second order in t Lambda;
+// what remains is the rounding of the final sum z + D, to nearest, of either
+// sign: the Casimirs wander like the square root of the number of steps. The
+// factors exp(i phi) - 1 come from v_l = u_l - 1 = (-2 sin^2(phi_l/2),
+// sin phi_l) without cancellation, so the increment's own rounding scales
+// with the angles, not with the field.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "../../core/error.hpp"
+#include "../sine_euler.hpp"
+#include "coordinates.hpp"
+#include "indexing.hpp"
+#include "kernels.hpp"
+#include "lpi_config.h"
+#include "projective_line.hpp"
+#include "transforms.hpp"
+
+#if LPI_HAVE_OPENMP
+#include <omp.h>
+#endif
+#if defined(__has_include)
+#if __has_include(<unistd.h>)
+#include <unistd.h>
+#endif
+#endif
+
+namespace lpi {
+
+#if !LPI_HAVE_FFTW
+
+std::unique_ptr<Model> make_sine_euler(int) {
+    fail(LPI_ERR_UNSUPPORTED, "sine-Euler needs FFTW3; this build has none "
+                              "(configure with -DLPI_WITH_FFTW=ON and libfftw3-dev)");
+}
+
+#else
+
+namespace {
+
+using namespace sine_euler;
+
+int this_thread() {
+#if LPI_HAVE_OPENMP
+    return omp_get_thread_num();
+#else
+    return 0;
+#endif
+}
+
+class SineEuler final : public SineEulerModel {
+public:
+    explicit SineEuler(int N)
+        : N_(N), blocks_(N), eps_(2.0 * std::acos(-1.0) / N), dirs_(projective_line(N)) {}
+
+    const char *kind() const override { return "sine-euler"; }
+    int truncation() const override { return N_; }
+    std::size_t dim() const override { return static_cast<std::size_t>(N_) * N_; }
+    std::size_t state_size() const override { return 2 * dim(); }
+
+    std::vector<std::string> split_names() const override { return split_.names(); }
+    void set_split(const std::string &name) override { split_.select(name, kind()); }
+    std::string split() const override { return split_.current(); }
+    std::size_t piece_count() const override { return dirs_.size(); }
+    // The thread count is a runtime setting (results are identical for every
+    // count), so N is all a checkpoint needs.
+    std::vector<double> checkpoint_parameters() const override { return {double(N_)}; }
+
+    void set_threads(int n) override {
+        if (n < 1) fail(LPI_ERR_INVALID, "thread count must be >= 1, got " + std::to_string(n));
+#if !LPI_HAVE_OPENMP
+        if (n > 1)
+            fail(LPI_ERR_UNSUPPORTED, "threads need OpenMP; this build has none (one thread only)");
+#endif
+        threads_ = n;
+    }
+
+    void to_public(const double *state, double *x) const override { public_from_state(N_, state, x); }
+    void from_public(const double *x, double *state) const override { state_from_public(N_, x, state); }
+    void public_from_modes(const double *modes, double *x) const override {
+        sine_euler::public_from_modes(N_, modes, x);
+    }
+    void public_from_grid(const double *grid, double *x) const override {
+        sine_euler::public_from_grid(N_, grid, x);
+    }
+    void grid(const double *state, double *out) const override { grid_from_modes(N_, state, out); }
+
+    void flow(std::size_t piece, double t, double *state) override;
+
+    double energy(const double *state) const override {
+        double sum = 0.0;
+        for (int a = 0; a < N_; ++a)
+            for (int b = 0; b < N_; ++b) {
+                const double m2 = norm2(a, b, N_);
+                if (m2 == 0) continue;
+                const double *z = state + 2 * mode_index(a, b, N_);
+                sum += (z[0] * z[0] + z[1] * z[1]) / m2;
+            }
+        return 0.5 * sum;
+    }
+    double enstrophy(const double *state) const override {
+        double sum = 0.0;
+        for (std::size_t i = 0; i < 2 * dim(); ++i) sum += state[i] * state[i];
+        return 0.5 * sum;
+    }
+    std::size_t casimir_count() const override { return static_cast<std::size_t>(N_); }
+    void casimirs(const double *state, double *out) const override {
+        sine_euler_spectrum(N_, state, out);
+    }
+    void casimir_traces(const double *state, int kmax, double *out) const override {
+        sine_euler_traces(N_, state, kmax, out);
+    }
+    void vector_field(const double *state, double *rate) const override {
+        sine_euler_matrix_vector_field(N_, state, rate);
+    }
+
+    TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) override;
+
+private:
+    LineTransforms &transforms();
+    bool line_spectrum(const Direction &D, const double *w);
+    void line_phase(int l, double factor);
+    void move_block(const Direction &D, int block, double *x, double *w);
+
+    int N_;
+    LineBlocks blocks_;
+    double eps_;
+    std::vector<Direction> dirs_;
+    SplitChoice split_{{"directions"}};
+    int threads_ = 1;
+    std::unique_ptr<LineTransforms> transforms_;  // planned on the first flow
+};
+
+LineTransforms &SineEuler::transforms() {
+    if (!transforms_) transforms_ = std::make_unique<LineTransforms>(N_);
+    transforms_->reserve_threads(static_cast<std::size_t>(threads_));
+    return *transforms_;
+}
+
+// b_s = w_sk / |sk|^2 on the owned modes, B = FFT(b) (real). Returns false
+// when every b_s is zero.
+bool SineEuler::line_spectrum(const Direction &D, const double *w) {
+    const int N = N_;
+    double *b = transforms_->spectrum();
+    int a = 0, c = 0;
+    bool active = false;
+    for (int s = 0; s < N; ++s) {
+        if (D.owned[s]) {
+            const double scale = 1.0 / norm2(a, c, N);
+            b[2 * s] = w[2 * mode_index(a, c, N)] * scale;
+            b[2 * s + 1] = w[2 * mode_index(a, c, N) + 1] * scale;
+            active = active || b[2 * s] != 0.0 || b[2 * s + 1] != 0.0;
+        } else {
+            b[2 * s] = b[2 * s + 1] = 0.0;
+        }
+        a += D.k1;
+        if (a >= N) a -= N;
+        c += D.k2;
+        if (c >= N) c -= N;
+    }
+    if (!active) return false;
+    transforms_->transform_spectrum();
+    return true;
+}
+
+// v_l = u_l - 1 = exp(i phi_l) - 1 = (-2 sin^2(phi_l / 2), sin phi_l), phi_l =
+// factor B_l with factor = t / (2 eps), stored three times over, forwards and
+// backwards, so that v_{l-c} and v_{l+c} need no reduction mod N and run
+// forwards along the lines of a block. Each l writes its own entries only, so
+// threads may share the loop over l.
+void SineEuler::line_phase(int l, double factor) {
+    const std::size_t N = N_;
+    double *up = transforms_->up(), *down = transforms_->down();
+    const double angle = factor * transforms_->spectrum()[2 * l];
+    const double half = std::sin(0.5 * angle);
+    const double re = -2.0 * half * half, im = std::sin(angle);
+    const std::size_t minus = l == 0 ? 0 : N - l;
+    for (std::size_t copy = 0; copy < 3; ++copy) {
+        up[2 * (l + copy * N)] = re;
+        up[2 * (l + copy * N) + 1] = im;
+        down[2 * (minus + copy * N)] = re;
+        down[2 * (minus + copy * N) + 1] = im;
+    }
+}
+
+// Lines d = d0 .. d0+count-1 of direction D: gather z_s = w_{d j + s k} into
+// x[s * count + (d - d0)], transform along s, multiply by the line's
+// (exp(t Lambda_l) - 1) / N, transform back, add the increments to the modes
+// and write the conjugates of the sums to the lines -d.
+void SineEuler::move_block(const Direction &D, int block, double *x, double *w) {
+    const int d0 = blocks_.first_line(block), count = blocks_.lines(block);
+    const int first_lane = blocks_.first_lane(block);
+    gather_block(D, N_, d0, count, first_lane, w, x);
+    transforms_->forward(count, x);
+    const std::size_t phase0 = 2 * (static_cast<std::size_t>(N_) + d0);
+    apply_phase(N_, count, transforms_->up() + phase0, transforms_->down() + phase0, -D.sigma, x);
+    transforms_->backward(count, x);
+    scatter_block(D, N_, d0, count, first_lane, x, w);
+}
+
+void SineEuler::flow(std::size_t piece, double t, double *state) {
+    transforms();
+    const Direction &D = dirs_[piece];
+    // A piece whose modes are all zero has H_k = 0: its flow is the identity
+    // (taken exactly, not through a round trip of FFTs).
+    if (!line_spectrum(D, state)) return;
+    const int blocks = blocks_.count();
+    const double factor = t / (2.0 * eps_);
+    // One parallel region per flow: the phases, then the blocks of lines (the
+    // implicit barrier between the two loops orders them).
+#if LPI_HAVE_OPENMP
+#pragma omp parallel num_threads(threads_) if (threads_ > 1 && blocks > 1)
+#endif
+    {
+#if LPI_HAVE_OPENMP
+#pragma omp for schedule(static)
+#endif
+        for (int l = 0; l < N_; ++l) line_phase(l, factor);
+#if LPI_HAVE_OPENMP
+#pragma omp for schedule(static)
+#endif
+        for (int blk = 0; blk < blocks; ++blk) move_block(D, blk, transforms_->block(this_thread()), state);
+    }
+}
+
+// The transforms of `flows_per_step * steps` flows alone, on the model's own
+// plans, buffers and threads, on zeros: what the splitting costs in FFTW.
+TransformTiming SineEuler::time_transforms(std::size_t flows_per_step, std::int64_t steps) {
+    if (steps < 1) fail(LPI_ERR_INVALID, "nsteps must be >= 1, got " + std::to_string(steps));
+    if (flows_per_step == 0 || static_cast<std::uint64_t>(steps) > SIZE_MAX / flows_per_step)
+        fail(LPI_ERR_OVERFLOW, "nsteps = " + std::to_string(steps) + " times " +
+                                   std::to_string(flows_per_step) +
+                                   " flows per step overflows the flow count");
+    LineTransforms &T = transforms();
+    const int blocks = blocks_.count();
+    std::memset(T.spectrum(), 0, sizeof(double) * 2 * N_);
+    for (int i = 0; i < threads_; ++i) std::memset(T.block(i), 0, sizeof(double) * 2 * N_ * kBlock);
+    const std::size_t flows = flows_per_step * static_cast<std::size_t>(steps);
+    const auto start = std::chrono::steady_clock::now();
+    for (std::size_t f = 0; f < flows; ++f) {
+        T.transform_spectrum();
+#if LPI_HAVE_OPENMP
+#pragma omp parallel for num_threads(threads_) schedule(static) if (threads_ > 1 && blocks > 1)
+#endif
+        for (int blk = 0; blk < blocks; ++blk) {
+            double *x = T.block(this_thread());
+            T.forward(blocks_.lines(blk), x);
+            T.backward(blocks_.lines(blk), x);
+        }
+    }
+    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+    const double per_step = static_cast<double>(steps);
+    return {elapsed.count() / per_step,
+            static_cast<double>(flows) * (1.0 + 2.0 * blocks_.M) / per_step};
+}
+
+// a * b, or false when it does not fit a std::size_t.
+bool checked_multiply(std::size_t a, std::size_t b, std::size_t &product) {
+    if (b != 0 && a > SIZE_MAX / b) return false;
+    product = a * b;
+    return true;
+}
+
+// Bytes of physical memory, 0 when the system does not say.
+std::size_t physical_memory() {
+#if defined(_SC_PHYS_PAGES) && defined(_SC_PAGESIZE)
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    std::size_t bytes = 0;
+    if (pages > 0 && page > 0 && checked_multiply(pages, page, bytes)) return bytes;
+#endif
+    return 0;
+}
+
+std::string gib(double bytes) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.3g GiB", bytes / (1024.0 * 1024.0 * 1024.0));
+    return text;
+}
+
+// A sine-Euler system holds two working states of 2 N^2 doubles (the state
+// and the copy a failed step rolls back to), one byte per mode and direction
+// to say which modes each piece owns, and for composite N one byte per mode
+// while the directions are built. Refused before anything is allocated when
+// that cannot be had: zero-filling vectors larger than the machine would
+// bring the out-of-memory killer, not std::bad_alloc.
+void require_memory(int N) {
+    std::size_t classes = N;
+    for (int p : prime_factors(N)) classes = classes / p * (p + 1);
+    const bool prime = classes == static_cast<std::size_t>(N) + 1;
+    const std::size_t n = N;
+    std::size_t modes = 0, states = 0, tables = 0, bytes = 0;
+    const bool fits = checked_multiply(n, n, modes) &&
+                      checked_multiply(modes, 2 * 2 * sizeof(double), states) &&
+                      checked_multiply(classes + (prime ? 0 : n), n, tables) &&
+                      states <= SIZE_MAX - tables;
+    const std::string what = "sine-Euler N = " + std::to_string(N) + " needs ";
+    const std::string parts = " (two working states of 2 N^2 doubles and the direction tables)";
+    if (!fits)
+        fail(LPI_ERR_NO_MEMORY, what + "more than " + std::to_string(SIZE_MAX) + " bytes" + parts);
+    bytes = states + tables;
+    const std::size_t available = physical_memory();
+    if (available != 0 && bytes > available)
+        fail(LPI_ERR_NO_MEMORY, what + std::to_string(bytes) + " bytes (" + gib(bytes) + ")" + parts +
+                                    "; this machine has " + std::to_string(available) + " bytes (" +
+                                    gib(available) + ") of physical memory");
+}
+
+}  // namespace
+
+std::unique_ptr<Model> make_sine_euler(int N) {
+    if (N < 3 || N % 2 == 0)
+        fail(LPI_ERR_INVALID, "N must be odd and >= 3 (Zeitlin's su(N) truncation), got " +
+                                  std::to_string(N));
+    require_memory(N);
+    return std::make_unique<SineEuler>(N);
+}
+
+#endif  // LPI_HAVE_FFTW
+
+}  // namespace lpi

@@ -1,0 +1,140 @@
+// The directions of the projective line over Z_N and the modes they own.
+#include "projective_line.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <numeric>
+
+#include "indexing.hpp"
+
+namespace lpi {
+namespace sine_euler {
+
+namespace {
+
+// The inverse of a unit a mod N (extended Euclid).
+int inverse_mod(int a, int N) {
+    std::int64_t r0 = N, r1 = a, t0 = 0, t1 = 1;
+    while (r1 != 0) {
+        const std::int64_t q = r0 / r1;
+        std::int64_t r = r0 - q * r1, t = t0 - q * t1;
+        r0 = r1, r1 = r, t0 = t1, t1 = t;
+    }
+    return modulo(t0, N);  // r0 = gcd(a, N) = 1
+}
+
+}  // namespace
+
+std::vector<int> prime_factors(int N) {
+    std::vector<int> primes;
+    for (int p = 3; static_cast<std::int64_t>(p) * p <= N; p += 2)
+        if (N % p == 0) {
+            primes.push_back(p);
+            while (N % p == 0) N /= p;
+        }
+    if (N > 1) primes.push_back(N);
+    return primes;
+}
+
+// A nonzero mode belongs to the first direction whose line through the
+// origin contains it. Setup is O(N^2) in sequential passes, by these facts
+// (g(x) = gcd(x, N)):
+// - a mode p lies on (0,1) when p1 = 0, else on (1,m) when p2 = p1 m, which
+//   has a solution when g(p1) divides p2, the least m < N / g(p1); so (1,m)
+//   owns s (the mode (s, s m)) when m < N / g(s), and (0,1) owns its line;
+// - a class k with a non-unit k1 is met first at k1 = g(k1) (the least
+//   residue of that gcd), so only rows k1 = g, the divisors 1 < g < N of N,
+//   hold new classes; in row g, k2 and u k2 are one class for the units
+//   u = 1 mod N/g;
+// - on a later class's line, s k is owned there when s is a unit (a primitive
+//   mode lies on its own class only); for a non-unit s, by (0,1) or (1,m) as
+//   above, or, when neither, by the first later class met (one byte per
+//   mode, for these modes only: N with a squared prime factor).
+std::vector<Direction> projective_line(int N) {
+    std::vector<Direction> dirs;
+    std::vector<int> gcd_with_n(N);
+    for (int x = 0; x < N; ++x) gcd_with_n[x] = std::gcd(x, N);
+    auto unit = [&](int x) { return gcd_with_n[x] == 1; };
+    std::vector<unsigned char> claimed;  // modes owned by a later class, allocated when needed
+
+    auto add = [&](int k1, int k2) {
+        // A class met with a unit k2 is scaled to k2 = 1 (the Column layout).
+        if (!unit(k1) && unit(k2)) {
+            k1 = modulo(static_cast<std::int64_t>(k1) * inverse_mod(k2, N), N);
+            k2 = 1;
+        }
+        Direction D;
+        D.k1 = k1;
+        D.k2 = k2;
+        D.owned.assign(N, 0);
+        if (k1 == 0) {  // (0,1), the first
+            std::fill(D.owned.begin() + 1, D.owned.end(), 1);
+        } else if (k1 == 1) {  // (1,m)
+            for (int s = 1; s < N; ++s) D.owned[s] = k2 < N / gcd_with_n[s];
+        } else {
+            for (int s = 1, a = k1, b = k2; s < N; ++s) {  // (a, b) = s k
+                if (unit(s)) {
+                    D.owned[s] = 1;
+                } else if (a != 0 && b % gcd_with_n[a] != 0) {
+                    if (claimed.empty()) claimed.assign(static_cast<std::size_t>(N) * N, 0);
+                    unsigned char &owner = claimed[mode_index(a, b, N)];
+                    D.owned[s] = !owner;
+                    owner = 1;
+                }
+                a += k1;
+                if (a >= N) a -= N;
+                b += k2;
+                if (b >= N) b -= N;
+            }
+        }
+        // Lines d j + s k, d in Z_N, tile Z_N^2 when j x k is a unit.
+        if (k1 == 1) {
+            D.j1 = 0, D.j2 = 1, D.layout = Direction::Row, D.sigma = -1;  // j x k = -1
+        } else if (k2 == 1) {
+            D.j1 = 1, D.j2 = 0, D.layout = Direction::Column, D.sigma = 1;
+        } else {
+            // k1 and k2 are both non-units here. j = (1, y): for each prime p
+            // of N, j x k = k2 - y k1 vanishes mod p for at most one y mod p,
+            // so the first unit comes after a few y.
+            D.layout = Direction::General, D.sigma = 1;
+            int cross = 0;
+            for (int y = 0; y < N && !cross; ++y) {
+                const int c = modulo(k2 - static_cast<std::int64_t>(y) * k1, N);
+                if (unit(c)) D.j1 = 1, D.j2 = y, cross = c;
+            }
+            const int inverse = inverse_mod(cross, N);  // scale j so that j x k = 1
+            D.j1 = modulo(static_cast<std::int64_t>(D.j1) * inverse, N);
+            D.j2 = modulo(static_cast<std::int64_t>(D.j2) * inverse, N);
+        }
+        dirs.push_back(std::move(D));
+    };
+    add(0, 1);
+    for (int m = 0; m < N; ++m) add(1, m);
+    std::vector<unsigned char> seen(N);  // row g: k2 whose class was met
+    for (int g = 3; g < N; g += 2) {
+        if (N % g != 0) continue;
+        std::fill(seen.begin(), seen.end(), 0);
+        for (int k2 = 0; k2 < N; ++k2) {
+            if (seen[k2] || std::gcd(gcd_with_n[g], gcd_with_n[k2]) != 1) continue;  // met, or not primitive
+            for (int u = 1; u < N; u += N / g)  // the units u = 1 mod N/g
+                if (unit(u)) seen[modulo(static_cast<std::int64_t>(u) * k2, N)] = 1;
+            add(g, k2);
+        }
+    }
+    return dirs;
+}
+
+double piece_energy(const Direction &D, int N, const double *modes) {
+    double sum = 0.0;
+    for (int s = 1; s < N; ++s) {
+        if (!D.owned[s]) continue;
+        const int a = modulo(static_cast<std::int64_t>(s) * D.k1, N);
+        const int b = modulo(static_cast<std::int64_t>(s) * D.k2, N);
+        const double *z = modes + 2 * mode_index(a, b, N);
+        sum += (z[0] * z[0] + z[1] * z[1]) / norm2(a, b, N);
+    }
+    return 0.5 * sum;
+}
+
+}  // namespace sine_euler
+}  // namespace lpi

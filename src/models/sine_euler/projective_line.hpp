@@ -1,0 +1,66 @@
+// The geometry of the sine-Euler splitting (McLachlan 1993, section 3),
+// independent of how the line flows are transformed: the directions of the
+// projective line over Z_N (one piece each), which modes each piece owns, the
+// parallel lines of a direction and their layout in the mode array, and the
+// blocks of lines a flow is cut into. A second backend (MPI, GPU) reuses
+// this and replaces the transforms.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace lpi {
+namespace sine_euler {
+
+// One direction k of Z_N^2. The piece H_k = 1/2 sum |w_sk|^2 / |sk|^2 over
+// the modes it owns leaves the line {s k} fixed and moves each parallel line
+// {d j + s k}, d = 1 .. M (M = (N-1)/2; the lines -d are their conjugates).
+struct Direction {
+    int k1, k2;          // the direction
+    int j1 = 0, j2 = 0;  // offset between parallel lines: d j + s k
+    // Row: k = (1, k2), j = (0, 1): element s of line d is at row s, column
+    //   s k2 + d, so a block's lines cross each row in one run.
+    // Column: k = (k1, 1), j = (1, 0): row s k1 + d, column s (runs down the
+    //   columns; all the other directions when N is a prime power).
+    // General: any k, j with j x k = 1 (N with two or more prime factors).
+    enum Layout { Row, Column, General } layout;
+    // c = j x k of line d is sigma d: -d for Row directions, +d for the
+    // others. With c = +-d, the phases of the lines of a block are read from
+    // consecutive entries of the phase table (see apply_phase).
+    int sigma;
+    std::vector<unsigned char> owned;  // owned[s]: this piece holds the energy of s k
+};
+
+// The directions of the projective line over Z_N, in the paper's order for
+// prime N ((0,1), then (1,m), m = 0..N-1), then, for composite N, the other
+// classes in lexicographic order. Every nonzero mode is owned by exactly one.
+std::vector<Direction> projective_line(int N);
+
+// The odd primes dividing N.
+std::vector<int> prime_factors(int N);
+
+// The energy of piece D, H_k = 1/2 sum |w_sk|^2 / |sk|^2 over the modes it owns.
+double piece_energy(const Direction &D, int N, const double *modes);
+
+// Lines d = 1 .. M of a direction, in blocks of kBlock. The block size is
+// fixed (not derived from the thread count), so each block meets the same
+// transform whichever thread runs it: results are identical to the bit for
+// every thread count.
+constexpr int kBlock = 16;
+struct LineBlocks {
+    int N, M;
+    explicit LineBlocks(int n) : N(n), M((n - 1) / 2) {}
+    int count() const { return (M + kBlock - 1) / kBlock; }
+    int first_line(int block) const { return 1 + block * kBlock; }
+    int lines(int block) const { return M - block * kBlock < kBlock ? M - block * kBlock : kBlock; }
+    // Blocks start at different lanes, so that threads working on different
+    // blocks are not in the same lane of the modes at the same moment (lanes
+    // meet at the blocks' edges, in shared cache lines). Every mode is
+    // written once per flow, so the order changes no bit.
+    int first_lane(int block) const {
+        return static_cast<int>(static_cast<long long>(block) * N / count());
+    }
+};
+
+}  // namespace sine_euler
+}  // namespace lpi

@@ -1,0 +1,225 @@
+// FFTW behind the LineTransforms interface, the grid transforms and wisdom.
+#include "transforms.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <new>
+
+#include "../../core/error.hpp"
+#include "../sine_euler.hpp"
+#include "lpi_config.h"
+#include "projective_line.hpp"
+
+#if LPI_HAVE_FFTW
+#include <fftw3.h>
+#endif
+
+namespace lpi {
+
+std::mutex &fftw_planner_mutex() {
+    static std::mutex mutex;
+    return mutex;
+}
+
+#if LPI_HAVE_FFTW
+
+namespace sine_euler {
+
+namespace {
+fftw_complex *complex_of(double *x) { return reinterpret_cast<fftw_complex *>(x); }
+}  // namespace
+
+struct LineTransforms::Plans {
+    fftw_plan spectrum = nullptr;
+    fftw_plan forward[2] = {nullptr, nullptr};  // [0]: full block, [1]: remainder
+    fftw_plan backward[2] = {nullptr, nullptr};
+};
+
+LineTransforms::LineTransforms(int N) : N_(N), M_((N - 1) / 2), plans_(new Plans) {
+    try {
+        spectrum_ = reinterpret_cast<double *>(fftw_alloc_complex(N));
+        up_ = static_cast<double *>(fftw_malloc(sizeof(double) * 6 * N));
+        down_ = static_cast<double *>(fftw_malloc(sizeof(double) * 6 * N));
+        if (!spectrum_ || !up_ || !down_) throw std::bad_alloc();
+        reserve_threads(1);
+        std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+        const unsigned flags = FFTW_MEASURE;
+        fftw_complex *b = complex_of(spectrum_), *x = complex_of(blocks_[0]);
+        plans_->spectrum = fftw_plan_dft_1d(N, b, b, FFTW_FORWARD, flags);
+        const int sizes[2] = {M_ >= kBlock ? kBlock : 0, M_ % kBlock};
+        for (int i = 0; i < 2; ++i) {
+            const int howmany = sizes[i];
+            if (howmany == 0) continue;
+            // Transform along s (stride howmany); the lines of a block are
+            // adjacent, as gathered from a row.
+            plans_->forward[i] = fftw_plan_many_dft(1, &N, howmany, x, nullptr, howmany, 1, x, nullptr,
+                                                    howmany, 1, FFTW_FORWARD, flags);
+            plans_->backward[i] = fftw_plan_many_dft(1, &N, howmany, x, nullptr, howmany, 1, x,
+                                                     nullptr, howmany, 1, FFTW_BACKWARD, flags);
+            if (!plans_->forward[i] || !plans_->backward[i]) break;
+        }
+    } catch (...) {
+        release();
+        throw;
+    }
+    if (!plans_->spectrum || (M_ >= kBlock && !plans_->forward[0]) || (M_ % kBlock && !plans_->forward[1])) {
+        release();
+        fail(LPI_ERR_INTERNAL, "FFTW could not create a plan for N = " + std::to_string(N));
+    }
+}
+
+LineTransforms::~LineTransforms() { release(); }
+
+void LineTransforms::release() {
+    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    if (plans_)
+        for (fftw_plan p : {plans_->spectrum, plans_->forward[0], plans_->forward[1],
+                            plans_->backward[0], plans_->backward[1]})
+            if (p) fftw_destroy_plan(p);
+    plans_.reset();
+    fftw_free(spectrum_);
+    fftw_free(up_);
+    fftw_free(down_);
+    for (double *x : blocks_) fftw_free(x);
+    spectrum_ = up_ = down_ = nullptr;
+    blocks_.clear();
+}
+
+void LineTransforms::reserve_threads(std::size_t threads) {
+    while (blocks_.size() < threads) {
+        fftw_complex *x = fftw_alloc_complex(static_cast<std::size_t>(N_) * kBlock);
+        if (!x) throw std::bad_alloc();
+        blocks_.push_back(reinterpret_cast<double *>(x));
+    }
+}
+
+void LineTransforms::transform_spectrum() {
+    fftw_execute_dft(plans_->spectrum, complex_of(spectrum_), complex_of(spectrum_));
+}
+
+void LineTransforms::forward(int lines, double *block) {
+    fftw_execute_dft(plans_->forward[lines == kBlock ? 0 : 1], complex_of(block), complex_of(block));
+}
+
+void LineTransforms::backward(int lines, double *block) {
+    fftw_execute_dft(plans_->backward[lines == kBlock ? 0 : 1], complex_of(block), complex_of(block));
+}
+
+namespace {
+
+// A 2D DFT of N x N complex values, in place, with a plan of its own.
+void dft_2d(int N, fftw_complex *buffer, int sign) {
+    fftw_plan plan;
+    {
+        std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+        plan = fftw_plan_dft_2d(N, N, buffer, buffer, sign, FFTW_ESTIMATE);
+    }
+    fftw_execute(plan);
+    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    fftw_destroy_plan(plan);
+}
+
+struct FftwBuffer {
+    fftw_complex *data;
+    explicit FftwBuffer(std::size_t n) : data(fftw_alloc_complex(n)) {
+        if (!data) throw std::bad_alloc();
+    }
+    ~FftwBuffer() { fftw_free(data); }
+};
+
+}  // namespace
+
+void grid_from_modes(int N, const double *modes, double *grid) {
+    const std::size_t n = static_cast<std::size_t>(N) * N;
+    FftwBuffer buffer(n);
+    std::memcpy(buffer.data, modes, sizeof(fftw_complex) * n);
+    dft_2d(N, buffer.data, FFTW_BACKWARD);
+    for (std::size_t i = 0; i < n; ++i) grid[i] = buffer.data[i][0];
+}
+
+void modes_from_grid(int N, const double *grid, double *modes) {
+    const std::size_t n = static_cast<std::size_t>(N) * N;
+    FftwBuffer buffer(n);
+    for (std::size_t i = 0; i < n; ++i) buffer.data[i][0] = grid[i], buffer.data[i][1] = 0.0;
+    dft_2d(N, buffer.data, FFTW_FORWARD);
+    const double scale = 1.0 / static_cast<double>(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        modes[2 * i] = buffer.data[i][0] * scale;
+        modes[2 * i + 1] = buffer.data[i][1] * scale;
+    }
+}
+
+}  // namespace sine_euler
+
+namespace {
+
+[[noreturn]] void io_failure(const char *action, const char *path, int error) {
+    fail(LPI_ERR_IO, std::string("could not ") + action + " FFTW wisdom file '" + path +
+                         "': " + std::strerror(error));
+}
+
+}  // namespace
+
+void fftw_wisdom_import_file(const char *path) {
+    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    std::FILE *file = std::fopen(path, "r");
+    if (!file) io_failure("open", path, errno);
+    const int imported = fftw_import_wisdom_from_file(file);
+    const int read_error = std::ferror(file) ? errno : 0;
+    std::fclose(file);
+    if (read_error) io_failure("read", path, read_error);
+    if (!imported) fail(LPI_ERR_INVALID, std::string("'") + path + "' is not FFTW wisdom");
+}
+
+void fftw_wisdom_export_file(const char *path) {
+    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    std::FILE *file = std::fopen(path, "w");
+    if (!file) io_failure("create", path, errno);
+    fftw_export_wisdom_to_file(file);
+    const int write_error = std::ferror(file) ? (errno ? errno : EIO) : 0;
+    if (std::fclose(file) != 0 && !write_error) io_failure("write", path, errno);
+    if (write_error) io_failure("write", path, write_error);
+}
+
+void fftw_wisdom_import_string(const char *wisdom) {
+    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    if (!fftw_import_wisdom_from_string(wisdom))
+        fail(LPI_ERR_INVALID, "the string is not valid FFTW wisdom");
+}
+
+std::string fftw_wisdom_export_string() {
+    char *text;
+    {
+        std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+        text = fftw_export_wisdom_to_string();
+    }
+    if (!text) throw std::bad_alloc();
+    std::string wisdom(text);
+    std::free(text);
+    return wisdom;
+}
+
+#else  // !LPI_HAVE_FFTW
+
+namespace {
+[[noreturn]] void no_fftw(const char *what = "FFTW wisdom") {
+    fail(LPI_ERR_UNSUPPORTED, std::string(what) + " needs FFTW3; this build has none");
+}
+}  // namespace
+
+namespace sine_euler {
+void grid_from_modes(int, const double *, double *) { no_fftw("the sine-Euler grid"); }
+void modes_from_grid(int, const double *, double *) { no_fftw("the sine-Euler grid"); }
+}  // namespace sine_euler
+
+void fftw_wisdom_import_file(const char *) { no_fftw(); }
+void fftw_wisdom_export_file(const char *) { no_fftw(); }
+void fftw_wisdom_import_string(const char *) { no_fftw(); }
+std::string fftw_wisdom_export_string() { no_fftw(); }
+
+#endif  // LPI_HAVE_FFTW
+
+}  // namespace lpi

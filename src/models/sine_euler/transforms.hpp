@@ -1,0 +1,66 @@
+// The transforms of the sine-Euler line flows, behind a small interface so
+// that another backend (MPI, GPU) can replace them and keep the geometry and
+// the kernels: FFTW plans and aligned buffers, created once per system, for
+// the spectrum of one direction's line through the origin (length N) and for
+// a block of lines (kBlock, or the remainder, transforms of length N along s,
+// stride the block's line count). Plan creation, destruction and wisdom hold
+// fftw_planner_mutex(). Everything here needs FFTW3 except the wisdom
+// functions, which refuse with LPI_ERR_UNSUPPORTED in a build without it.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace lpi {
+namespace sine_euler {
+
+class LineTransforms {
+public:
+    // Plans (FFTW_MEASURE) and buffers for N, with one block buffer.
+    explicit LineTransforms(int N);
+    ~LineTransforms();
+    LineTransforms(const LineTransforms &) = delete;
+    LineTransforms &operator=(const LineTransforms &) = delete;
+
+    // One block buffer per thread (N * kBlock complex each).
+    void reserve_threads(std::size_t threads);
+    // The line spectrum b: N complex (interleaved), transformed in place.
+    double *spectrum() { return spectrum_; }
+    void transform_spectrum();
+    // The phase tables: 3N complex each (see SineEuler::line_phase).
+    double *up() { return up_; }
+    double *down() { return down_; }
+    // Block buffer of a thread, and its forward / backward transform in place
+    // for a block of `lines` lines (kBlock, or the remainder M mod kBlock).
+    double *block(std::size_t thread) { return blocks_[thread]; }
+    void forward(int lines, double *block);
+    void backward(int lines, double *block);
+
+private:
+    struct Plans;
+    void release();
+    int N_, M_;
+    std::unique_ptr<Plans> plans_;
+    double *spectrum_ = nullptr, *up_ = nullptr, *down_ = nullptr;
+    std::vector<double *> blocks_;
+};
+
+// The 2D DFTs between the mode array (2 N^2 doubles) and the real grid:
+// grid[a N + b] = Re sum_m w_m exp(2 pi i (m1 a + m2 b) / N), and its inverse
+// modes = (1 / N^2) sum_x grid_x exp(-2 pi i (m . x) / N).
+void grid_from_modes(int N, const double *modes, double *grid);
+void modes_from_grid(int N, const double *grid, double *modes);
+
+}  // namespace sine_euler
+
+// FFTW wisdom of the process. A file that cannot be opened, read or written
+// is LPI_ERR_IO (naming the path and the system's reason); text that is not
+// wisdom is LPI_ERR_INVALID.
+void fftw_wisdom_import_file(const char *path);
+void fftw_wisdom_export_file(const char *path);
+void fftw_wisdom_import_string(const char *wisdom);
+std::string fftw_wisdom_export_string();
+
+}  // namespace lpi
