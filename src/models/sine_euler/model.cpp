@@ -315,7 +315,7 @@ std::string gib(double bytes) {
 // bring the out-of-memory killer, not std::bad_alloc.
 void require_memory(int N) {
     std::size_t classes = N;
-    for (int p : prime_factors(N)) classes = classes / p * (p + 1);
+    for (int p : prime_factors(N)) classes = classes / p * (static_cast<std::size_t>(p) + 1);
     const bool prime = classes == static_cast<std::size_t>(N) + 1;
     const std::size_t n = N;
     std::size_t modes = 0, states = 0, tables = 0, bytes = 0;
