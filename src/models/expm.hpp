@@ -28,6 +28,11 @@ void expm_dense(std::size_t n, const double *A, double *E);
 // W = exp(A) - I, computed without cancellation: accurate relative to ||A||
 // when exp(A) is close to I (what the increment form of a flow needs).
 void expm1_dense(std::size_t n, const double *A, double *W);
+// The same with its scratch kept in `scratch` (no allocation once it is large
+// enough).
+void expm1_dense(std::size_t n, const double *A, double *W, std::vector<double> &scratch);
+// ||A||_1, the largest column sum of |A|.
+double dense_norm1(std::size_t n, const double *A);
 
 // One term of a matrix A = sum_p g_p C_p with fixed sparse C_p: the
 // coefficient of C_parameter at (row, col).
@@ -45,6 +50,9 @@ enum class ExpmPath { Nilpotent, Plane, Pade };
 // closed form of the plane path is held to the same bound, so whether a step
 // is refused does not depend on the path.
 constexpr int kMaxSquarings = 32;
+// theta_13 of Higham (2005), Table 2.3: the largest ||A||_1 that the degree-13
+// Pade approximant takes without scaling.
+constexpr double kPadeTheta13 = 5.371920351148152e0;
 
 // x <- exp(t A) x for the matrices A = sum_p g_p C_p of fixed sparse C_p,
 // the parameters g changing from call to call: a piece flow, whose C_p

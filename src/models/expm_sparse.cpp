@@ -1,0 +1,302 @@
+// The sparse exponentials of a fixed pattern (SparseExponential, expm.hpp):
+// what the pattern decides is planned once, each flow only fills in values.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <tuple>
+
+#include "../core/error.hpp"
+#include "expm.hpp"
+
+namespace lpi {
+
+namespace {
+
+// exp(A) - I of a 2x2 A = [[a, b], [c, d]] (W row-major) in closed form:
+// A = tau I + N, tau = (a + d) / 2, N^2 = delta I with delta = -det N, so
+// exp(A) = e^tau (C I + S N), C = cosh or cos of r = sqrt|delta|, S = sinh r
+// or sin r over r. Formed as differences from I (C - 1 from the half angle,
+// expm1 for e^tau) so that W is accurate relative to ||A||.
+void plane_expm1(double a, double b, double c, double d, double W[4]) {
+    const double tau = 0.5 * (a + d), p = 0.5 * (a - d);
+    double c_minus_1 = 0.0, sp = p, sb = b, sc = c;  // C - 1 and S times p, b, c
+    if (p == 0.0 && c == -b) {
+        // A rotation generator (the Lie-Poisson rotations: so(3), e(2)):
+        // r = |b| and S b = sin b, with no square root or division.
+        const double h = std::sin(0.5 * b);
+        c_minus_1 = -2.0 * h * h;
+        sb = 2.0 * h * std::cos(0.5 * b);
+        sc = -sb;
+    } else {
+        const double delta = p * p + b * c;
+        double s = 1.0;
+        if (delta > 0.0) {
+            const double r = std::sqrt(delta), inverse_r = 1.0 / r, h = std::sinh(0.5 * r);
+            c_minus_1 = 2.0 * h * h;
+            s = 2.0 * h * std::sqrt(1.0 + h * h) * inverse_r;  // sinh r / r
+        } else if (delta < 0.0) {
+            const double r = std::sqrt(-delta), inverse_r = 1.0 / r, h = std::sin(0.5 * r);
+            c_minus_1 = -2.0 * h * h;
+            s = 2.0 * h * std::cos(0.5 * r) * inverse_r;  // sin r / r
+        }
+        sp = s * p;
+        sb = s * b;
+        sc = s * c;
+    }
+    // The Lie-Poisson rotations are traceless: no exponential to take.
+    const double scale_minus_1 = tau == 0.0 ? 0.0 : std::expm1(tau);
+    const double scale = 1.0 + scale_minus_1;
+    W[0] = scale * (c_minus_1 + sp) + scale_minus_1;
+    W[1] = scale * sb;
+    W[2] = scale * sc;
+    W[3] = scale * (c_minus_1 - sp) + scale_minus_1;
+}
+
+}  // namespace
+
+// ---- sparse exponentials of a fixed pattern -----------------------------------
+
+SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> terms) {
+    std::sort(terms.begin(), terms.end(), [](const SparseTerm &a, const SparseTerm &b) {
+        return std::tie(a.row, a.col, a.parameter) < std::tie(b.row, b.col, b.parameter);
+    });
+    // Distinct positions (terms first .. end - 1) and the indices they touch,
+    // numbered locally in order of appearance.
+    struct Position {
+        std::uint32_t row, col;  // local
+        std::size_t first, end;
+    };
+    std::vector<Position> positions;
+    std::vector<std::int64_t> local_of(n, -1);
+    std::vector<std::uint32_t> touched;
+    auto local = [&](std::uint32_t g) {
+        if (local_of[g] < 0) {
+            local_of[g] = static_cast<std::int64_t>(touched.size());
+            touched.push_back(g);
+        }
+        return static_cast<std::uint32_t>(local_of[g]);
+    };
+    for (std::size_t q = 0; q < terms.size(); ++q) {
+        if (q > 0 && terms[q].row == terms[q - 1].row && terms[q].col == terms[q - 1].col) {
+            positions.back().end = q + 1;
+            continue;
+        }
+        positions.push_back({local(terms[q].row), local(terms[q].col), q, q + 1});
+    }
+    const std::size_t m = touched.size();
+
+    // Levels by Kahn's algorithm on edges col -> row (x_col drives x_row):
+    // level[v] is the longest path ending at v. A cycle (a self-loop
+    // included) means the pattern does not force nilpotency.
+    std::vector<std::size_t> start(m + 1, 0), cursor;
+    std::vector<std::uint32_t> indegree(m, 0), adjacency(positions.size()), queue;
+    for (const Position &e : positions) {
+        ++start[e.col + 1];
+        ++indegree[e.row];
+    }
+    for (std::size_t v = 0; v < m; ++v) start[v + 1] += start[v];
+    cursor.assign(start.begin(), start.end() - 1);
+    for (const Position &e : positions) adjacency[cursor[e.col]++] = e.row;
+    for (std::uint32_t v = 0; v < m; ++v)
+        if (indegree[v] == 0) queue.push_back(v);
+    std::vector<std::size_t> level(m, 0);
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+        const std::uint32_t u = queue[head];
+        depth_ = std::max(depth_, level[u]);
+        for (std::size_t a = start[u]; a < start[u + 1]; ++a) {
+            const std::uint32_t v = adjacency[a];
+            level[v] = std::max(level[v], level[u] + 1);
+            if (--indegree[v] == 0) queue.push_back(v);
+        }
+    }
+
+    if (queue.size() != m) {
+        path_ = m <= 2 ? ExpmPath::Plane : ExpmPath::Pade;
+        moved_ = std::move(touched);
+        for (const Position &e : positions) block_.push_back({e.row, e.col});
+    } else {
+        // Nilpotent: the moved indices (level >= 1) by level are in
+        // topological order; each position goes with the node of its row.
+        path_ = ExpmPath::Nilpotent;
+        std::vector<std::uint32_t> order;
+        for (std::uint32_t v = 0; v < m; ++v)
+            if (level[v] >= 1) order.push_back(v);
+        std::stable_sort(order.begin(), order.end(),
+                         [&](std::uint32_t u, std::uint32_t v) { return level[u] < level[v]; });
+        std::vector<std::uint32_t> node_of(m, 0);
+        for (std::uint32_t r = 0; r < order.size(); ++r) {
+            node_of[order[r]] = r;
+            moved_.push_back(touched[order[r]]);
+            nodes_.push_back({touched[order[r]], 0, 0});
+        }
+        auto fixed = [&](const Position &e) { return level[e.col] == 0; };
+        std::stable_sort(positions.begin(), positions.end(),
+                         [&](const Position &a, const Position &b) {
+                             return std::make_pair(node_of[a.row], !fixed(a)) <
+                                    std::make_pair(node_of[b.row], !fixed(b));
+                         });
+        for (const Position &e : positions) {
+            SeriesNode &node = nodes_[node_of[e.row]];
+            ++(fixed(e) ? node.fixed_columns : node.moved_columns);
+            columns_.push_back(fixed(e) ? touched[e.col] : node_of[e.col]);
+        }
+        lanes_ = depth_ <= 1 ? 1 : depth_ <= 2 ? 2 : depth_ <= 4 ? 4 : depth_ <= 8 ? 8 : depth_;
+        for (std::size_t k = 0; k < lanes_; ++k) inverse_.push_back(1.0 / static_cast<double>(k + 1));
+        coefficients_.resize(nodes_.size() * lanes_);
+        accumulator_.resize(lanes_);
+    }
+    for (std::uint32_t j = 0; j < positions.size(); ++j) {
+        first_terms_.push_back(terms[positions[j].first]);
+        for (std::size_t q = positions[j].first + 1; q < positions[j].end; ++q)
+            further_terms_.push_back({j, terms[q].parameter, terms[q].coefficient});
+    }
+    scaled_.resize(positions.size());
+    increment_.resize(moved_.size());
+}
+
+void SparseExponential::fail_nonfinite() const {
+    std::size_t v = 0;
+    while (v + 1 < moved_.size() && std::isfinite(increment_[v])) ++v;
+    fail(LPI_ERR_NONFINITE, "the exact flow overflows (component " + std::to_string(moved_[v]) + ")");
+}
+
+void SparseExponential::check_norm(double norm, double t) const {
+    // Each squaring doubles the relative error of the computed exponential
+    // (for a rotation: its departure from orthogonality, which the Casimirs
+    // see), so beyond kMaxSquarings the flow is refused rather than returned
+    // with a Casimir error above about 2^kMaxSquarings unit round-offs.
+    if (!std::isfinite(norm))
+        fail(LPI_ERR_NONFINITE, "the matrix t A of the exact flow overflows (t = " +
+                                    std::to_string(t) + ")");
+    if (norm > std::ldexp(kPadeTheta13, kMaxSquarings)) {
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      "the step is too large for the exact flow: ||t A||_1 = %.3g needs more "
+                      "than 2^%d squarings in the matrix exponential; reduce dt",
+                      norm, kMaxSquarings);
+        fail(LPI_ERR_INVALID, text);
+    }
+}
+
+void SparseExponential::scale_entries(const double *g, double t) {
+    const SparseTerm *first = first_terms_.data();
+    double *scaled = scaled_.data();
+    const std::size_t count = first_terms_.size();
+    if (further_terms_.empty()) {  // the usual case: one term a position
+        for (std::size_t j = 0; j < count; ++j)
+            scaled[j] = t * (first[j].coefficient * g[first[j].parameter]);
+        return;
+    }
+    for (std::size_t j = 0; j < count; ++j)
+        scaled[j] = first[j].coefficient * g[first[j].parameter];
+    for (const Term &q : further_terms_) scaled[q.position] += q.coefficient * g[q.parameter];
+    for (std::size_t j = 0; j < count; ++j) scaled[j] *= t;
+}
+
+// One pass over the nodes in topological order, each node's Taylor
+// coefficients from those of the nodes it reads: c_v[k] for all k at once,
+// in `Lanes` lanes that the compiler unrolls (0: lanes_ at run time).
+// Lanes beyond a node's level hold exact zeros. A node's component is read
+// (into c_v[0]) before it is written, and written as x + increment, rounded
+// once. Returns false, x restored, when an increment is not finite.
+template <std::size_t Lanes>
+bool SparseExponential::sweep(double *x) {
+    const std::size_t lanes = Lanes ? Lanes : lanes_;
+    double fixed_width[Lanes ? Lanes : 1];
+    double *acc = Lanes ? fixed_width : accumulator_.data();
+    const double *a = scaled_.data();
+    const std::uint32_t *column = columns_.data();
+    const double *inverse = inverse_.data();
+    double *coefficients = coefficients_.data();
+    bool finite = true;
+    for (std::size_t v = 0; v < nodes_.size(); ++v) {
+        const SeriesNode &node = nodes_[v];
+        for (std::size_t k = 0; k < lanes; ++k) acc[k] = 0.0;
+        for (std::uint32_t i = 0; i < node.fixed_columns; ++i, ++a, ++column)
+            acc[0] += *a * x[*column];
+        for (std::uint32_t i = 0; i < node.moved_columns; ++i, ++a, ++column) {
+            const double *c = coefficients + static_cast<std::size_t>(*column) * lanes;
+            for (std::size_t k = 0; k < lanes; ++k) acc[k] += *a * c[k];
+        }
+        // c_v[k + 1] = acc[k] / (k + 1); the increment sums them in order of k.
+        double *own = coefficients + v * lanes;
+        own[0] = x[node.global];
+        double total = 0.0;
+        for (std::size_t k = 0; k < lanes; ++k) {
+            const double term = acc[k] * inverse[k];
+            total += term;
+            if (k + 1 < lanes) own[k + 1] = term;
+        }
+        increment_[v] = total;
+        finite &= std::isfinite(total);
+        x[node.global] = own[0] + total;
+    }
+    if (finite) return true;
+    for (std::size_t v = 0; v < nodes_.size(); ++v) x[nodes_[v].global] = coefficients[v * lanes];
+    return false;
+}
+
+void SparseExponential::apply(const double *g, double t, double *x) {
+    scale_entries(g, t);
+    if (path_ == ExpmPath::Plane) {
+        apply_plane(t, x);
+        return;
+    }
+    if (path_ == ExpmPath::Pade) {
+        apply_pade(t, x);
+        return;
+    }
+    bool finite = true;
+    switch (lanes_) {
+        case 1: finite = sweep<1>(x); break;
+        case 2: finite = sweep<2>(x); break;
+        case 4: finite = sweep<4>(x); break;
+        case 8: finite = sweep<8>(x); break;
+        default: finite = sweep<0>(x); break;
+    }
+    if (!finite) fail_nonfinite();
+}
+
+void SparseExponential::apply_plane(double t, double *x) {
+    double A[4] = {0.0, 0.0, 0.0, 0.0};
+    for (std::size_t j = 0; j < block_.size(); ++j) A[block_[j].row * 2 + block_[j].col] = scaled_[j];
+    check_norm(std::max(std::fabs(A[0]) + std::fabs(A[2]), std::fabs(A[1]) + std::fabs(A[3])), t);
+    const bool pair = moved_.size() == 2;
+    const double x0 = x[moved_[0]], x1 = pair ? x[moved_[1]] : 0.0;
+    double W[4] = {0.0, 0.0, 0.0, 0.0};
+    if (pair)
+        plane_expm1(A[0], A[1], A[2], A[3], W);
+    else
+        W[0] = std::expm1(A[0]);
+    // x += (exp(tA) - I) x, rounded once; untouched when not representable.
+    increment_[0] = W[0] * x0 + W[1] * x1;
+    if (pair) increment_[1] = W[2] * x0 + W[3] * x1;
+    if (!std::isfinite(increment_[0]) || (pair && !std::isfinite(increment_[1]))) fail_nonfinite();
+    x[moved_[0]] = x0 + increment_[0];
+    if (pair) x[moved_[1]] = x1 + increment_[1];
+}
+
+void SparseExponential::apply_pade(double t, double *x) {
+    const std::size_t m = moved_.size();
+    dense_.assign(square_entries(m, "exponential's matrix"), 0.0);
+    for (std::size_t j = 0; j < block_.size(); ++j) dense_[block_[j].row * m + block_[j].col] = scaled_[j];
+    check_norm(dense_norm1(m, dense_.data()), t);
+    exp_.resize(dense_.size());
+    expm1_dense(m, dense_.data(), exp_.data(), pade_scratch_);
+    // x += (exp(tA) - I) x: the increment carries its own small rounding
+    // errors, and x is rounded once (as on the other paths). x is left
+    // untouched when the exact flow is not representable.
+    bool finite = true;
+    for (std::size_t r = 0; r < m; ++r) {
+        double s = 0.0;
+        for (std::size_t c = 0; c < m; ++c) s += exp_[r * m + c] * x[moved_[c]];
+        increment_[r] = s;
+        finite &= std::isfinite(s);
+    }
+    if (!finite) fail_nonfinite();
+    for (std::size_t r = 0; r < m; ++r) x[moved_[r]] += increment_[r];
+}
+
+}  // namespace lpi
