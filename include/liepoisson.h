@@ -317,6 +317,23 @@ LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, d
 LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *seconds_per_step,
                                      double *transforms_per_step);
 
+/* How FFTW chooses the plans of a sine-Euler system's line transforms:
+ * "estimate" (the default), "measure" or "patient". Estimate is
+ * deterministic: a run gives the same bits in every process on the same
+ * machine and FFTW build, so a checkpoint resumed in another process continues
+ * bit for bit. Measure and patient time candidate plans (up to seconds per
+ * N): the transforms are often faster (1.0-1.7x for N = 61 .. 1021 here), but
+ * another process may choose other plans, which changes results at
+ * round-off. Every rigor uses the wisdom the process holds for a transform
+ * (imported, or planned earlier at that rigor or higher): importing the same
+ * wisdom first makes measured plans, and their results, the same in every
+ * process. set_planning plans at once (on failure the old plans stay);
+ * get_planning sets *rigor to a static string. Not stored in checkpoints (a
+ * property of the process, like wisdom and threads). Other kinds:
+ * LPI_ERR_UNSUPPORTED; an unknown name: LPI_ERR_INVALID. */
+LPI_API int lpi_sine_euler_set_planning(lpi_system *sys, const char *rigor);
+LPI_API int lpi_sine_euler_get_planning(const lpi_system *sys, const char **rigor);
+
 /* Threads used inside one step (OpenMP over the lines of a direction);
  * 1 <= n <= 4 x the processors available (omp_get_num_procs), else
  * LPI_ERR_INVALID. Results are identical to the bit for every n. Models that

@@ -98,6 +98,18 @@ if [ "$have_sine_euler" = 1 ]; then
     "$lpi" run sine-euler --N 5 --dt 0.05 --steps 4 --out "$out/s" --checkpoint "$out/se5.lpi" >/dev/null
     refused "N = 5, not 7" run sine-euler --N 7 --resume "$out/se5.lpi" --out "$out/bad"
     refused "another" run pendulum --resume "$out/se5.lpi" --out "$out/bad"
+    refused --planning run sine-euler --planning exhaustive --out "$out/bad"
+    refused --planning run sine-euler --planning "" --out "$out/bad"
+    refused --planning $rb --planning measure
+    # Measured plans differ from process to process; shared wisdom makes a
+    # second run choose the first run's plans: the same bits.
+    for run in 1 2; do
+        "$lpi" run sine-euler --N 15 --dt 0.05 --steps 30 --every 10 --planning measure \
+            --wisdom "$out/se.wisdom" --out "$out/measured$run" >/dev/null
+        [ -s "$out/se.wisdom" ] || { echo "--planning measure --wisdom wrote no wisdom"; exit 1; }
+    done
+    cmp -s "$out/measured1/sine-euler.csv" "$out/measured2/sine-euler.csv" ||
+        { echo "two measured runs sharing --wisdom differ"; exit 1; }
 fi
 
 # --checkpoint then --resume with the same options: the CSV (every row, to

@@ -364,6 +364,15 @@ static int call_lpi_sine_euler_fft_floor(lpi_system *s, const args *a, lpi_syste
     (void)o;
     return lpi_sine_euler_fft_floor(s, a->k, PTR(P1, &out_d1), PTR(P2, &out_d2));
 }
+static int call_lpi_sine_euler_set_planning(lpi_system *s, const args *a, lpi_system **o) {
+    (void)o;
+    return lpi_sine_euler_set_planning(s, a->s);
+}
+static int call_lpi_sine_euler_get_planning(lpi_system *s, const args *a, lpi_system **o) {
+    (void)o;
+    const char *rigor;
+    return lpi_sine_euler_get_planning(s, PTR(P1, &rigor));
+}
 static int call_lpi_set_threads(lpi_system *s, const args *a, lpi_system **o) {
     (void)o;
     return lpi_set_threads(s, (int32_t)a->k);
@@ -650,6 +659,14 @@ static const bad_case kCases[] = {
     C(lpi_sine_euler_fft_floor, "rk4 (not a splitting)", LPI_ERR_INVALID, SE_RK4, .k = 1),
     C(lpi_sine_euler_fft_floor, "implicit-midpoint (not a splitting)", LPI_ERR_INVALID, SE_IMP, .k = 1),
     C(lpi_sine_euler_fft_floor, "nsteps x flows per step overflows", LPI_ERR_OVERFLOW, SE, .k = INT64_MAX),
+    C(lpi_sine_euler_set_planning, "NULL handle", LPI_ERR_NULL, NONE, .s = "measure"),
+    C(lpi_sine_euler_set_planning, "a rigid body (wrong kind)", LPI_ERR_UNSUPPORTED, RB, .s = "measure"),
+    C(lpi_sine_euler_set_planning, "NULL rigor", LPI_ERR_NULL, SE),
+    C(lpi_sine_euler_set_planning, "unknown rigor", LPI_ERR_INVALID, SE, .s = "exhaustive"),
+    C(lpi_sine_euler_set_planning, "empty rigor", LPI_ERR_INVALID, SE, .s = ""),
+    C(lpi_sine_euler_get_planning, "NULL handle", LPI_ERR_NULL, NONE),
+    C(lpi_sine_euler_get_planning, "a generic system (wrong kind)", LPI_ERR_UNSUPPORTED, GEN),
+    C(lpi_sine_euler_get_planning, "NULL rigor", LPI_ERR_NULL, SE, .nul = P1),
     C(lpi_set_threads, "NULL handle", LPI_ERR_NULL, NONE, .k = 2),
     C(lpi_set_threads, "n = 0", LPI_ERR_INVALID, SE, .k = 0),
     C(lpi_set_threads, "n < 0", LPI_ERR_INVALID, SE, .k = -2),

@@ -650,6 +650,46 @@ static void test_wisdom(void **state) {
                      "lpi_fftw_wisdom_import_file");
 }
 
+/* The planning rigor: "estimate" by default; "measure" plans at once without
+ * touching the state, and its (other) plans give the same trajectory to
+ * round-off. */
+static void test_planning(void **state) {
+    (void)state;
+    const int Ns[] = {25, 31};
+    for (size_t i = 0; i < 2; ++i) {
+        const int N = Ns[i];
+        const size_t n = 2 * (size_t)N * N;
+        double *w = malloc(sizeof(double) * n), *a = malloc(sizeof(double) * n),
+               *b = malloc(sizeof(double) * n);
+        random_field(N, 11u + (unsigned)i, w);
+        lpi_system *estimated = sine_euler(N, w), *measured = sine_euler(N, w);
+        const char *rigor = NULL;
+        assert_int_equal(lpi_sine_euler_get_planning(estimated, &rigor), LPI_OK);
+        assert_string_equal(rigor, "estimate");
+        assert_int_equal(lpi_step(measured, 0.05, 3), LPI_OK); /* planned already */
+        assert_int_equal(lpi_sine_euler_get_modes(measured, a, n), LPI_OK);
+        assert_int_equal(lpi_sine_euler_set_planning(measured, "measure"), LPI_OK);
+        assert_int_equal(lpi_sine_euler_get_modes(measured, b, n), LPI_OK);
+        assert_memory_equal(a, b, sizeof(double) * n);
+        assert_int_equal(lpi_sine_euler_get_planning(measured, &rigor), LPI_OK);
+        assert_string_equal(rigor, "measure");
+        assert_int_equal(lpi_step(estimated, 0.05, 3), LPI_OK);
+        assert_int_equal(lpi_step(estimated, 0.05, 40), LPI_OK);
+        assert_int_equal(lpi_step(measured, 0.05, 40), LPI_OK);
+        assert_int_equal(lpi_sine_euler_get_modes(estimated, a, n), LPI_OK);
+        assert_int_equal(lpi_sine_euler_get_modes(measured, b, n), LPI_OK);
+        double diff = 0.0, size = 0.0;
+        for (size_t k = 0; k < n; ++k) {
+            diff = fmax(diff, fabs(a[k] - b[k]));
+            size = fmax(size, fabs(a[k]));
+        }
+        assert_true(diff <= 1e-13 * size);
+        lpi_destroy(estimated);
+        lpi_destroy(measured);
+        free(w), free(a), free(b);
+    }
+}
+
 /* ---- bad input ----------------------------------------------------------- */
 
 static void test_bad_input(void **state) {
@@ -774,6 +814,7 @@ int main(void) {
         cmocka_unit_test(test_threads_bitwise),
         cmocka_unit_test(test_handles_on_threads),
         cmocka_unit_test(test_wisdom),
+        cmocka_unit_test(test_planning),
         cmocka_unit_test(test_bad_input),
     };
     return lpi_run_tests(tests);

@@ -321,6 +321,18 @@ module liepoisson
             integer(c_int64_t), value :: nsteps
             real(c_double), intent(out) :: seconds_per_step, transforms_per_step
         end function
+        integer(c_int) function c_lpi_sine_euler_set_planning(sys, rigor) &
+                bind(C, name="lpi_sine_euler_set_planning")
+            import :: c_int, c_ptr, c_char
+            type(c_ptr), value :: sys
+            character(kind=c_char), intent(in) :: rigor(*)
+        end function
+        integer(c_int) function c_lpi_sine_euler_get_planning(sys, rigor) &
+                bind(C, name="lpi_sine_euler_get_planning")
+            import :: c_int, c_ptr
+            type(c_ptr), value :: sys
+            type(c_ptr), intent(out) :: rigor
+        end function
         integer(c_int) function c_lpi_set_threads(sys, n) bind(C, name="lpi_set_threads")
             import :: c_int, c_ptr, c_int32_t
             type(c_ptr), value :: sys
@@ -388,7 +400,8 @@ module liepoisson
         c_lpi_moments_add_product_piece, c_lpi_sine_euler_create, c_lpi_sine_euler_size, &
         c_lpi_sine_euler_set_modes, c_lpi_sine_euler_get_modes, c_lpi_sine_euler_set_grid, &
         c_lpi_sine_euler_get_grid, c_lpi_sine_euler_enstrophy, c_lpi_sine_euler_casimir_traces, &
-        c_lpi_sine_euler_fft_floor, c_lpi_set_threads, c_lpi_fftw_wisdom_import_file, &
+        c_lpi_sine_euler_fft_floor, c_lpi_sine_euler_set_planning, c_lpi_sine_euler_get_planning, &
+        c_lpi_set_threads, c_lpi_fftw_wisdom_import_file, &
         c_lpi_fftw_wisdom_export_file, c_lpi_fftw_wisdom_import_string, &
         c_lpi_fftw_wisdom_export_string, c_lpi_save, c_lpi_load, c_lpi_save_buffer, c_lpi_load_buffer
 
@@ -409,7 +422,8 @@ module liepoisson
         lpi_moments_add_product_piece, lpi_sine_euler_create, lpi_sine_euler_size, &
         lpi_sine_euler_set_modes, lpi_sine_euler_get_modes, lpi_sine_euler_set_grid, &
         lpi_sine_euler_get_grid, lpi_sine_euler_enstrophy, lpi_sine_euler_casimir_traces, &
-        lpi_sine_euler_fft_floor, lpi_set_threads, lpi_fftw_wisdom_import_file, &
+        lpi_sine_euler_fft_floor, lpi_sine_euler_set_planning, lpi_sine_euler_get_planning, &
+        lpi_set_threads, lpi_fftw_wisdom_import_file, &
         lpi_fftw_wisdom_export_file, lpi_fftw_wisdom_import_string, lpi_fftw_wisdom_export_string, &
         lpi_save, lpi_load, lpi_save_buffer, lpi_load_buffer
 
@@ -877,6 +891,26 @@ contains
         integer, intent(out), optional :: status
         call finish(c_lpi_sine_euler_fft_floor(sys, int(nsteps, c_int64_t), seconds_per_step, &
                                                transforms_per_step), sys, status)
+    end subroutine
+
+    ! rigor: "estimate" (the default), "measure" or "patient".
+    subroutine lpi_sine_euler_set_planning(sys, rigor, status)
+        type(c_ptr), intent(in) :: sys
+        character(len=*), intent(in) :: rigor
+        integer, intent(out), optional :: status
+        call finish(c_lpi_sine_euler_set_planning(sys, c_string(rigor)), sys, status)
+    end subroutine
+
+    subroutine lpi_sine_euler_get_planning(sys, rigor, status)
+        type(c_ptr), intent(in) :: sys
+        character(len=:), allocatable, intent(out) :: rigor
+        integer, intent(out), optional :: status
+        type(c_ptr) :: p
+        integer(c_int) :: st
+        p = c_null_ptr
+        st = c_lpi_sine_euler_get_planning(sys, p)
+        rigor = f_string(p)
+        call finish(st, sys, status)
     end subroutine
 
     subroutine lpi_set_threads(sys, n, status)

@@ -151,6 +151,22 @@ LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *se
     });
 }
 
+LPI_API int lpi_sine_euler_set_planning(lpi_system *sys, const char *rigor) {
+    return guarded(sys, "lpi_sine_euler_set_planning", [&] {
+        auto &model = sine_euler(sys);
+        require(rigor, "rigor");
+        model.set_planning(lpi::planning_from_name(rigor));
+    });
+}
+
+LPI_API int lpi_sine_euler_get_planning(const lpi_system *sys, const char **rigor) {
+    return guarded(sys, "lpi_sine_euler_get_planning", [&] {
+        const auto &model = sine_euler(sys);
+        require(rigor, "rigor");
+        *rigor = lpi::planning_name(model.planning());
+    });
+}
+
 LPI_API int lpi_fftw_wisdom_import_file(const char *path) {
     return guarded(nullptr, "lpi_fftw_wisdom_import_file", [&] {
         require(path, "path");

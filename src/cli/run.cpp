@@ -5,6 +5,7 @@
 #include "run.hpp"
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -149,6 +150,15 @@ int run_command(int argc, char **argv) {
     lpi_system *sys = h.get();
     if (!o.method.empty()) check_option(lpi_set_method(sys, o.method.c_str()), sys, "--method");
     if (o.threads != 1) check_option(lpi_set_threads(sys, o.threads), sys, "--threads");
+    // Wisdom first, so that any planning (the first step's or --planning's)
+    // uses it; measured plans are written back for the next run.
+    if (!o.wisdom.empty() && access(o.wisdom.c_str(), F_OK) == 0)
+        check_option(lpi_fftw_wisdom_import_file(o.wisdom.c_str()), nullptr, "--wisdom");
+    if (!o.planning.empty()) {
+        check_option(lpi_sine_euler_set_planning(sys, o.planning.c_str()), sys, "--planning");
+        if (!o.wisdom.empty() && o.planning != "estimate")
+            check_option(lpi_fftw_wisdom_export_file(o.wisdom.c_str()), nullptr, "--wisdom");
+    }
     // The method in use: --method's, else a new system's default or the
     // checkpoint's (it holds the method).
     const std::string method = lpi_get_method(sys);

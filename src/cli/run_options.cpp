@@ -21,6 +21,11 @@ void run_usage(FILE *to) {
                  "  --until T         end time (default: the scene's final time)\n"
                  "  --every K         write a row every K steps (default: about 100 rows)\n"
                  "  --threads N       threads inside a step (sine-Euler; default 1)\n"
+                 "  --planning R      sine-Euler FFTW planning: estimate (default: the same bits in\n"
+                 "                    every process), measure or patient (faster transforms; other\n"
+                 "                    processes may round differently unless they share --wisdom)\n"
+                 "  --wisdom FILE     FFTW wisdom: imported first when FILE exists, and written\n"
+                 "                    after measured planning, so later runs reuse those plans\n"
                  "  --N N             sine-Euler size (odd >= 3, default 31, or the --init grid's)\n"
                  "  --init FILE       sine-Euler: the initial vorticity on the N x N grid, from a\n"
                  "                    .npy array (N, N) (float64 or float32) or an HDF5 file's\n"
@@ -59,6 +64,11 @@ void parse_run_options(int argc, char **argv, RunOptions &o) {
         else if (arg == "--until") o.until = args.positive(arg);
         else if (arg == "--every") o.every = args.integer(arg, 1, INT64_MAX);
         else if (arg == "--threads") o.threads = static_cast<int32_t>(args.integer(arg, 1, int32_max));
+        else if (arg == "--planning") {
+            o.planning = args.value(arg);
+            if (o.planning != "estimate" && o.planning != "measure" && o.planning != "patient")
+                args.fail("--planning: '" + o.planning + "' is not estimate, measure or patient");
+        } else if (arg == "--wisdom") o.wisdom = args.value(arg);
         else if (arg == "--N") {
             o.scene_options.sine_euler_n = static_cast<int>(args.integer(arg, 3, int32_max));
             if (o.scene_options.sine_euler_n % 2 == 0) args.fail("--N must be odd");

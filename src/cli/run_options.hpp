@@ -16,6 +16,8 @@ struct RunOptions {
     double until = 0.0;        // ...its end time (0: the scene's final time)
     int64_t every = 0;         // output interval in steps (0: about 100 rows)
     int32_t threads = 1;
+    std::string planning;      // sine-Euler FFTW planning (empty: the library's default)
+    std::string wisdom;        // FFTW wisdom file: imported when it exists, written after measuring
     int64_t snapshot_every = 10;  // keep the state every this many output rows (0: none)
     std::string out_dir = "lpi-run";
     std::string checkpoint;    // save here at the start, every checkpoint_every rows and at the end

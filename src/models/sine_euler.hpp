@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <string>
 
 #include "../core/model.hpp"
 
@@ -26,6 +27,18 @@ struct TransformTiming {
     double seconds_per_step;
     double transforms_per_step;
 };
+
+// How FFTW chooses the plans of the line transforms. Estimate (the default)
+// is deterministic: the same plans, and so the same bits, in every process
+// of a machine and FFTW build. Measure and Patient time candidate plans
+// while planning: faster transforms, but another process may choose others
+// and round differently. Every rigor uses wisdom the process holds for the
+// transform (imported, or planned earlier at that rigor or higher), so
+// importing the same wisdom makes measured plans reproducible too.
+enum class FftPlanning { Estimate, Measure, Patient };
+const char *planning_name(FftPlanning planning);
+// LPI_ERR_INVALID naming the choices for an unknown name.
+FftPlanning planning_from_name(const std::string &name);
 
 // What the C API needs of a sine-Euler model beyond lpi::Model.
 class SineEulerModel : public Model {
@@ -47,6 +60,10 @@ public:
     // LPI_ERR_INVALID for steps < 1, LPI_ERR_OVERFLOW when the flow count
     // overflows.
     virtual TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) = 0;
+    // Plans the line transforms anew at this rigor (now, so its cost and any
+    // failure come here; on failure the old plans stay).
+    virtual void set_planning(FftPlanning planning) = 0;
+    virtual FftPlanning planning() const = 0;
 };
 
 // Throws LPI_ERR_UNSUPPORTED when built without FFTW3, LPI_ERR_INVALID for

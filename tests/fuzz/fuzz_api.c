@@ -196,7 +196,7 @@ static const char *const kSplits[] = {"casimir-shift", "axes", "standard-map", "
 static void run_call(lpi_system **slot, reader *r) {
     lpi_system *sys = *slot;
     snapshot before;
-    const uint8_t op = byte(r) % 30;
+    const uint8_t op = byte(r) % 31;
     int status = LPI_OK;
     switch (op) {
     case 0: case 1: case 2: case 3: case 4: { /* create into an empty slot */
@@ -448,6 +448,14 @@ static void run_call(lpi_system **slot, reader *r) {
         check_status(lpi_fftw_wisdom_export_file(scratch_path("no-such-dir/wisdom", path, sizeof path)));
         check_status(lpi_fftw_wisdom_import_file(NULL));
         return;
+    }
+    case 29: { /* the FFTW planning rigor (estimate only: measuring is slow), read back */
+        static const char *const names[] = {"estimate", "", "measure!", NULL};
+        const char *rigor = NULL;
+        status = lpi_sine_euler_set_planning(sys, names[byte(r) % 4]);
+        compare(sys, &before, status, "lpi_sine_euler_set_planning");
+        check_status(lpi_sine_euler_get_planning(sys, byte(r) % 8 ? &rigor : NULL));
+        break;
     }
     default: { /* the FFT floor, a few steps' worth */
         double seconds = 0, count = 0;

@@ -287,6 +287,13 @@ contains
         call check(status == LPI_OK, "sine-Euler create")
         call lpi_sine_euler_size(sys, size_n)
         call check(size_n == n, "sine-Euler size")
+        call lpi_sine_euler_get_planning(sys, wisdom)
+        call check(wisdom == "estimate", "default planning")
+        call lpi_sine_euler_set_planning(sys, "measure")
+        call lpi_sine_euler_get_planning(sys, wisdom)
+        call check(wisdom == "measure", "planning read back")
+        call lpi_sine_euler_set_planning(sys, "exhaustive", status)
+        call check(status == LPI_ERR_INVALID, "unknown planning refused")
         call random_seed()
         call random_number(grid)
         grid = grid - 0.5_c_double

@@ -36,7 +36,7 @@ import sys
 import threading
 import time
 import weakref
-from ctypes import byref, c_double, c_int32, c_size_t
+from ctypes import byref, c_char_p, c_double, c_int32, c_size_t
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 from . import _lib
@@ -1486,6 +1486,45 @@ class SineEuler(System):
         sec, count = c_double(), c_double()
         self._call("lpi_sine_euler_fft_floor", _integer(nsteps, "nsteps", "int64"), byref(sec), byref(count))
         return sec.value, count.value
+
+    @property
+    def planning(self) -> str:
+        """How FFTW chooses the line transforms' plans.
+
+        Returns
+        -------
+        str
+            ``"estimate"`` (the default), ``"measure"`` or ``"patient"``.
+        """
+        rigor = c_char_p()
+        self._call("lpi_sine_euler_get_planning", byref(rigor))
+        return _text(rigor.value)
+
+    @planning.setter
+    def planning(self, rigor: str) -> None:
+        self.set_planning(rigor)
+
+    def set_planning(self, rigor: str) -> None:
+        """Plan the line transforms anew, now, at this FFTW rigor.
+
+        ``"estimate"`` (the default) is deterministic: the same bits in every
+        process on this machine and FFTW build. ``"measure"`` and
+        ``"patient"`` time candidate plans: often faster, but another process
+        may choose other plans and round differently, unless the same FFTW
+        wisdom was imported first (`fftw_wisdom_import_file`). See
+        lpi_sine_euler_set_planning(3).
+
+        Parameters
+        ----------
+        rigor : str
+            ``"estimate"``, ``"measure"`` or ``"patient"``.
+
+        Raises
+        ------
+        InvalidArgumentError
+            An unknown rigor; the plans are unchanged.
+        """
+        self._call("lpi_sine_euler_set_planning", _c_string(rigor, "rigor"))
 
 
 # ---- checkpoints ----------------------------------------------------------------

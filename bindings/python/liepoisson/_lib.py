@@ -86,6 +86,8 @@ PROTOTYPES = {
     "lpi_sine_euler_enstrophy": (c_int, [c_handle, c_double_p]),
     "lpi_sine_euler_casimir_traces": (c_int, [c_handle, c_int32, c_double_p]),
     "lpi_sine_euler_fft_floor": (c_int, [c_handle, c_int64, c_double_p, c_double_p]),
+    "lpi_sine_euler_set_planning": (c_int, [c_handle, c_char_p]),
+    "lpi_sine_euler_get_planning": (c_int, [c_handle, POINTER(c_char_p)]),
     "lpi_set_threads": (c_int, [c_handle, c_int32]),
     "lpi_fftw_wisdom_import_file": (c_int, [c_char_p]),
     "lpi_fftw_wisdom_export_file": (c_int, [c_char_p]),

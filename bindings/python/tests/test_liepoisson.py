@@ -395,6 +395,12 @@ class TestSineEuler(unittest.TestCase):
         sec, count = s.fft_floor(2)
         self.assertGreater(count, 0)
         self.assertGreaterEqual(sec, 0.0)
+        self.assertEqual(s.planning, "estimate")
+        s.planning = "measure"
+        self.assertEqual(s.planning, "measure")
+        with self.assertRaises(lp.InvalidArgumentError):
+            s.set_planning("exhaustive")
+        self.assertEqual(s.planning, "measure")
 
     def test_wisdom(self):
         text = lp.fftw_wisdom_export_string()

@@ -146,6 +146,14 @@ public:
 
     TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) override;
 
+    void set_planning(FftPlanning planning) override {
+        auto planned = std::make_unique<LineTransforms>(N_, planning);
+        planned->reserve_threads(static_cast<std::size_t>(threads_));
+        transforms_ = std::move(planned);
+        planning_ = planning;
+    }
+    FftPlanning planning() const override { return planning_; }
+
 private:
     LineTransforms &transforms();
     bool line_spectrum(const Direction &D, const double *w);
@@ -158,11 +166,12 @@ private:
     std::vector<Direction> dirs_;
     SplitChoice split_{{"directions"}};
     int threads_ = 1;
+    FftPlanning planning_ = FftPlanning::Estimate;
     std::unique_ptr<LineTransforms> transforms_;  // planned on the first flow
 };
 
 LineTransforms &SineEuler::transforms() {
-    if (!transforms_) transforms_ = std::make_unique<LineTransforms>(N_);
+    if (!transforms_) transforms_ = std::make_unique<LineTransforms>(N_, planning_);
     transforms_->reserve_threads(static_cast<std::size_t>(threads_));
     return *transforms_;
 }

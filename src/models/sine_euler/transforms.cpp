@@ -24,12 +24,33 @@ std::mutex &fftw_planner_mutex() {
     return mutex;
 }
 
+namespace {
+constexpr const char *kPlanningNames[] = {"estimate", "measure", "patient"};
+}  // namespace
+
+const char *planning_name(FftPlanning planning) { return kPlanningNames[static_cast<int>(planning)]; }
+
+FftPlanning planning_from_name(const std::string &name) {
+    for (int i = 0; i < 3; ++i)
+        if (name == kPlanningNames[i]) return static_cast<FftPlanning>(i);
+    fail(LPI_ERR_INVALID, "unknown FFTW planning '" + name + "' (estimate, measure or patient)");
+}
+
 #if LPI_HAVE_FFTW
 
 namespace sine_euler {
 
 namespace {
 fftw_complex *complex_of(double *x) { return reinterpret_cast<fftw_complex *>(x); }
+
+unsigned planner_flags(FftPlanning planning) {
+    switch (planning) {
+    case FftPlanning::Measure: return FFTW_MEASURE;
+    case FftPlanning::Patient: return FFTW_PATIENT;
+    case FftPlanning::Estimate: break;
+    }
+    return FFTW_ESTIMATE;
+}
 }  // namespace
 
 struct LineTransforms::Plans {
@@ -38,7 +59,7 @@ struct LineTransforms::Plans {
     fftw_plan backward[2] = {nullptr, nullptr};
 };
 
-LineTransforms::LineTransforms(int N) : N_(N), M_((N - 1) / 2), plans_(new Plans) {
+LineTransforms::LineTransforms(int N, FftPlanning planning) : N_(N), M_((N - 1) / 2), plans_(new Plans) {
     try {
         spectrum_ = reinterpret_cast<double *>(fftw_alloc_complex(N));
         up_ = static_cast<double *>(fftw_malloc(sizeof(double) * 6 * N));
@@ -46,7 +67,7 @@ LineTransforms::LineTransforms(int N) : N_(N), M_((N - 1) / 2), plans_(new Plans
         if (!spectrum_ || !up_ || !down_) throw std::bad_alloc();
         reserve_threads(1);
         std::lock_guard<std::mutex> lock(fftw_planner_mutex());
-        const unsigned flags = FFTW_MEASURE;
+        const unsigned flags = planner_flags(planning);
         fftw_complex *b = complex_of(spectrum_), *x = complex_of(blocks_[0]);
         plans_->spectrum = fftw_plan_dft_1d(N, b, b, FFTW_FORWARD, flags);
         const int sizes[2] = {M_ >= kBlock ? kBlock : 0, M_ % kBlock};

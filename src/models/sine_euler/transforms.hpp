@@ -13,13 +13,15 @@
 #include <string>
 #include <vector>
 
+#include "../sine_euler.hpp"
+
 namespace lpi {
 namespace sine_euler {
 
 class LineTransforms {
 public:
-    // Plans (FFTW_MEASURE) and buffers for N, with one block buffer.
-    explicit LineTransforms(int N);
+    // Plans at the given rigor and buffers for N, with one block buffer.
+    LineTransforms(int N, FftPlanning planning);
     ~LineTransforms();
     LineTransforms(const LineTransforms &) = delete;
     LineTransforms &operator=(const LineTransforms &) = delete;

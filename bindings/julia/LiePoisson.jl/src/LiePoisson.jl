@@ -107,6 +107,10 @@ lpi_sine_euler_casimir_traces(sys, kmax, out) =
 lpi_sine_euler_fft_floor(sys, nsteps, seconds, transforms) =
     ccall(_sym(:lpi_sine_euler_fft_floor), Cint, (Sys, Int64, Ptr{Cdouble}, Ptr{Cdouble}),
           sys, nsteps, seconds, transforms)
+lpi_sine_euler_set_planning(sys, rigor) =
+    ccall(_sym(:lpi_sine_euler_set_planning), Cint, (Sys, Cstring), sys, rigor)
+lpi_sine_euler_get_planning(sys, rigor) =
+    ccall(_sym(:lpi_sine_euler_get_planning), Cint, (Sys, Ptr{Cstring}), sys, rigor)
 lpi_set_threads(sys, n) = ccall(_sym(:lpi_set_threads), Cint, (Sys, Int32), sys, n)
 lpi_fftw_wisdom_import_file(path) = ccall(_sym(:lpi_fftw_wisdom_import_file), Cint, (Cstring,), path)
 lpi_fftw_wisdom_export_file(path) = ccall(_sym(:lpi_fftw_wisdom_export_file), Cint, (Cstring,), path)
@@ -397,6 +401,11 @@ function fft_floor(sys::System, nsteps::Integer)
     _call(h -> C.lpi_sine_euler_fft_floor(h, nsteps, s, t), sys)
     (seconds_per_step = s[], transforms_per_step = t[])
 end
+# FFTW planning rigor: "estimate" (default, deterministic), "measure", "patient".
+set_planning!(sys::System, rigor::AbstractString) = _call(h -> C.lpi_sine_euler_set_planning(h, rigor), sys)
+function planning(sys::System)
+    out = Ref{Cstring}(C_NULL); _call(h -> C.lpi_sine_euler_get_planning(h, out), sys); unsafe_string(out[])
+end
 
 # ---- FFTW wisdom (process-wide) ------------------------------------------------------
 fftw_wisdom_import_file(path::AbstractString) = _check(C.lpi_fftw_wisdom_import_file(path))
@@ -417,6 +426,6 @@ export LiePoissonError, RigidBody, Pendulum, Generic, Moments, SineEuler, System
     set_method!, set_split!, set_composition!, flows_per_step, set_implicit_options!,
     set_threads!, dim, state, set_state!, step!, energy, casimir_count, casimirs, last_error,
     exact, poisson_rank, add_piece!, add_casimir!, add_product_piece!, sine_euler_size, modes,
-    set_modes!, grid, set_grid!, enstrophy, casimir_traces, fft_floor
+    set_modes!, grid, set_grid!, enstrophy, casimir_traces, fft_floor, set_planning!, planning
 
 end # module
