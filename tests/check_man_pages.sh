@@ -110,6 +110,7 @@ done
 # ---- Family pages: RETURN VALUE, ERRORS, an EXAMPLES program that works --
 cc=${CC:-cc}
 programs=""
+mpi_programs=""
 examples_checked=compile
 for page in "$root"/man/man3/*.3; do
     [ -L "$page" ] && continue
@@ -136,8 +137,26 @@ for page in "$root"/man/man3/*.3; do
     if ! grep -q 'int main(' "$program"; then
         complain "$rel: EXAMPLES has no complete program (.EX ... int main( ... .EE)"; continue
     fi
-    programs="$programs $program"
+    # A program of the MPI part builds with MPI (MPICC, set by the build when
+    # it has MPI) and libliepoisson_mpi, and runs as a single process.
+    if grep -q 'liepoisson_mpi.h' "$program"; then
+        mpi_programs="$mpi_programs $program"
+    else
+        programs="$programs $program"
+    fi
 done
+mpi_programs=${mpi_programs# }
+if [ -n "$mpi_programs" ] && [ -n "${MPICC:-}" ]; then
+    for program in $mpi_programs; do
+        name=$(basename "$program" .c)
+        if ! out=$($MPICC ${LPI_EXAMPLE_CFLAGS:-} -std=c99 -Wall -Wextra -Werror -I "$root/include" -c "$program" -o "$work/$name.o" 2>&1); then
+            complain "man/man3/$name.3: the EXAMPLES program does not compile:"; printf '%s\n' "$out"
+        elif [ -n "$libdir" ] && ! out=$($MPICC ${LPI_EXAMPLE_CFLAGS:-} "$work/$name.o" -L "$libdir" -lliepoisson_mpi -lm \
+            -Wl,-rpath,"$libdir" -o "$work/$name.mpi" 2>&1 && cd "$work" && "./$name.mpi" 2>&1); then
+            complain "man/man3/$name.3: the EXAMPLES program fails:"; printf '%s\n' "$out"
+        fi
+    done
+fi
 # One compiler run for all (its messages name the page: lpi_step.c is the
 # program of man3/lpi_step.3): objects when they are to run, else a syntax
 # check. The file names have no spaces; LPI_EXAMPLE_CFLAGS is a list.

@@ -49,7 +49,9 @@ LPI_API int lpi_save(const lpi_system *sys, const char *path) {
         require(sys, "system");
         require(path, "path");
         if (!*path) lpi::fail(LPI_ERR_INVALID, "path is empty");
-        lpi::write_file_atomically(path, lpi::encode_checkpoint(sys->system));
+        const std::vector<unsigned char> bytes = lpi::encode_checkpoint(sys->system);
+        // Written once when the system is spread over processes.
+        sys->system.model().on_one_process([&] { lpi::write_file_atomically(path, bytes); });
     });
 }
 

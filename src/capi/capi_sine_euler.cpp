@@ -78,8 +78,8 @@ LPI_API int lpi_sine_euler_get_modes(const lpi_system *sys, double *re_im, size_
         const auto &model = sine_euler(sys);
         require(re_im, "modes buffer");
         lpi::require_length("modes buffer", n, 2 * squared(model.truncation()));
-        const std::vector<double> &state = sys->system.working_state();
-        std::memcpy(re_im, state.data(), sizeof(double) * n);
+        const std::vector<double> modes = model.whole_state(sys->system.working_state().data());
+        std::memcpy(re_im, modes.data(), sizeof(double) * n);
     });
 }
 

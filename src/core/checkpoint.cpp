@@ -228,7 +228,9 @@ std::vector<unsigned char> encode_checkpoint(const System &system) {
     w.put(system.implicit_settings().tolerance);
     w.put(static_cast<std::int32_t>(system.implicit_settings().max_iterations));
     w.put(system.time());
-    const std::vector<double> &state = system.working_state();
+    // A model spread over processes stores its whole state, as one process
+    // holding it would: the file loads either way.
+    const std::vector<double> state = model.whole_state(system.working_state().data());
     w.put(static_cast<std::uint64_t>(state.size()));
     for (double x : state) w.put(x);
 

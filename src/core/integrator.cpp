@@ -80,7 +80,7 @@ public:
                 }
             }
             const bool checked = observed || final || step % kFiniteCheckInterval == 0;
-            if (checked && !all_finite(state, size)) return {RunOutcome::NonFinite, step};
+            if (checked && !model.finite(state)) return {RunOutcome::NonFinite, step};
             if (observed && observer.observe(step)) return {RunOutcome::Stopped, step};
             if (merge_seam_ && observed && !final) {
                 std::copy(pending_.begin(), pending_.end(), state);
@@ -114,6 +114,11 @@ std::unique_ptr<Integrator> make_integrator(const Method &method, const Model &m
                                             const ImplicitSettings &implicit) {
     if (!method.make_integrator)
         fail(LPI_ERR_INTERNAL, "method '" + method.name + "' has no integrator factory");
+    // A baseline works on the whole state; a distributed model holds a part.
+    if (model.distributed() && method.kind == MethodKind::Baseline)
+        fail(LPI_ERR_UNSUPPORTED, "method '" + method.name + "' is a baseline, which needs the whole " +
+                                      "state on one process; a " + model.kind() +
+                                      " system spread over processes steps by splitting methods");
     return method.make_integrator(method, model, implicit);
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "error.hpp"
+#include "integrator.hpp"
 
 namespace lpi {
 
@@ -23,6 +24,12 @@ void Model::set_threads(int n) {
     if (n < 1) fail(LPI_ERR_INVALID, "thread count must be >= 1, got " + std::to_string(n));
     if (n > 1)
         fail(LPI_ERR_UNSUPPORTED, std::string(kind()) + " integrates on one thread only");
+}
+
+bool Model::finite(const double *state) const { return all_finite(state, state_size()); }
+
+std::vector<double> Model::whole_state(const double *state) const {
+    return std::vector<double>(state, state + state_size());
 }
 
 std::vector<double> Model::checkpoint_parameters() const {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,20 @@ public:
     // src/registry.cpp) turns back into the model. The default refuses with
     // LPI_ERR_UNSUPPORTED.
     virtual std::vector<double> checkpoint_parameters() const;
+
+    // ---- models spread over processes (sine-Euler on MPI) ----------------
+    // Their working state is this process's part of the field, and every call
+    // on them is collective: each process makes the same calls in the same
+    // order. The defaults describe a model held whole by one process.
+    virtual bool distributed() const { return false; }
+    // Whether the working state is finite: the same answer on every process.
+    virtual bool finite(const double *state) const;
+    // The working state of the whole model, as a model of its kind held by
+    // one process stores it (what a checkpoint saves), on every process.
+    virtual std::vector<double> whole_state(const double *state) const;
+    // Runs action on one process (a file written once) and gives its outcome,
+    // a return or an lpi::Error, to every process.
+    virtual void on_one_process(const std::function<void()> &action) const { action(); }
 };
 
 }  // namespace lpi

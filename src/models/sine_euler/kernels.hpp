@@ -6,6 +6,9 @@
 // bits.
 #pragma once
 
+#include <cmath>
+#include <cstddef>
+
 #include "projective_line.hpp"
 
 namespace lpi {
@@ -24,6 +27,26 @@ void scatter_block(const Direction &D, int N, int d0, int count, int first_lane,
 // flows' increments (exp(t Lambda_l) - 1) / N; up and down point into the
 // phase tables at entry N + d0 (see the definition).
 void apply_phase(int N, int count, const double *up, const double *down, double sign, double *x);
+
+// v_l = u_l - 1 = exp(i phi_l) - 1 = (-2 sin^2(phi_l / 2), sin phi_l), phi_l =
+// factor B_l (B: the line spectrum, N complex, real parts used), stored three
+// times over in the phase tables (3N complex each), forwards in up and
+// backwards in down, so that v_{l-c} and v_{l+c} need no reduction mod N and
+// run forwards along the lines of a block. Each l writes its own entries only.
+inline void write_phase(int n, int l, double factor, const double *spectrum, double *up,
+                        double *down) {
+    const std::size_t N = n;
+    const double angle = factor * spectrum[2 * l];
+    const double half = std::sin(0.5 * angle);
+    const double re = -2.0 * half * half, im = std::sin(angle);
+    const std::size_t minus = l == 0 ? 0 : N - l;
+    for (std::size_t copy = 0; copy < 3; ++copy) {
+        up[2 * (l + copy * N)] = re;
+        up[2 * (l + copy * N) + 1] = im;
+        down[2 * (minus + copy * N)] = re;
+        down[2 * (minus + copy * N) + 1] = im;
+    }
+}
 
 }  // namespace sine_euler
 }  // namespace lpi

@@ -202,24 +202,9 @@ bool SineEuler::line_spectrum(const Direction &D, const double *w) {
     return true;
 }
 
-// v_l = u_l - 1 = exp(i phi_l) - 1 = (-2 sin^2(phi_l / 2), sin phi_l), phi_l =
-// factor B_l with factor = t / (2 eps), stored three times over, forwards and
-// backwards, so that v_{l-c} and v_{l+c} need no reduction mod N and run
-// forwards along the lines of a block. Each l writes its own entries only, so
-// threads may share the loop over l.
+// The phase tables of DFT index l (write_phase, kernels.hpp).
 void SineEuler::line_phase(int l, double factor) {
-    const std::size_t N = N_;
-    double *up = transforms_->up(), *down = transforms_->down();
-    const double angle = factor * transforms_->spectrum()[2 * l];
-    const double half = std::sin(0.5 * angle);
-    const double re = -2.0 * half * half, im = std::sin(angle);
-    const std::size_t minus = l == 0 ? 0 : N - l;
-    for (std::size_t copy = 0; copy < 3; ++copy) {
-        up[2 * (l + copy * N)] = re;
-        up[2 * (l + copy * N) + 1] = im;
-        down[2 * (minus + copy * N)] = re;
-        down[2 * (minus + copy * N) + 1] = im;
-    }
+    write_phase(N_, l, factor, transforms_->spectrum(), transforms_->up(), transforms_->down());
 }
 
 // Lines d = d0 .. d0+count-1 of direction D: gather z_s = w_{d j + s k} into

@@ -1,0 +1,65 @@
+// The C ABI of the MPI part (include/liepoisson_mpi.h).
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "../capi/handle.hpp"
+#include "../core/checkpoint.hpp"
+#include "../models/sine_euler.hpp"
+#include "communicator.hpp"
+#include "liepoisson_mpi.h"
+#include "sine_euler_mpi.hpp"
+
+using lpi::capi::create;
+using lpi::capi::guarded;
+using lpi::capi::require;
+
+extern "C" {
+
+LPI_API int lpi_sine_euler_create_mpi(lpi_system **out, int32_t N, MPI_Comm comm) {
+    return create(out, "lpi_sine_euler_create_mpi", [&] { return lpi::make_sine_euler_mpi(N, comm); });
+}
+
+LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
+    if (out) *out = nullptr;
+    return guarded(nullptr, "lpi_load_mpi", [&] {
+        require(out, "out");
+        require(path, "path");
+        const lpi::mpi::Communicator reader(comm);
+        // Rank 0 reads; every process decodes the same bytes.
+        std::vector<unsigned char> bytes;
+        double size = 0.0;
+        reader.on_root([&] {
+            bytes = lpi::read_checkpoint_file(path);
+            size = static_cast<double>(bytes.size());
+        });
+        reader.broadcast(&size, 1);
+        std::vector<double> words((static_cast<std::size_t>(size) + sizeof(double) - 1) / sizeof(double));
+        if (reader.rank() == 0) std::memcpy(words.data(), bytes.data(), bytes.size());
+        reader.broadcast(words.data(), words.size());
+        const auto *data = reinterpret_cast<const unsigned char *>(words.data());
+        lpi::Checkpoint cp;
+        reader.agree([&] {
+            try {
+                cp = lpi::decode_checkpoint(data, static_cast<std::size_t>(size));
+            } catch (const lpi::Error &e) {
+                lpi::fail(e.status(), std::string("'") + path + "': " + e.what());
+            }
+            if (std::string(cp.model->kind()) != "sine-euler")
+                lpi::fail(LPI_ERR_UNSUPPORTED, std::string("'") + path + "' holds a " +
+                                                   cp.model->kind() +
+                                                   " system; only sine-euler is spread over processes");
+        });
+        const int N = static_cast<const lpi::SineEulerModel &>(*cp.model).truncation();
+        std::unique_ptr<lpi::Model> model = lpi::make_sine_euler_mpi(N, comm);
+        model->set_split(cp.model->split());
+        cp.state = lpi::local_state_of_modes(*model, cp.state.data());
+        cp.model.reset();  // the whole field is not kept
+        auto handle = std::make_unique<lpi_system>(std::move(model));
+        reader.agree([&] { lpi::restore_checkpoint(handle->system, cp); });
+        *out = handle.release();
+    });
+}
+
+}  // extern "C"

@@ -1,0 +1,195 @@
+// The lines each process holds and the exchange between directions (see the
+// header).
+#include "line_exchange.hpp"
+
+#include <climits>
+#include <numeric>
+#include <string>
+
+#include "../core/error.hpp"
+#include "../models/sine_euler/indexing.hpp"
+
+namespace lpi {
+namespace mpi {
+
+using sine_euler::Direction;
+using sine_euler::modulo;
+
+LineOwnership::LineOwnership(int n, int processes)
+    : N(n), M((n - 1) / 2), P(processes), first(static_cast<std::size_t>(processes) + 1),
+      owner(static_cast<std::size_t>(M) + 1, -1) {
+    for (int r = 0; r <= P; ++r)
+        first[r] = 1 + static_cast<int>(static_cast<std::int64_t>(r) * M / P);
+    for (int r = 0; r < P; ++r)
+        for (int d = first[r]; d < first[r + 1]; ++d) owner[d] = r;
+}
+
+namespace {
+
+std::int64_t cross(std::int64_t x1, std::int64_t x2, std::int64_t y1, std::int64_t y2) {
+    return x1 * y2 - x2 * y1;
+}
+
+// The linear map from direction D' = to (d', s') to direction D = from
+// (v, u), and the solutions of gamma s' = c (mod N).
+struct Transition {
+    Transition(const Direction &from, const Direction &to, int n) : N(n) {
+        const std::int64_t sigma = from.sigma;
+        gamma = modulo(sigma * cross(to.k1, to.k2, from.k1, from.k2), N);
+        delta = modulo(sigma * cross(to.j1, to.j2, from.k1, from.k2), N);
+        mu = modulo(sigma * cross(from.j1, from.j2, to.j1, to.j2), N);
+        nu = modulo(sigma * cross(from.j1, from.j2, to.k1, to.k2), N);
+        g = std::gcd(gamma, N);
+        period = N / g;
+        // The inverse of gamma / g mod N / g (extended Euclid).
+        std::int64_t r0 = period, r1 = (gamma / g) % period, t0 = 0, t1 = 1;
+        while (r1 != 0) {
+            const std::int64_t q = r0 / r1, r = r0 - q * r1, t = t0 - q * t1;
+            r0 = r1, r1 = r, t0 = t1, t1 = t;
+        }
+        inverse = period == 1 ? 0 : modulo(t0, period);
+    }
+    // Calls f(s') for the s' in 0 .. N-1, ascending, with gamma s' = c (mod N).
+    template <class F>
+    void solve(int c, F &&f) const {
+        if (c % g != 0) return;
+        const int s0 = static_cast<int>(static_cast<std::int64_t>(c / g) * inverse % period);
+        for (int s = s0; s < N; s += period) f(s);
+    }
+    int line_of_new_origin_line(int s) const { return static_cast<int>(static_cast<std::int64_t>(gamma) * s % N); }
+    int element(int d_new, int s_new) const {
+        return static_cast<int>((static_cast<std::int64_t>(mu) * d_new + static_cast<std::int64_t>(nu) * s_new) % N);
+    }
+    int N, gamma, delta, mu, nu, g, period, inverse;
+};
+
+// Calls f(d', s', d, element, mirrored) for each mode that `source` sends to
+// `target`, in the order both use: the mode at element s' of line d' of the
+// new direction is at `element` of line d of the old one, conjugated when
+// `mirrored` (it lies on line -d there).
+template <class F>
+void for_each_exchanged(const Transition &T, const LineOwnership &L, int target, int source, F &&f) {
+    const int N = L.N;
+    for (int d_new = L.first[target]; d_new < L.first[target + 1]; ++d_new) {
+        const int delta = static_cast<int>(static_cast<std::int64_t>(T.delta) * d_new % N);
+        for (int d = L.first[source]; d < L.first[source + 1]; ++d) {
+            T.solve(modulo(d - delta, N), [&](int s_new) { f(d_new, s_new, d, T.element(d_new, s_new), false); });
+            T.solve(modulo(N - d - delta, N), [&](int s_new) {
+                const int u = T.element(d_new, s_new);
+                f(d_new, s_new, d, u == 0 ? 0 : N - u, true);
+            });
+        }
+    }
+}
+
+int as_count(std::size_t n) {
+    if (n > static_cast<std::size_t>(INT_MAX))
+        fail(LPI_ERR_OVERFLOW, "an exchange of " + std::to_string(n) +
+                                   " modes overflows an MPI count (use more processes)");
+    return static_cast<int>(n);
+}
+
+}  // namespace
+
+void LineExchange::move(const Direction &from, std::size_t from_index, const Direction &to,
+                        std::size_t to_index, double *state) {
+    if (from_index == to_index) return;
+    const LineOwnership &L = lines_;
+    const int N = L.N, P = L.P, me = comm_.rank(), mine = L.count(me);
+    const Transition T(from, to, N);
+    double *line0 = state + line0_entry();
+    double *slab = state + slab_entry(N);
+
+    // Where each mode of the new line 0 comes from: the owner of its old
+    // line, or -1 for modes on the old line 0 (at hand here). By owner, in
+    // ascending s' within each.
+    std::vector<int> origin_source(static_cast<std::size_t>(N), -1), origin_order;
+    std::vector<int> origin_first(static_cast<std::size_t>(P) + 1, 0);
+    for (int s = 1; s < N; ++s) {
+        const int v = T.line_of_new_origin_line(s);
+        if (v != 0) origin_source[s] = L.owner[v <= L.M ? v : N - v];
+        if (origin_source[s] >= 0) ++origin_first[origin_source[s] + 1];
+    }
+    std::partial_sum(origin_first.begin(), origin_first.end(), origin_first.begin());
+    origin_order.resize(static_cast<std::size_t>(origin_first[P]));
+    {
+        std::vector<int> next(origin_first.begin(), origin_first.end() - 1);
+        for (int s = 1; s < N; ++s)
+            if (origin_source[s] >= 0) origin_order[next[origin_source[s]]++] = s;
+    }
+    // The value of the old layout at element u of line v (v != 0).
+    auto old_value = [&](int v, int u, double &re, double &im) {
+        const bool mirrored = v > L.M;
+        const int d = mirrored ? N - v : v, e = mirrored ? (u == 0 ? 0 : N - u) : u;
+        const double *z = slab + 2 * (static_cast<std::size_t>(e) * mine + (d - L.first[me]));
+        re = z[0];
+        im = mirrored ? -z[1] : z[1];
+    };
+
+    // Pack: for each process, the new line 0's modes held here, then its lines' modes.
+    send_.clear();
+    send_counts_.assign(P, 0);
+    send_offsets_.assign(P, 0);
+    for (int q = 0; q < P; ++q) {
+        const std::size_t start = send_.size() / 2;
+        for (int i = origin_first[me]; i < origin_first[me + 1]; ++i) {
+            const int s = origin_order[i];
+            double re, im;
+            old_value(T.line_of_new_origin_line(s), T.element(0, s), re, im);
+            send_.push_back(re);
+            send_.push_back(im);
+        }
+        for_each_exchanged(T, L, q, me, [&](int, int, int d, int e, bool mirrored) {
+            const double *z = slab + 2 * (static_cast<std::size_t>(e) * mine + (d - L.first[me]));
+            send_.push_back(z[0]);
+            send_.push_back(mirrored ? -z[1] : z[1]);
+        });
+        send_offsets_[q] = as_count(start);
+        send_counts_[q] = as_count(send_.size() / 2 - start);
+    }
+    // Where each value received goes (complex entries after the index: line
+    // 0 at 0 .. N-1, the lines from N).
+    targets_.clear();
+    receive_counts_.assign(P, 0);
+    receive_offsets_.assign(P, 0);
+    for (int r = 0; r < P; ++r) {
+        const std::size_t start = targets_.size();
+        for (int i = origin_first[r]; i < origin_first[r + 1]; ++i) targets_.push_back(origin_order[i]);
+        for_each_exchanged(T, L, me, r, [&](int d_new, int s_new, int, int, bool) {
+            targets_.push_back(N + static_cast<std::uint64_t>(s_new) * mine + (d_new - L.first[me]));
+        });
+        receive_offsets_[r] = as_count(start);
+        receive_counts_[r] = as_count(targets_.size() - start);
+    }
+    receive_.resize(2 * targets_.size());
+    old_line0_.assign(line0, line0 + 2 * static_cast<std::size_t>(N));
+
+    comm_.alltoallv(send_.data(), send_counts_, send_offsets_, receive_.data(), receive_counts_,
+                    receive_offsets_);
+
+    double *entries = state + line0_entry();
+    for (std::size_t i = 0; i < targets_.size(); ++i) {
+        entries[2 * targets_[i]] = receive_[2 * i];
+        entries[2 * targets_[i] + 1] = receive_[2 * i + 1];
+    }
+    // Modes on the old line 0: from the copy held here.
+    for (int s = 1; s < N; ++s)
+        if (origin_source[s] < 0) {
+            const int u = T.element(0, s);
+            line0[2 * s] = old_line0_[2 * u];
+            line0[2 * s + 1] = old_line0_[2 * u + 1];
+        }
+    for (int d_new = L.first[me]; d_new < L.first[me + 1]; ++d_new) {
+        const int delta = static_cast<int>(static_cast<std::int64_t>(T.delta) * d_new % N);
+        T.solve(modulo(-delta, N), [&](int s_new) {
+            const int u = T.element(d_new, s_new);
+            double *z = slab + 2 * (static_cast<std::size_t>(s_new) * mine + (d_new - L.first[me]));
+            z[0] = old_line0_[2 * u];
+            z[1] = old_line0_[2 * u + 1];
+        });
+    }
+    state[0] = static_cast<double>(to_index);
+}
+
+}  // namespace mpi
+}  // namespace lpi

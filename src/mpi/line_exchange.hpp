@@ -1,0 +1,80 @@
+// How sine-Euler's field is spread over P processes, and how it moves from
+// one direction's lines to the next's.
+//
+// Layout of direction D (a piece, src/models/sine_euler/projective_line.hpp):
+// the lines d = 1 .. M of D (M = (N-1)/2) are cut into P contiguous runs, one
+// per process; process r holds the N modes d j + s k of each of its lines,
+// element s of its line i at complex entry s * count + i (the layout of a
+// transform block, so a block of lines is gathered by rows). Lines -d are the
+// conjugates of lines d and are not held. Every process also holds the whole
+// line through the origin {s k} (N modes): the flow of D leaves it fixed and
+// needs all of it for its line spectrum.
+//
+// The working state of a process (doubles): [0] the index of the direction
+// whose layout it holds, then line 0 (N complex, element s = mode s k), then
+// its lines (count * N complex). The index travels with the state, so a copy
+// (the rollback of a failed step, an observed step's copy) keeps its meaning.
+//
+// The exchange. Moving from direction D to D' is a linear bijection of
+// Z_N^2: mode p = d' j' + s' k' lies on line v = sigma (p x k) of D at element
+// u = sigma (j x p), both linear in (d', s'). Each mode of D' goes from the
+// process that holds its line v (or -v, conjugated) to the one that holds
+// its line d'; modes on line 0 of D are at hand everywhere. One MPI_Alltoallv
+// carries all of them, and each process also sends every other the modes of
+// the new line 0 that it holds (O(N) in all): one collective per flow. Both
+// sides enumerate the modes from process r to process q in one order (by d'
+// in q's lines, then d in r's lines, then v = d, -d, then s' solving
+// gamma s' = v - delta(d') mod N), so nothing but values is sent, and the
+// work is O(N^2 / P) per process.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "../models/sine_euler/projective_line.hpp"
+#include "communicator.hpp"
+
+namespace lpi {
+namespace mpi {
+
+struct LineOwnership {
+    LineOwnership(int N, int processes);
+    int N, M, P;
+    std::vector<int> first;  // process r holds lines first[r] .. first[r+1]-1
+    std::vector<int> owner;  // owner[d] for d = 1 .. M
+    int count(int r) const { return first[r + 1] - first[r]; }
+};
+
+// Sizes of a process's working state.
+inline std::size_t line0_entry() { return 1; }  // doubles before line 0
+inline std::size_t slab_entry(int N) { return 1 + 2 * static_cast<std::size_t>(N); }
+inline std::size_t local_state_size(int N, int count) {
+    return slab_entry(N) + 2 * static_cast<std::size_t>(N) * count;
+}
+
+// The mode (a, b) of element s of line d of a direction.
+inline void line_mode(const sine_euler::Direction &D, int N, int d, int s, int &a, int &b) {
+    a = static_cast<int>((static_cast<std::int64_t>(d) * D.j1 + static_cast<std::int64_t>(s) * D.k1) % N);
+    b = static_cast<int>((static_cast<std::int64_t>(d) * D.j2 + static_cast<std::int64_t>(s) * D.k2) % N);
+}
+
+// Moves a process's working state from one direction's layout to another's,
+// with buffers kept between flows.
+class LineExchange {
+public:
+    LineExchange(const Communicator &comm, const LineOwnership &lines) : comm_(comm), lines_(lines) {}
+    // state holds the layout of `from`; afterwards that of `to`.
+    void move(const sine_euler::Direction &from, std::size_t from_index,
+              const sine_euler::Direction &to, std::size_t to_index, double *state);
+
+private:
+    const Communicator &comm_;
+    const LineOwnership &lines_;
+    std::vector<double> send_, receive_, old_line0_;
+    std::vector<std::uint64_t> targets_;  // complex entry of the state for each value received
+    std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
+};
+
+}  // namespace mpi
+}  // namespace lpi

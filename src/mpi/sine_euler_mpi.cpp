@@ -1,0 +1,454 @@
+// The distributed sine-Euler model. A flow of direction D moves the working
+// state to D's layout (one exchange, line_exchange.hpp), computes the line
+// spectrum from line 0, which every process holds, and integrates the lines
+// held here block by block exactly as the model of one process does: gather,
+// forward transform, phase (apply_phase), backward transform, and the
+// increment added to the modes. While stepping a process holds its lines,
+// line 0 and O(N) tables; the whole field is gathered only on request
+// (getters, Casimirs, checkpoints).
+#include "sine_euler_mpi.hpp"
+
+#include <fftw3.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "../core/error.hpp"
+#include "../core/integrator.hpp"
+#include "../models/sine_euler.hpp"
+#include "../models/sine_euler/coordinates.hpp"
+#include "../models/sine_euler/indexing.hpp"
+#include "../models/sine_euler/kernels.hpp"
+#include "../models/sine_euler/transforms.hpp"
+#include "communicator.hpp"
+#include "line_exchange.hpp"
+#include "lpi_config.h"
+
+#if LPI_HAVE_OPENMP
+#include <omp.h>
+#endif
+
+namespace lpi {
+
+namespace {
+
+using namespace sine_euler;
+using mpi::Communicator;
+using mpi::LineExchange;
+using mpi::LineOwnership;
+
+int this_thread() {
+#if LPI_HAVE_OPENMP
+    return omp_get_thread_num();
+#else
+    return 0;
+#endif
+}
+
+fftw_complex *complex_of(double *x) { return reinterpret_cast<fftw_complex *>(x); }
+
+// FFTW plans and buffers of this process's lines: the line spectrum, and
+// blocks of kBlock lines (or the remainder of this process's count), as in
+// LineTransforms. The spectrum is planned FFTW_ESTIMATE, the same plan on
+// every process, so that every process computes the same phases.
+class LocalTransforms {
+public:
+    LocalTransforms(int N, int lines) : N_(N) {
+        try {
+            spectrum_ = reinterpret_cast<double *>(fftw_alloc_complex(N));
+            up_ = static_cast<double *>(fftw_malloc(sizeof(double) * 6 * N));
+            down_ = static_cast<double *>(fftw_malloc(sizeof(double) * 6 * N));
+            if (!spectrum_ || !up_ || !down_) throw std::bad_alloc();
+            reserve_threads(1);
+            std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+            fftw_complex *b = complex_of(spectrum_), *x = complex_of(blocks_[0]);
+            spectrum_plan_ = fftw_plan_dft_1d(N, b, b, FFTW_FORWARD, FFTW_ESTIMATE);
+            const int sizes[2] = {lines >= kBlock ? kBlock : 0, lines % kBlock};
+            for (int i = 0; i < 2; ++i) {
+                if (sizes[i] == 0) continue;
+                forward_[i] = fftw_plan_many_dft(1, &N, sizes[i], x, nullptr, sizes[i], 1, x, nullptr,
+                                                 sizes[i], 1, FFTW_FORWARD, FFTW_MEASURE);
+                backward_[i] = fftw_plan_many_dft(1, &N, sizes[i], x, nullptr, sizes[i], 1, x, nullptr,
+                                                  sizes[i], 1, FFTW_BACKWARD, FFTW_MEASURE);
+                if (!forward_[i] || !backward_[i])
+                    fail(LPI_ERR_INTERNAL, "FFTW could not create a plan for N = " + std::to_string(N));
+            }
+            if (!spectrum_plan_) fail(LPI_ERR_INTERNAL, "FFTW could not create a plan for N = " + std::to_string(N));
+        } catch (...) {
+            release();
+            throw;
+        }
+    }
+    ~LocalTransforms() { release(); }
+    LocalTransforms(const LocalTransforms &) = delete;
+    LocalTransforms &operator=(const LocalTransforms &) = delete;
+
+    void reserve_threads(std::size_t threads) {
+        while (blocks_.size() < threads) {
+            fftw_complex *x = fftw_alloc_complex(static_cast<std::size_t>(N_) * kBlock);
+            if (!x) throw std::bad_alloc();
+            blocks_.push_back(reinterpret_cast<double *>(x));
+        }
+    }
+    double *spectrum() { return spectrum_; }
+    double *up() { return up_; }
+    double *down() { return down_; }
+    double *block(std::size_t thread) { return blocks_[thread]; }
+    void transform_spectrum() { fftw_execute_dft(spectrum_plan_, complex_of(spectrum_), complex_of(spectrum_)); }
+    void forward(int lines, double *x) {
+        fftw_execute_dft(forward_[lines == kBlock ? 0 : 1], complex_of(x), complex_of(x));
+    }
+    void backward(int lines, double *x) {
+        fftw_execute_dft(backward_[lines == kBlock ? 0 : 1], complex_of(x), complex_of(x));
+    }
+
+private:
+    void release() {
+        std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+        for (fftw_plan p : {spectrum_plan_, forward_[0], forward_[1], backward_[0], backward_[1]})
+            if (p) fftw_destroy_plan(p);
+        spectrum_plan_ = forward_[0] = forward_[1] = backward_[0] = backward_[1] = nullptr;
+        fftw_free(spectrum_);
+        fftw_free(up_);
+        fftw_free(down_);
+        for (double *x : blocks_) fftw_free(x);
+        spectrum_ = up_ = down_ = nullptr;
+        blocks_.clear();
+    }
+    int N_;
+    fftw_plan spectrum_plan_ = nullptr, forward_[2] = {nullptr, nullptr}, backward_[2] = {nullptr, nullptr};
+    double *spectrum_ = nullptr, *up_ = nullptr, *down_ = nullptr;
+    std::vector<double *> blocks_;
+};
+
+// FNV-1a of the bytes of n doubles: the processes compare their inputs.
+long long fingerprint(const double *x, std::size_t n) {
+    std::uint64_t h = 1469598103934665603ull;
+    const auto *bytes = reinterpret_cast<const unsigned char *>(x);
+    for (std::size_t i = 0; i < n * sizeof(double); ++i) h = (h ^ bytes[i]) * 1099511628211ull;
+    return static_cast<long long>(h);
+}
+
+class SineEulerMpi final : public SineEulerModel {
+public:
+    SineEulerMpi(int N, std::shared_ptr<const Communicator> comm)
+        : N_(N), eps_(2.0 * std::acos(-1.0) / N), comm_(std::move(comm)),
+          lines_(N, comm_->size()), mine_(lines_.count(comm_->rank())),
+          first_(lines_.first[comm_->rank()]), dirs_(projective_line(N)), exchange_(*comm_, lines_) {}
+
+    const char *kind() const override { return "sine-euler"; }
+    int truncation() const override { return N_; }
+    std::size_t dim() const override { return static_cast<std::size_t>(N_) * N_; }
+    std::size_t state_size() const override { return mpi::local_state_size(N_, mine_); }
+
+    std::vector<std::string> split_names() const override { return split_.names(); }
+    void set_split(const std::string &name) override { split_.select(name, kind()); }
+    std::string split() const override { return split_.current(); }
+    std::size_t piece_count() const override { return dirs_.size(); }
+    std::vector<double> checkpoint_parameters() const override { return {double(N_)}; }
+
+    void set_threads(int n) override {
+        if (n < 1) fail(LPI_ERR_INVALID, "thread count must be >= 1, got " + std::to_string(n));
+#if !LPI_HAVE_OPENMP
+        if (n > 1) fail(LPI_ERR_UNSUPPORTED, "threads need OpenMP; this build has none (one thread only)");
+#endif
+        threads_ = n;
+    }
+
+    // ---- spread over processes ------------------------------------------
+    bool distributed() const override { return true; }
+    bool finite(const double *state) const override {
+        return comm_->all(all_finite(state, state_size()));
+    }
+    std::vector<double> whole_state(const double *state) const override;
+    void on_one_process(const std::function<void()> &action) const override { comm_->on_root(action); }
+    std::vector<double> local_state(const double *modes, std::size_t direction) const;
+
+    void to_public(const double *state, double *x) const override {
+        public_from_state(N_, whole_state(state).data(), x);
+    }
+    void from_public(const double *x, double *state) const override {
+        require_same_input(x, dim(), "state");
+        std::vector<double> modes(2 * dim());
+        state_from_public(N_, x, modes.data());
+        const std::vector<double> local = local_state(modes.data(), 0);
+        std::copy(local.begin(), local.end(), state);
+    }
+    void public_from_modes(const double *modes, double *x) const override {
+        require_same_input(modes, 2 * dim(), "modes");
+        sine_euler::public_from_modes(N_, modes, x);
+    }
+    void public_from_grid(const double *grid, double *x) const override {
+        require_same_input(grid, dim(), "grid");
+        sine_euler::public_from_grid(N_, grid, x);
+    }
+    // Computed from the whole field on rank 0 and sent to every process, so
+    // that every process returns the same bits.
+    void grid(const double *state, double *out) const override {
+        const std::vector<double> modes = whole_state(state);
+        comm_->on_root([&] { grid_from_modes(N_, modes.data(), out); });
+        comm_->broadcast(out, dim());
+    }
+    void casimirs(const double *state, double *out) const override {
+        const std::vector<double> modes = whole_state(state);
+        comm_->on_root([&] { sine_euler_spectrum(N_, modes.data(), out); });
+        comm_->broadcast(out, casimir_count());
+    }
+    void casimir_traces(const double *state, int kmax, double *out) const override {
+        const std::vector<double> modes = whole_state(state);
+        comm_->on_root([&] { sine_euler_traces(N_, modes.data(), kmax, out); });
+        comm_->broadcast(out, static_cast<std::size_t>(kmax));
+    }
+    std::size_t casimir_count() const override { return static_cast<std::size_t>(N_); }
+    double energy(const double *state) const override { return 0.5 * sum_over_field(state, true); }
+    double enstrophy(const double *state) const override { return 0.5 * sum_over_field(state, false); }
+    // Only the baselines ask for it, and they are refused for a model spread
+    // over processes (make_integrator).
+    void vector_field(const double *, double *) const override {
+        fail(LPI_ERR_UNSUPPORTED, "the vector field of a sine-Euler system spread over processes");
+    }
+
+    void flow(std::size_t piece, double t, double *state) override;
+    TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) override;
+
+private:
+    LocalTransforms &transforms();
+    bool line_spectrum(const Direction &D, const double *line0);
+    void move_block(const Direction &D, int block, double *x, double *slab);
+    double sum_over_field(const double *state, bool energy) const;
+    void require_same_input(const double *x, std::size_t n, const char *what) const {
+        const std::vector<long long> prints = comm_->allgather(fingerprint(x, n));
+        for (long long p : prints)
+            if (p != prints[0])
+                fail(LPI_ERR_INVALID, std::string("the ") + what +
+                                          " differs between the processes (each must pass the same)");
+    }
+    int blocks() const { return (mine_ + kBlock - 1) / kBlock; }
+
+    int N_;
+    double eps_;
+    std::shared_ptr<const Communicator> comm_;
+    LineOwnership lines_;
+    int mine_, first_;  // this process's lines: first_ .. first_ + mine_ - 1
+    std::vector<Direction> dirs_;
+    LineExchange exchange_;
+    SplitChoice split_{{"directions"}};
+    int threads_ = 1;
+    std::unique_ptr<LocalTransforms> transforms_;  // planned on the first flow
+};
+
+LocalTransforms &SineEulerMpi::transforms() {
+    if (!transforms_) transforms_ = std::make_unique<LocalTransforms>(N_, mine_);
+    transforms_->reserve_threads(static_cast<std::size_t>(threads_));
+    return *transforms_;
+}
+
+std::vector<double> SineEulerMpi::whole_state(const double *state) const {
+    const Direction &D = dirs_[static_cast<std::size_t>(state[0])];
+    const int P = lines_.P;
+    std::vector<int> counts(P), offsets(P);
+    for (int r = 0; r < P; ++r) {
+        counts[r] = lines_.count(r) * N_;
+        offsets[r] = (lines_.first[r] - 1) * N_;
+    }
+    std::vector<double> lines(2 * static_cast<std::size_t>(N_) * lines_.M);
+    comm_->allgatherv(state + mpi::slab_entry(N_), mine_ * N_, lines.data(), counts, offsets);
+    std::vector<double> modes(2 * dim());
+    const double *line0 = state + mpi::line0_entry();
+    for (int s = 0; s < N_; ++s) {
+        int a, b;
+        mpi::line_mode(D, N_, 0, s, a, b);
+        modes[2 * mode_index(a, b, N_)] = line0[2 * s];
+        modes[2 * mode_index(a, b, N_) + 1] = line0[2 * s + 1];
+    }
+    for (int r = 0; r < P; ++r) {
+        const double *slab = lines.data() + 2 * static_cast<std::size_t>(offsets[r]);
+        const int count = lines_.count(r);
+        for (int i = 0; i < count; ++i)
+            for (int s = 0; s < N_; ++s) {
+                int a, b;
+                mpi::line_mode(D, N_, lines_.first[r] + i, s, a, b);
+                const double *z = slab + 2 * (static_cast<std::size_t>(s) * count + i);
+                double *w = modes.data() + 2 * mode_index(a, b, N_);
+                double *m = modes.data() + 2 * mirror_index(a, b, N_);
+                w[0] = z[0], w[1] = z[1];
+                m[0] = z[0], m[1] = -z[1];
+            }
+    }
+    return modes;
+}
+
+std::vector<double> SineEulerMpi::local_state(const double *modes, std::size_t direction) const {
+    const Direction &D = dirs_[direction];
+    std::vector<double> state(state_size());
+    state[0] = static_cast<double>(direction);
+    double *line0 = state.data() + mpi::line0_entry(), *slab = state.data() + mpi::slab_entry(N_);
+    for (int s = 0; s < N_; ++s) {
+        int a, b;
+        mpi::line_mode(D, N_, 0, s, a, b);
+        line0[2 * s] = modes[2 * mode_index(a, b, N_)];
+        line0[2 * s + 1] = modes[2 * mode_index(a, b, N_) + 1];
+        for (int i = 0; i < mine_; ++i) {
+            mpi::line_mode(D, N_, first_ + i, s, a, b);
+            const std::size_t e = static_cast<std::size_t>(s) * mine_ + i;
+            slab[2 * e] = modes[2 * mode_index(a, b, N_)];
+            slab[2 * e + 1] = modes[2 * mode_index(a, b, N_) + 1];
+        }
+    }
+    return state;
+}
+
+// sum |w_m|^2 / |m|^2 (energy) or sum |w_m|^2 (enstrophy) over the field:
+// this process's lines count twice (their conjugates -d are not held), line
+// 0 is counted by rank 0; the partial sums are added in rank order, the same
+// on every process.
+double SineEulerMpi::sum_over_field(const double *state, bool energy) const {
+    const Direction &D = dirs_[static_cast<std::size_t>(state[0])];
+    auto weight = [&](int d, int s) {
+        if (!energy) return 1.0;
+        int a, b;
+        mpi::line_mode(D, N_, d, s, a, b);
+        const double m2 = norm2(a, b, N_);
+        return m2 == 0 ? 0.0 : 1.0 / m2;
+    };
+    double sum = 0.0;
+    const double *slab = state + mpi::slab_entry(N_);
+    for (int s = 0; s < N_; ++s)
+        for (int i = 0; i < mine_; ++i) {
+            const double *z = slab + 2 * (static_cast<std::size_t>(s) * mine_ + i);
+            sum += 2.0 * (z[0] * z[0] + z[1] * z[1]) * weight(first_ + i, s);
+        }
+    if (comm_->rank() == 0) {
+        const double *line0 = state + mpi::line0_entry();
+        for (int s = 0; s < N_; ++s)
+            sum += (line0[2 * s] * line0[2 * s] + line0[2 * s + 1] * line0[2 * s + 1]) * weight(0, s);
+    }
+    double total = 0.0;
+    for (double part : comm_->allgather(sum)) total += part;
+    return total;
+}
+
+// b_s = w_sk / |sk|^2 on the modes D owns, B = FFT(b), as the model of one
+// process computes it. False when every b_s is zero.
+bool SineEulerMpi::line_spectrum(const Direction &D, const double *line0) {
+    double *b = transforms_->spectrum();
+    bool active = false;
+    for (int s = 0; s < N_; ++s) {
+        if (D.owned[s]) {
+            int a, c;
+            mpi::line_mode(D, N_, 0, s, a, c);
+            const double scale = 1.0 / norm2(a, c, N_);
+            b[2 * s] = line0[2 * s] * scale;
+            b[2 * s + 1] = line0[2 * s + 1] * scale;
+            active = active || b[2 * s] != 0.0 || b[2 * s + 1] != 0.0;
+        } else {
+            b[2 * s] = b[2 * s + 1] = 0.0;
+        }
+    }
+    if (!active) return false;
+    transforms_->transform_spectrum();
+    return true;
+}
+
+// Block `block` of this process's lines: gathered from the rows of the slab,
+// transformed, multiplied by the lines' (exp(t Lambda_l) - 1) / N, transformed
+// back and added to the modes.
+void SineEulerMpi::move_block(const Direction &D, int block, double *x, double *slab) {
+    const int i0 = block * kBlock, count = mine_ - i0 < kBlock ? mine_ - i0 : kBlock;
+    const int d0 = first_ + i0;
+    const std::size_t row = 2 * static_cast<std::size_t>(mine_);
+    for (int s = 0; s < N_; ++s)
+        std::memcpy(x + 2 * static_cast<std::size_t>(s) * count, slab + s * row + 2 * i0,
+                    sizeof(double) * 2 * count);
+    transforms_->forward(count, x);
+    const std::size_t phase0 = 2 * (static_cast<std::size_t>(N_) + d0);
+    apply_phase(N_, count, transforms_->up() + phase0, transforms_->down() + phase0, -D.sigma, x);
+    transforms_->backward(count, x);
+    for (int s = 0; s < N_; ++s) {
+        double *z = slab + s * row + 2 * i0;
+        const double *increment = x + 2 * static_cast<std::size_t>(s) * count;
+        for (int i = 0; i < 2 * count; ++i) z[i] = z[i] + increment[i];
+    }
+}
+
+void SineEulerMpi::flow(std::size_t piece, double t, double *state) {
+    transforms();
+    const std::size_t held = static_cast<std::size_t>(state[0]);
+    const Direction &D = dirs_[piece];
+    exchange_.move(dirs_[held], held, D, piece, state);
+    if (!line_spectrum(D, state + mpi::line0_entry())) return;
+    const double factor = t / (2.0 * eps_);
+    double *slab = state + mpi::slab_entry(N_);
+    const int count = blocks();
+#if LPI_HAVE_OPENMP
+#pragma omp parallel num_threads(threads_) if (threads_ > 1 && count > 1)
+#endif
+    {
+#if LPI_HAVE_OPENMP
+#pragma omp for schedule(static)
+#endif
+        for (int l = 0; l < N_; ++l)
+            write_phase(N_, l, factor, transforms_->spectrum(), transforms_->up(), transforms_->down());
+#if LPI_HAVE_OPENMP
+#pragma omp for schedule(static)
+#endif
+        for (int blk = 0; blk < count; ++blk) move_block(D, blk, transforms_->block(this_thread()), slab);
+    }
+}
+
+// The transforms of this process's lines alone; the slowest process's time.
+TransformTiming SineEulerMpi::time_transforms(std::size_t flows_per_step, std::int64_t steps) {
+    if (steps < 1) fail(LPI_ERR_INVALID, "nsteps must be >= 1, got " + std::to_string(steps));
+    if (flows_per_step == 0 || static_cast<std::uint64_t>(steps) > SIZE_MAX / flows_per_step)
+        fail(LPI_ERR_OVERFLOW, "nsteps = " + std::to_string(steps) + " times " +
+                                   std::to_string(flows_per_step) + " flows per step overflows the flow count");
+    LocalTransforms &T = transforms();
+    const int count = blocks();
+    std::memset(T.spectrum(), 0, sizeof(double) * 2 * N_);
+    for (int i = 0; i < threads_; ++i) std::memset(T.block(i), 0, sizeof(double) * 2 * N_ * kBlock);
+    const std::size_t flows = flows_per_step * static_cast<std::size_t>(steps);
+    const auto start = std::chrono::steady_clock::now();
+    for (std::size_t f = 0; f < flows; ++f) {
+        T.transform_spectrum();
+#if LPI_HAVE_OPENMP
+#pragma omp parallel for num_threads(threads_) schedule(static) if (threads_ > 1 && count > 1)
+#endif
+        for (int blk = 0; blk < count; ++blk) {
+            const int lines = mine_ - blk * kBlock < kBlock ? mine_ - blk * kBlock : kBlock;
+            double *x = T.block(this_thread());
+            T.forward(lines, x);
+            T.backward(lines, x);
+        }
+    }
+    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+    const double per_step = static_cast<double>(steps);
+    return {comm_->max(elapsed.count()) / per_step,
+            static_cast<double>(flows) * (1.0 + 2.0 * lines_.M) / per_step};
+}
+
+}  // namespace
+
+std::unique_ptr<Model> make_sine_euler_mpi(int N, MPI_Comm comm) {
+    auto communicator = std::make_shared<const Communicator>(comm);
+    const std::vector<long long> orders = communicator->allgather(static_cast<long long>(N));
+    for (long long n : orders)
+        if (n != N)
+            fail(LPI_ERR_INVALID, "the processes passed different N (" + std::to_string(orders[0]) +
+                                      " on rank 0, " + std::to_string(n) + " elsewhere)");
+    if (N < 3 || N % 2 == 0)
+        fail(LPI_ERR_INVALID, "N must be odd and >= 3 (Zeitlin's su(N) truncation), got " +
+                                  std::to_string(N));
+    std::unique_ptr<Model> model;
+    communicator->agree([&] { model = std::make_unique<SineEulerMpi>(N, communicator); });
+    return model;
+}
+
+std::vector<double> local_state_of_modes(const Model &model, const double *modes) {
+    return static_cast<const SineEulerMpi &>(model).local_state(modes, 0);
+}
+
+}  // namespace lpi

@@ -1,0 +1,218 @@
+/* Sine-Euler spread over MPI processes (liepoisson_mpi.h), run by ctest under
+ * mpirun with 1 to 4 processes: the distributed handle follows the library's
+ * one-process model to 1e-12 (a 4th-order method, 40 steps, N prime and
+ * composite), its outputs are the same on every process, checkpoints are one
+ * file that both load, and bad input gets the same status on every process
+ * with the state unchanged. */
+#include <liepoisson_mpi.h>
+
+#include "lpi_test.h"
+
+static int rank_, size_;
+
+/* The same random field on every process (public coordinates, N^2). */
+static void random_field(double *x, size_t n, unsigned seed) {
+    uint64_t s = 0x9E3779B97F4A7C15ull ^ seed;
+    for (size_t i = 0; i < n; ++i) {
+        s ^= s << 13, s ^= s >> 7, s ^= s << 17;
+        x[i] = ((double)(s >> 11) / 9007199254740992.0 - 0.5);
+    }
+}
+
+static double max_abs(const double *x, size_t n) {
+    double m = 0.0;
+    for (size_t i = 0; i < n; ++i) m = fmax(m, fabs(x[i]));
+    return m;
+}
+
+static double max_diff(const double *a, const double *b, size_t n) {
+    double m = 0.0;
+    for (size_t i = 0; i < n; ++i) m = fmax(m, fabs(a[i] - b[i]));
+    return m;
+}
+
+/* Every process holds the same bytes. */
+static void assert_same_on_every_process(const double *x, size_t n) {
+    double *root = malloc(n * sizeof *root);
+    assert_non_null(root);
+    memcpy(root, x, n * sizeof *root);
+    MPI_Bcast(root, (int)n, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    assert_memory_equal(root, x, n * sizeof *root);
+    free(root);
+}
+
+/* A spread handle and a one-process handle with the same field and method. */
+static void make_pair(int N, const char *method, lpi_system **spread, lpi_system **single, double *x) {
+    const size_t n = (size_t)N * N;
+    random_field(x, n, (unsigned)N);
+    assert_int_equal(lpi_sine_euler_create_mpi(spread, N, MPI_COMM_WORLD), LPI_OK);
+    assert_int_equal(lpi_sine_euler_create(single, N), LPI_OK);
+    assert_int_equal(lpi_set_state(*spread, x, n), LPI_OK);
+    assert_int_equal(lpi_set_state(*single, x, n), LPI_OK);
+    assert_int_equal(lpi_set_method(*spread, method), LPI_OK);
+    assert_int_equal(lpi_set_method(*single, method), LPI_OK);
+}
+
+static void test_matches_one_process(void **state) {
+    (void)state;
+    static const int orders[] = {13, 15, 25, 31};
+    for (size_t k = 0; k < sizeof orders / sizeof orders[0]; ++k) {
+        const int N = orders[k];
+        const size_t n = (size_t)N * N;
+        double *x0 = malloc(n * sizeof *x0), *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+        assert_true(x0 && a && b);
+        lpi_system *spread, *single;
+        make_pair(N, "suzuki-4", &spread, &single, x0);
+        /* The state read back before stepping is the one set. */
+        assert_int_equal(lpi_get_state(spread, a, n), LPI_OK);
+        assert_memory_equal(a, x0, n * sizeof *a);
+        assert_int_equal(lpi_step(spread, 0.05, 40), LPI_OK);
+        assert_int_equal(lpi_step(single, 0.05, 40), LPI_OK);
+        assert_int_equal(lpi_get_state(spread, a, n), LPI_OK);
+        assert_int_equal(lpi_get_state(single, b, n), LPI_OK);
+        const double scale = max_abs(b, n);
+        const double gap = max_diff(a, b, n);
+        if (rank_ == 0) printf("N = %d, P = %d: max |spread - one process| / max |w| = %.2e\n", N, size_, gap / scale);
+        assert_true(gap <= 1e-12 * scale);
+        assert_true(max_diff(a, x0, n) > 1e-3 * scale); /* the field moved */
+        assert_same_on_every_process(a, n);
+
+        double h1, h2, z1, z2, t1[3], t2[3];
+        assert_int_equal(lpi_energy(spread, &h1), LPI_OK);
+        assert_int_equal(lpi_energy(single, &h2), LPI_OK);
+        assert_true(fabs(h1 - h2) <= 1e-12 * fabs(h2));
+        assert_same_on_every_process(&h1, 1);
+        assert_int_equal(lpi_sine_euler_enstrophy(spread, &z1), LPI_OK);
+        assert_int_equal(lpi_sine_euler_enstrophy(single, &z2), LPI_OK);
+        assert_true(fabs(z1 - z2) <= 1e-12 * fabs(z2));
+        assert_int_equal(lpi_sine_euler_casimir_traces(spread, 3, t1), LPI_OK);
+        assert_int_equal(lpi_sine_euler_casimir_traces(single, 3, t2), LPI_OK);
+        for (int i = 0; i < 3; ++i) assert_true(fabs(t1[i] - t2[i]) <= 1e-12 * (fabs(t2[i]) + 1e-300));
+        assert_same_on_every_process(t1, 3);
+
+        /* Modes and grid: the whole field on every process. */
+        double *m1 = malloc(2 * n * sizeof *m1), *m2 = malloc(2 * n * sizeof *m2);
+        assert_true(m1 && m2);
+        assert_int_equal(lpi_sine_euler_get_modes(spread, m1, 2 * n), LPI_OK);
+        assert_int_equal(lpi_sine_euler_get_modes(single, m2, 2 * n), LPI_OK);
+        assert_true(max_diff(m1, m2, 2 * n) <= 1e-12 * max_abs(m2, 2 * n));
+        assert_int_equal(lpi_sine_euler_get_grid(spread, m1, n), LPI_OK);
+        assert_int_equal(lpi_sine_euler_get_grid(single, m2, n), LPI_OK);
+        assert_true(max_diff(m1, m2, n) <= 1e-11 * max_abs(m2, n));
+        assert_same_on_every_process(m1, n);
+        free(m1), free(m2);
+        lpi_destroy(spread), lpi_destroy(single);
+        free(x0), free(a), free(b);
+    }
+}
+
+/* Threads per process change no bit (one handle, so one set of FFTW plans). */
+static void test_threads_per_process(void **state) {
+    (void)state;
+    const int N = 67; /* M = 33: three blocks of lines on one process */
+    const size_t n = (size_t)N * N;
+    double *x = malloc(n * sizeof *x), *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+    assert_true(x && a && b);
+    lpi_system *sys;
+    random_field(x, n, 7);
+    assert_int_equal(lpi_sine_euler_create_mpi(&sys, N, MPI_COMM_WORLD), LPI_OK);
+    assert_int_equal(lpi_set_state(sys, x, n), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.03, 5), LPI_OK);
+    assert_int_equal(lpi_get_state(sys, a, n), LPI_OK);
+    const int threads = lpi_set_threads(sys, 2);
+    if (threads == LPI_ERR_UNSUPPORTED) {
+        lpi_destroy(sys), free(x), free(a), free(b);
+        LPI_SKIP("this build has no OpenMP");
+    }
+    assert_int_equal(threads, LPI_OK);
+    assert_int_equal(lpi_set_state(sys, x, n), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.03, 5), LPI_OK);
+    assert_int_equal(lpi_get_state(sys, b, n), LPI_OK);
+    assert_memory_equal(a, b, n * sizeof *a);
+    lpi_destroy(sys), free(x), free(a), free(b);
+}
+
+/* One file, written by rank 0: the one-process library loads it to the same
+ * state, and lpi_load_mpi continues the trajectory to the bit. */
+static void test_checkpoint(void **state) {
+    (void)state;
+    const int N = 15;
+    const size_t n = (size_t)N * N;
+    double x[225], a[225], b[225];
+    char path[64];
+    snprintf(path, sizeof path, "test_sine_euler_mpi_%d.lpi", size_);
+    lpi_system *spread, *single, *loaded, *reloaded;
+    make_pair(N, "mclachlan-4", &spread, &single, x);
+    assert_int_equal(lpi_step(spread, 0.05, 10), LPI_OK);
+    assert_int_equal(lpi_save(spread, path), LPI_OK);
+    assert_int_equal(lpi_load(&loaded, path), LPI_OK);
+    assert_int_equal(lpi_get_state(spread, a, n), LPI_OK);
+    assert_int_equal(lpi_get_state(loaded, b, n), LPI_OK);
+    assert_memory_equal(a, b, sizeof a);
+    assert_string_equal(lpi_get_method(loaded), "mclachlan-4");
+    assert_int_equal(lpi_load_mpi(&reloaded, path, MPI_COMM_WORLD), LPI_OK);
+    assert_true(lpi_time(reloaded) == lpi_time(spread));
+    assert_int_equal(lpi_step(spread, 0.05, 10), LPI_OK);
+    assert_int_equal(lpi_step(reloaded, 0.05, 10), LPI_OK);
+    assert_int_equal(lpi_get_state(spread, a, n), LPI_OK);
+    assert_int_equal(lpi_get_state(reloaded, b, n), LPI_OK);
+    assert_memory_equal(a, b, sizeof a);
+    /* A file that is not there: LPI_ERR_IO on every process. */
+    lpi_system *none = NULL;
+    assert_int_equal(lpi_load_mpi(&none, "no/such/file.lpi", MPI_COMM_WORLD), LPI_ERR_IO);
+    assert_null(none);
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (rank_ == 0) remove(path);
+    lpi_destroy(spread), lpi_destroy(single), lpi_destroy(loaded), lpi_destroy(reloaded);
+}
+
+/* Bad input: the same status on every process, the state unchanged. */
+static void test_bad_input(void **state) {
+    (void)state;
+    const int N = 13;
+    const size_t n = (size_t)N * N;
+    double x[169], y[169];
+    lpi_system *spread, *single, *none = NULL;
+    make_pair(N, "leapfrog", &spread, &single, x);
+    LPI_ASSERT_FAILS(spread, lpi_set_method(spread, "rk4"), LPI_ERR_UNSUPPORTED, "lpi_set_method");
+    LPI_ASSERT_FAILS(spread, lpi_set_method(spread, "rk4-matrix"), LPI_ERR_UNSUPPORTED,
+                     "lpi_set_method");
+    /* A field that differs between the processes. */
+    memcpy(y, x, sizeof y);
+    y[5] += rank_;
+    if (size_ > 1)
+        LPI_ASSERT_FAILS(spread, lpi_set_state(spread, y, n), LPI_ERR_INVALID, "lpi_set_state");
+    y[5] = NAN;
+    LPI_ASSERT_FAILS(spread, lpi_set_state(spread, y, n), LPI_ERR_NONFINITE, "lpi_set_state");
+    LPI_ASSERT_FAILS(spread, lpi_set_state(spread, y, n - 1), LPI_ERR_SIZE, "lpi_set_state");
+    /* A field so large that the first flow overflows on every process. */
+    for (size_t i = 0; i < n; ++i) y[i] = 1e308;
+    assert_int_equal(lpi_set_state(spread, y, n), LPI_OK);
+    LPI_ASSERT_FAILS(spread, lpi_step(spread, 1.0, 3), LPI_ERR_NONFINITE, "lpi_step");
+    /* Creation. */
+    assert_int_equal(lpi_sine_euler_create_mpi(&none, 14, MPI_COMM_WORLD), LPI_ERR_INVALID);
+    assert_null(none);
+    assert_int_equal(lpi_sine_euler_create_mpi(&none, 13, MPI_COMM_NULL), LPI_ERR_INVALID);
+    if (size_ > 1) {
+        assert_int_equal(lpi_sine_euler_create_mpi(&none, rank_ == 0 ? 13 : 15, MPI_COMM_WORLD),
+                         LPI_ERR_INVALID);
+        assert_null(none);
+    }
+    assert_int_equal(lpi_sine_euler_create_mpi(NULL, 13, MPI_COMM_WORLD), LPI_ERR_NULL);
+    lpi_destroy(spread), lpi_destroy(single);
+}
+
+int main(void) {
+    MPI_Init(NULL, NULL);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &size_);
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_matches_one_process),
+        cmocka_unit_test(test_threads_per_process),
+        cmocka_unit_test(test_checkpoint),
+        cmocka_unit_test(test_bad_input),
+    };
+    const int status = lpi_run_tests(tests);
+    MPI_Finalize();
+    return status;
+}
