@@ -8,12 +8,9 @@
 // (getters, Casimirs, checkpoints).
 #include "sine_euler_mpi.hpp"
 
-#include <fftw3.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <mutex>
 #include <string>
 #include <vector>
 
@@ -48,82 +45,6 @@ int this_thread() {
     return 0;
 #endif
 }
-
-fftw_complex *complex_of(double *x) { return reinterpret_cast<fftw_complex *>(x); }
-
-// FFTW plans and buffers of this process's lines: the line spectrum, and
-// blocks of kBlock lines (or the remainder of this process's count), as in
-// LineTransforms. The spectrum is planned FFTW_ESTIMATE, the same plan on
-// every process, so that every process computes the same phases.
-class LocalTransforms {
-public:
-    LocalTransforms(int N, int lines) : N_(N) {
-        try {
-            spectrum_ = reinterpret_cast<double *>(fftw_alloc_complex(N));
-            up_ = static_cast<double *>(fftw_malloc(sizeof(double) * 6 * N));
-            down_ = static_cast<double *>(fftw_malloc(sizeof(double) * 6 * N));
-            if (!spectrum_ || !up_ || !down_) throw std::bad_alloc();
-            reserve_threads(1);
-            std::lock_guard<std::mutex> lock(fftw_planner_mutex());
-            fftw_complex *b = complex_of(spectrum_), *x = complex_of(blocks_[0]);
-            spectrum_plan_ = fftw_plan_dft_1d(N, b, b, FFTW_FORWARD, FFTW_ESTIMATE);
-            const int sizes[2] = {lines >= kBlock ? kBlock : 0, lines % kBlock};
-            for (int i = 0; i < 2; ++i) {
-                if (sizes[i] == 0) continue;
-                forward_[i] = fftw_plan_many_dft(1, &N, sizes[i], x, nullptr, sizes[i], 1, x, nullptr,
-                                                 sizes[i], 1, FFTW_FORWARD, FFTW_MEASURE);
-                backward_[i] = fftw_plan_many_dft(1, &N, sizes[i], x, nullptr, sizes[i], 1, x, nullptr,
-                                                  sizes[i], 1, FFTW_BACKWARD, FFTW_MEASURE);
-                if (!forward_[i] || !backward_[i])
-                    fail(LPI_ERR_INTERNAL, "FFTW could not create a plan for N = " + std::to_string(N));
-            }
-            if (!spectrum_plan_) fail(LPI_ERR_INTERNAL, "FFTW could not create a plan for N = " + std::to_string(N));
-        } catch (...) {
-            release();
-            throw;
-        }
-    }
-    ~LocalTransforms() { release(); }
-    LocalTransforms(const LocalTransforms &) = delete;
-    LocalTransforms &operator=(const LocalTransforms &) = delete;
-
-    void reserve_threads(std::size_t threads) {
-        while (blocks_.size() < threads) {
-            fftw_complex *x = fftw_alloc_complex(static_cast<std::size_t>(N_) * kBlock);
-            if (!x) throw std::bad_alloc();
-            blocks_.push_back(reinterpret_cast<double *>(x));
-        }
-    }
-    double *spectrum() { return spectrum_; }
-    double *up() { return up_; }
-    double *down() { return down_; }
-    double *block(std::size_t thread) { return blocks_[thread]; }
-    void transform_spectrum() { fftw_execute_dft(spectrum_plan_, complex_of(spectrum_), complex_of(spectrum_)); }
-    void forward(int lines, double *x) {
-        fftw_execute_dft(forward_[lines == kBlock ? 0 : 1], complex_of(x), complex_of(x));
-    }
-    void backward(int lines, double *x) {
-        fftw_execute_dft(backward_[lines == kBlock ? 0 : 1], complex_of(x), complex_of(x));
-    }
-
-private:
-    void release() {
-        std::lock_guard<std::mutex> lock(fftw_planner_mutex());
-        for (fftw_plan p : {spectrum_plan_, forward_[0], forward_[1], backward_[0], backward_[1]})
-            if (p) fftw_destroy_plan(p);
-        spectrum_plan_ = forward_[0] = forward_[1] = backward_[0] = backward_[1] = nullptr;
-        fftw_free(spectrum_);
-        fftw_free(up_);
-        fftw_free(down_);
-        for (double *x : blocks_) fftw_free(x);
-        spectrum_ = up_ = down_ = nullptr;
-        blocks_.clear();
-    }
-    int N_;
-    fftw_plan spectrum_plan_ = nullptr, forward_[2] = {nullptr, nullptr}, backward_[2] = {nullptr, nullptr};
-    double *spectrum_ = nullptr, *up_ = nullptr, *down_ = nullptr;
-    std::vector<double *> blocks_;
-};
 
 // FNV-1a of the bytes of n doubles: the processes compare their inputs.
 long long fingerprint(const double *x, std::size_t n) {
@@ -215,8 +136,19 @@ public:
     void flow(std::size_t piece, double t, double *state) override;
     TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) override;
 
+    // Measured plans may differ between processes; that changes only the
+    // rounding of each process's own lines (the phases come from the
+    // heuristic's plan on every process).
+    void set_planning(FftPlanning planning) override {
+        auto planned = std::make_unique<LineTransforms>(N_, mine_, planning);
+        planned->reserve_threads(static_cast<std::size_t>(threads_));
+        transforms_ = std::move(planned);
+        planning_ = planning;
+    }
+    FftPlanning planning() const override { return planning_; }
+
 private:
-    LocalTransforms &transforms();
+    LineTransforms &transforms();
     bool line_spectrum(const Direction &D, const double *line0);
     void move_block(const Direction &D, int block, double *x, double *slab);
     double sum_over_field(const double *state, bool energy) const;
@@ -238,11 +170,12 @@ private:
     LineExchange exchange_;
     SplitChoice split_{{"directions"}};
     int threads_ = 1;
-    std::unique_ptr<LocalTransforms> transforms_;  // planned on the first flow
+    FftPlanning planning_ = FftPlanning::Estimate;
+    std::unique_ptr<LineTransforms> transforms_;  // this process's lines, planned on the first flow
 };
 
-LocalTransforms &SineEulerMpi::transforms() {
-    if (!transforms_) transforms_ = std::make_unique<LocalTransforms>(N_, mine_);
+LineTransforms &SineEulerMpi::transforms() {
+    if (!transforms_) transforms_ = std::make_unique<LineTransforms>(N_, mine_, planning_);
     transforms_->reserve_threads(static_cast<std::size_t>(threads_));
     return *transforms_;
 }
@@ -406,7 +339,7 @@ TransformTiming SineEulerMpi::time_transforms(std::size_t flows_per_step, std::i
     if (flows_per_step == 0 || static_cast<std::uint64_t>(steps) > SIZE_MAX / flows_per_step)
         fail(LPI_ERR_OVERFLOW, "nsteps = " + std::to_string(steps) + " times " +
                                    std::to_string(flows_per_step) + " flows per step overflows the flow count");
-    LocalTransforms &T = transforms();
+    LineTransforms &T = transforms();
     const int count = blocks();
     std::memset(T.spectrum(), 0, sizeof(double) * 2 * N_);
     for (int i = 0; i < threads_; ++i) std::memset(T.block(i), 0, sizeof(double) * 2 * N_ * kBlock);

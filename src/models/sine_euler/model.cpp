@@ -147,7 +147,7 @@ public:
     TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) override;
 
     void set_planning(FftPlanning planning) override {
-        auto planned = std::make_unique<LineTransforms>(N_, planning);
+        auto planned = std::make_unique<LineTransforms>(N_, blocks_.M, planning);
         planned->reserve_threads(static_cast<std::size_t>(threads_));
         transforms_ = std::move(planned);
         planning_ = planning;
@@ -171,7 +171,7 @@ private:
 };
 
 LineTransforms &SineEuler::transforms() {
-    if (!transforms_) transforms_ = std::make_unique<LineTransforms>(N_, planning_);
+    if (!transforms_) transforms_ = std::make_unique<LineTransforms>(N_, blocks_.M, planning_);
     transforms_->reserve_threads(static_cast<std::size_t>(threads_));
     return *transforms_;
 }

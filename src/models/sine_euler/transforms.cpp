@@ -59,7 +59,8 @@ struct LineTransforms::Plans {
     fftw_plan backward[2] = {nullptr, nullptr};
 };
 
-LineTransforms::LineTransforms(int N, FftPlanning planning) : N_(N), M_((N - 1) / 2), plans_(new Plans) {
+LineTransforms::LineTransforms(int N, int lines, FftPlanning planning)
+    : N_(N), lines_(lines), plans_(new Plans) {
     try {
         spectrum_ = reinterpret_cast<double *>(fftw_alloc_complex(N));
         up_ = static_cast<double *>(fftw_malloc(sizeof(double) * 6 * N));
@@ -69,8 +70,10 @@ LineTransforms::LineTransforms(int N, FftPlanning planning) : N_(N), M_((N - 1) 
         std::lock_guard<std::mutex> lock(fftw_planner_mutex());
         const unsigned flags = planner_flags(planning);
         fftw_complex *b = complex_of(spectrum_), *x = complex_of(blocks_[0]);
-        plans_->spectrum = fftw_plan_dft_1d(N, b, b, FFTW_FORWARD, flags);
-        const int sizes[2] = {M_ >= kBlock ? kBlock : 0, M_ % kBlock};
+        // The spectrum is one FFT per flow: planned by the heuristic always,
+        // so that processes sharing a field compute the same phases.
+        plans_->spectrum = fftw_plan_dft_1d(N, b, b, FFTW_FORWARD, FFTW_ESTIMATE);
+        const int sizes[2] = {lines_ >= kBlock ? kBlock : 0, lines_ % kBlock};
         for (int i = 0; i < 2; ++i) {
             const int howmany = sizes[i];
             if (howmany == 0) continue;
@@ -86,7 +89,8 @@ LineTransforms::LineTransforms(int N, FftPlanning planning) : N_(N), M_((N - 1) 
         release();
         throw;
     }
-    if (!plans_->spectrum || (M_ >= kBlock && !plans_->forward[0]) || (M_ % kBlock && !plans_->forward[1])) {
+    if (!plans_->spectrum || (lines_ >= kBlock && !plans_->forward[0]) ||
+        (lines_ % kBlock && !plans_->forward[1])) {
         release();
         fail(LPI_ERR_INTERNAL, "FFTW could not create a plan for N = " + std::to_string(N));
     }

@@ -20,8 +20,10 @@ namespace sine_euler {
 
 class LineTransforms {
 public:
-    // Plans at the given rigor and buffers for N, with one block buffer.
-    LineTransforms(int N, FftPlanning planning);
+    // Plans at the given rigor and buffers for `lines` lines of length N (the
+    // (N - 1) / 2 integrated lines of a direction, or one process's share of
+    // them), with one block buffer.
+    LineTransforms(int N, int lines, FftPlanning planning);
     ~LineTransforms();
     LineTransforms(const LineTransforms &) = delete;
     LineTransforms &operator=(const LineTransforms &) = delete;
@@ -43,7 +45,7 @@ public:
 private:
     struct Plans;
     void release();
-    int N_, M_;
+    int N_, lines_;
     std::unique_ptr<Plans> plans_;
     double *spectrum_ = nullptr, *up_ = nullptr, *down_ = nullptr;
     std::vector<double *> blocks_;
