@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "processes.hpp"
 #include "report.hpp"
 #include "run.hpp"
 #include "scenes.hpp"
@@ -115,6 +116,7 @@ int methods_command(int argc, char **argv) {
 }  // namespace
 
 int main(int argc, char **argv) {
+    start_processes(&argc, &argv);
     if (argc < 2) {
         print_usage(stderr);
         return 2;
@@ -127,6 +129,11 @@ int main(int argc, char **argv) {
     if (command == "--version") {
         std::printf("lpi (liepoisson) %s\n", lpi_version_string());
         return 0;
+    }
+    if (process_count() > 1 && command != "run") {
+        std::fprintf(stderr, "lpi %s runs on one process; under mpirun only lpi run spreads its work\n",
+                     command.c_str());
+        return 2;
     }
     if (command == "report") return report_command(argc - 2, argv + 2);
     if (command == "run") return run_command(argc - 2, argv + 2);

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "plots.hpp"
+#include "processes.hpp"
 #include "run_data.hpp"
 #include "run_options.hpp"
 #include "run_watch.hpp"
@@ -135,7 +136,7 @@ int run_command(int argc, char **argv) {
     }
     if (!o.resume.empty()) {
         Handle loaded;
-        if (lpi_load(loaded.out(), o.resume.c_str()) != LPI_OK) {
+        if (load_checkpoint(loaded.out(), o.resume.c_str()) != LPI_OK) {
             std::fprintf(stderr, "lpi run: --resume: %s\n", lpi_last_error(nullptr));
             return 1;
         }
@@ -156,7 +157,7 @@ int run_command(int argc, char **argv) {
         check_option(lpi_fftw_wisdom_import_file(o.wisdom.c_str()), nullptr, "--wisdom");
     if (!o.planning.empty()) {
         check_option(lpi_sine_euler_set_planning(sys, o.planning.c_str()), sys, "--planning");
-        if (!o.wisdom.empty() && o.planning != "estimate")
+        if (!o.wisdom.empty() && o.planning != "estimate" && writes_output())
             check_option(lpi_fftw_wisdom_export_file(o.wisdom.c_str()), nullptr, "--wisdom");
     }
     // The method in use: --method's, else a new system's default or the
@@ -241,7 +242,10 @@ int run_command(int argc, char **argv) {
     }
     if (!o.resume.empty()) keep_snapshots(o, start, data);
 
-    FILE *f = std::fopen(csv.c_str(), "w");
+    // Every process has read what it keeps before rank 0 rewrites the file;
+    // the others write their rows nowhere.
+    synchronize();
+    FILE *f = std::fopen(writes_output() ? csv.c_str() : "/dev/null", "w");
     if (!f) {
         std::fprintf(stderr, "lpi run: cannot write %s: %s\n", csv.c_str(), std::strerror(errno));
         return 1;
@@ -298,6 +302,7 @@ int run_command(int argc, char **argv) {
     };
     SnapshotBytes bytes;
     auto keep_data = [&] {
+        if (!writes_output()) return true;
         const std::string why = write_data(o, data, attributes, bytes);
         if (why.empty()) return true;
         std::fprintf(stderr, "lpi run: the data %s was not written: %s\n", data_path(o).c_str(), why.c_str());
@@ -326,7 +331,7 @@ int run_command(int argc, char **argv) {
     const double t0 = cpu_seconds();
     int64_t done = start;
     bool stopped_between_rows = false;
-    while (done < end && !interrupted_by) {
+    while (done < end && !(interrupted_by = agreed_signal(interrupted_by))) {
         const int64_t next = std::min(end, (done / every + 1) * every);
         if (!o.checkpoint.empty()) {
             std::size_t size = 0;
@@ -359,12 +364,12 @@ int run_command(int argc, char **argv) {
         progress.update(done);
     }
     progress.finish();
-    if (stopped_between_rows && !o.checkpoint.empty()) {
+    if (stopped_between_rows && !o.checkpoint.empty() && writes_output()) {
         Handle at_call_start;
         check(lpi_load_buffer(at_call_start.out(), call_start_checkpoint.data(), call_start_checkpoint.size()),
               nullptr, "checkpoint");
         save_checkpoint(at_call_start.get(), done);
-    } else {
+    } else if (!stopped_between_rows) {
         save(done, true);
     }
     if (std::ferror(f) != 0 || std::fclose(f) != 0) {
@@ -387,7 +392,7 @@ int run_command(int argc, char **argv) {
     std::printf("done: t = %g, %.3f CPU seconds, relative energy error %.3e; wrote %s and %s\n", lpi_time(sys),
                 cpu_seconds() - t0, (H - H0) / std::fabs(H0), csv.c_str(), data_path(o).c_str());
 
-    if (data.vorticity && !data.snapshot_step.empty()) {
+    if (writes_output() && data.vorticity && !data.snapshot_step.empty()) {
         if (!have_gnuplot()) {
             std::printf("gnuplot not found: no vorticity images (the snapshots are in %s)\n",
                         data_path(o).c_str());

@@ -1,5 +1,7 @@
 #include "run_watch.hpp"
 
+#include "processes.hpp"
+
 namespace lpi_cli {
 
 volatile std::sig_atomic_t interrupted_by = 0;
@@ -21,6 +23,8 @@ void catch_interrupts() {
 
 extern "C" int watch_steps(const lpi_system *, int64_t step, double, void *user) {
     Watch *watch = static_cast<Watch *>(user);
+    // Every process observes the same steps: they stop at the same one.
+    interrupted_by = agreed_signal(interrupted_by);
     if (interrupted_by) {
         watch->stopped_at = watch->call_start + step;
         return 1;

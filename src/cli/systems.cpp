@@ -1,6 +1,7 @@
 #include "systems.hpp"
 
 #include "fields.hpp"
+#include "processes.hpp"
 
 namespace lpi_cli {
 
@@ -27,7 +28,7 @@ Handle pendulum(const std::vector<double> &x) {
 
 Handle sine_euler(int N, const std::vector<double> &w) {
     Handle h;
-    check(lpi_sine_euler_create(h.out(), N), nullptr, "create sine-Euler");
+    check(create_sine_euler(h.out(), N), nullptr, "create sine-Euler");
     check(lpi_sine_euler_set_modes(h.get(), w.data(), w.size()), h.get(), "set modes");
     return h;
 }

@@ -1,0 +1,46 @@
+#!/bin/sh
+# lpi run under mpirun: sine-Euler spread over P = 1 .. 3 processes gives the
+# one-process run's rows (to 1e-12 relative: energies are summed in another
+# order), the output is written once (one CSV, each row once, one data file),
+# a run resumed under mpirun from its checkpoint ends bit for bit where the
+# uninterrupted run under mpirun ends, the checkpoint loads in a one-process
+# lpi too, and the commands that do not spread refuse to run under mpirun.
+#   check_lpi_run_mpi.sh LPI MPIEXEC OUT
+set -eu
+lpi="$1"; mpiexec="$2"; out="$3"
+rm -rf "$out"; mkdir -p "$out"
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_mpi_yield_when_idle=1
+run="run sine-euler --N 15 --dt 0.05 --every 10 --method suzuki-4 --format npy --snapshots 0"
+"$lpi" $run --steps 40 --out "$out/serial" >/dev/null
+close() {  # close A B: the CSVs have the same rows, numbers to 1e-12 relative
+    awk -F, 'NR == FNR { a[FNR] = $0; n = FNR; next }
+             { if (FNR > n) { print "extra row " FNR; bad = 1; exit }
+               split(a[FNR], x, ",")
+               if (FNR == 1) { if (a[FNR] != $0) { print "headers differ"; bad = 1 }; next }
+               for (i = 1; i <= NF; ++i) {
+                   if (i == 4) continue   # the energy error: a difference of nearby energies
+                   d = x[i] - $i; if (d < 0) d = -d; s = x[i] < 0 ? -x[i] : x[i]
+                   if (d > 1e-12 * (s > 1 ? s : 1)) { print "row " FNR " field " i ": " x[i] " vs " $i; bad = 1 }
+               } m = FNR }
+             END { if (!bad && m != n) { print "rows: " m " vs " n; bad = 1 }; exit bad }' "$1" "$2"
+}
+for p in 1 2 3; do
+    "$mpiexec" -n $p --oversubscribe "$lpi" $run --steps 40 --out "$out/p$p" >"$out/p$p.out"
+    close "$out/serial/sine-euler.csv" "$out/p$p/sine-euler.csv" ||
+        { echo "P = $p: the rows differ from the one-process run"; exit 1; }
+    [ "$(grep -c '^done:' "$out/p$p.out")" -eq 1 ] || { echo "P = $p: printed $(grep -c '^done:' "$out/p$p.out") times"; exit 1; }
+    [ -f "$out/p$p/sine-euler/energy.npy" ] || { echo "P = $p: no data written"; exit 1; }
+done
+# Checkpoint at step 20, resume to 40, under 3 processes: the same bits.
+"$mpiexec" -n 3 --oversubscribe "$lpi" $run --steps 40 --out "$out/whole" >/dev/null
+"$mpiexec" -n 3 --oversubscribe "$lpi" $run --steps 20 --out "$out/parts" --checkpoint "$out/c.lpi" >/dev/null
+"$mpiexec" -n 3 --oversubscribe "$lpi" $run --steps 40 --out "$out/parts" --resume "$out/c.lpi" >/dev/null
+cmp -s "$out/whole/sine-euler.csv" "$out/parts/sine-euler.csv" ||
+    { echo "resumed under mpirun: the CSV differs"; exit 1; }
+# The one file loads in a one-process lpi, which continues it to round-off.
+"$lpi" $run --steps 40 --out "$out/parts" --resume "$out/c.lpi" >/dev/null
+close "$out/whole/sine-euler.csv" "$out/parts/sine-euler.csv" ||
+    { echo "an MPI checkpoint resumed by one process differs"; exit 1; }
+rc=0; "$mpiexec" -n 2 --oversubscribe "$lpi" methods >/dev/null 2>&1 || rc=$?
+[ "$rc" -ne 0 ] || { echo "lpi methods under mpirun -n 2 did not refuse"; exit 1; }
+echo "lpi run under mpirun: P = 1..3 agree with one process, output once, resume bit for bit"
