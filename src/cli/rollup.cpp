@@ -137,8 +137,15 @@ int run_rollup(const OwnRun &run) {
         "plot '%s.csv' using 1:4 every ::1 with lines lc rgb '#0072b2' title 'sine-Euler N = %d', "
         "%g with lines dt 2 lc rgb '#999999' title 'equipartition'\n"
         "set title 'enstrophy spectrum' noenhanced\nset xlabel 'shell k'\nset ylabel 'Z(k)'\n"
-        "set logscale xy\nset format y '10^{%%L}'\nset key bottom left\nplot ",
+        "set logscale x\nset key bottom left\n",
         base.c_str(), N, high_fraction(modes_per_shell));
+    // The y axis spans the spectra after the start: the smooth initial one
+    // falls to 1e-90 and is drawn only where it is within that range.
+    Range range;
+    for (std::size_t i = 1; i < kept.size(); ++i)
+        for (double z : kept[i].enstrophy) range.add(z);
+    for (double z : kept[0].enstrophy) range.add(std::max(z, range.lo));
+    commands += decade_axis("y", range.lo, range.hi) + "plot ";
     for (std::size_t i = 0; i < kept.size(); ++i)
         commands += format("%s'%s_spectra.csv' using 1:($%zu > 0 ? $%zu : 1/0) with linespoints lc %s "
                            "pt 7 ps 0.5 title 't = %g'",
