@@ -185,7 +185,6 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         s.unavailable = sine_euler_unavailable;
         s.in_default_report = false;
         s.run_own = run_rollup;
-        s.custom_run = [](const std::string &out_dir) { run_rollup({0, 0, 0.0, out_dir}); };
         scenes.push_back(s);
     }
     {
