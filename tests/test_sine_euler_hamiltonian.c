@@ -1,10 +1,11 @@
 /* The sine-bracket family: sine-Euler with any Hamiltonian
  * H = 1/2 sum lambda_n |w_n|^2 + sum conj(f_n) w_n, against an independent
- * matrix-form integration written from the definitions (J_m built entry
- * by entry, P = sum psi_n J_n with psi = lambda w + f, classical RK4 with tiny
- * steps; sine_euler_hamiltonian_reference.h): SQG and Euler over a topography, prime and composite N, measured
- * orders, every method, the Casimirs, steady single-line fields, the default
- * to the bit, checkpoints, the diagnostics and the API contract. */
+ * matrix-form integration written from the definitions
+ * (sine_euler_hamiltonian_reference.h: J_m built entry by entry,
+ * P = sum psi_n J_n with psi = lambda w + f, classical RK4 with tiny steps):
+ * SQG and Euler over a topography, prime and composite N, measured orders,
+ * every method, the Casimirs, steady single-line fields, the default to the
+ * bit, checkpoints, the diagnostics and the API contract. */
 #include "lpi_test.h"
 #include "sine_euler_hamiltonian_reference.h"
 
