@@ -281,7 +281,7 @@ LPI_API int lpi_moments_add_product_piece(lpi_system *sys, lpi_scalar_fn h, lpi_
  * round-off. See lpi_sine_euler_create(3). */
 
 /* Built without FFTW3: LPI_ERR_UNSUPPORTED. N even or < 3: LPI_ERR_INVALID.
- * A system needing more bytes (about 34 N^2) than the machine's physical
+ * A system needing more bytes (about 42 N^2) than the machine's physical
  * memory: LPI_ERR_NO_MEMORY, before anything is allocated. */
 LPI_API int lpi_sine_euler_create(lpi_system **out, int32_t N);
 /* N of a sine-Euler system (LPI_ERR_UNSUPPORTED for another kind of system). */
@@ -333,6 +333,39 @@ LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *se
  * LPI_ERR_UNSUPPORTED; an unknown name: LPI_ERR_INVALID. */
 LPI_API int lpi_sine_euler_set_planning(lpi_system *sys, const char *rigor);
 LPI_API int lpi_sine_euler_get_planning(const lpi_system *sys, const char **rigor);
+
+/* ---- The sine-bracket family: any quadratic Hamiltonian ------------------ *
+ * The same bracket and splitting integrate every Hamiltonian quadratic and
+ * diagonal in the modes plus a linear term,
+ *   H(w) = 1/2 sum_{n != 0} lambda_n |w_n|^2 + sum_{n != 0} conj(f_n) w_n,
+ * with the flow dW/dt = (i / (2 eps)) [P, W], P = sum_{n != 0} psi_n J_n and
+ * the stream function psi_n = lambda_n w_n + f_n. Euler is lambda_n = 1/|n|^2,
+ * f = 0, the default; SQG is lambda_n = 1/|n|, QG with deformation wavenumber
+ * k_d is 1/(|n|^2 + k_d^2), Euler over a topography h (q = w + h) is
+ * lambda_n = 1/|n|^2, f_n = -h_n/|n|^2. See lpi_sine_euler_set_hamiltonian(3). */
+
+/* Sets lambda (n_lambda = N*N reals) and f (n_f = 2*N*N doubles, interleaved
+ * re, im; or f = NULL and n_f = 0 for f = 0), both in the modes' layout (entry
+ * [a*N + b] is mode (a, b) mod N). lambda must be finite and symmetric
+ * (lambda_{-n} = lambda_n), f finite and Hermitian (f_{-n} = conj(f_n)), each
+ * within 1e-10 times its largest entry (the mean of each pair is stored); the
+ * zero mode's entries are ignored. Every method, lpi_energy (which is this H),
+ * the diagnostics and checkpoints use it from the next call on; the state and
+ * the time are kept. Bad input changes nothing: LPI_ERR_NULL, LPI_ERR_SIZE,
+ * LPI_ERR_NONFINITE, LPI_ERR_INVALID. */
+LPI_API int lpi_sine_euler_set_hamiltonian(lpi_system *sys, const double *lambda, size_t n_lambda,
+                                           const double *f, size_t n_f);
+/* The stream function on the grid, n = N*N: entry [a*N + b] is
+ * psi(2 pi a / N, 2 pi b / N) = sum_{n != 0} psi_n exp(i (n1 x + n2 y)). */
+LPI_API int lpi_sine_euler_get_stream(const lpi_system *sys, double *psi, size_t n);
+/* Shell sums of the energy and enstrophy spectra: the mode n (representative
+ * in -M..M) lies in shell k = floor(|n| + 1/2); energy[k-1] sums the terms
+ * 1/2 lambda_n |w_n|^2 + Re(conj(f_n) w_n) of H over the shell (the shells add
+ * up to H) and enstrophy[k-1] sums 1/2 |w_n|^2 (adding up to the enstrophy
+ * less 1/2 w_0^2), k = 1 .. K, K = floor(M sqrt 2 + 1/2). *shells is set to K;
+ * LPI_ERR_SIZE when n < K (the buffers may then be NULL with n = 0). */
+LPI_API int lpi_sine_euler_spectrum(const lpi_system *sys, double *energy, double *enstrophy,
+                                    size_t n, size_t *shells);
 
 /* Threads used inside one step (OpenMP over the lines of a direction);
  * 1 <= n <= 4 x the processors available (omp_get_num_procs), else

@@ -47,15 +47,18 @@ else
 fi
 runpath() { readelf -d "$1" | sed -n 's/.*(R\(UN\)\{0,1\}PATH).*\[\(.*\)\]/\2/p'; }
 # where the loader finds libliepoisson for FILE, with no LD_LIBRARY_PATH
-resolved() {
-    found=$(ldd "$1" | sed -n "s/^[[:space:]]*libliepoisson.so.$major => \([^ ]*\).*/\1/p")
+resolved() {  # resolved PROGRAM [LIBRARY]: the file PROGRAM loads LIBRARY (libliepoisson) from
+    found=$(ldd "$1" | sed -n "s/^[[:space:]]*${2:-libliepoisson}.so.$major => \([^ ]*\).*/\1/p")
     [ -n "$found" ] && readlink -f "$found"
 }
 staged_lib=$(readlink -f "$root/$libdir/libliepoisson.so.$major")
 [ "$(runpath "$root/bin/lpi")" = "$lpi_runpath" ] || fail "installed lpi has RUNPATH '$(runpath "$root/bin/lpi")'"
 [ -z "$(runpath "$root/$libdir/libliepoisson.so.$major")" ] || fail "libliepoisson has a RUNPATH"
-[ "$(resolved "$root/bin/lpi")" = "$staged_lib" ] ||
-    fail "installed lpi loads libliepoisson from '$(resolved "$root/bin/lpi")'"
+# A build with MPI links lpi to libliepoisson_mpi (which carries the whole API).
+lpi_lib=libliepoisson
+ldd "$root/bin/lpi" | grep -q "libliepoisson_mpi.so.$major" && lpi_lib=libliepoisson_mpi
+[ "$(resolved "$root/bin/lpi" $lpi_lib)" = "$(readlink -f "$root/$libdir/$lpi_lib.so.$major")" ] ||
+    fail "installed lpi loads $lpi_lib from '$(resolved "$root/bin/lpi" $lpi_lib)'"
 [ "$("$root/bin/lpi" --version)" = "lpi (liepoisson) $version" ] || fail "the installed lpi does not run"
 if [ "$have_fortran" = 1 ]; then
     [ "$(runpath "$root/$libdir/libliepoisson_fortran.so.$major")" = "$fortran_runpath" ] ||

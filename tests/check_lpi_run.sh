@@ -110,6 +110,25 @@ if [ "$have_sine_euler" = 1 ]; then
     done
     cmp -s "$out/measured1/sine-euler.csv" "$out/measured2/sine-euler.csv" ||
         { echo "two measured runs sharing --wisdom differ"; exit 1; }
+    # The sine-bracket family: SQG, QG (--kd) and topography run, a checkpoint
+    # of one Hamiltonian does not resume another, and the roll-up scene runs
+    # at a tiny size and writes its CSVs.
+    for scene in sqg qg topography; do
+        "$lpi" run $scene --N 9 --dt 0.05 --steps 10 --every 5 --out "$out/f" >/dev/null
+        rows=$(wc -l < "$out/f/$scene.csv")
+        [ "$rows" -eq 4 ] || { echo "lpi run $scene: expected 4 lines, got $rows"; exit 1; }
+    done
+    for v in 0 -1 nan inf ""; do refused --kd run qg --N 9 --out "$out/bad" --kd "$v"; done
+    "$lpi" run qg --N 9 --kd 2 --dt 0.05 --steps 4 --out "$out/q" --checkpoint "$out/qg.lpi" >/dev/null
+    refused "Hamiltonian differs" run qg --N 9 --kd 3 --resume "$out/qg.lpi" --out "$out/bad"
+    refused "Hamiltonian differs" run sine-euler --N 9 --resume "$out/qg.lpi" --out "$out/bad"
+    "$lpi" run qg --N 9 --kd 2 --dt 0.05 --steps 8 --resume "$out/qg.lpi" --out "$out/q" >/dev/null
+    refused "takes --N, --steps, --dt and --out only" run rollup --method rk4 --out "$out/bad"
+    "$lpi" run rollup --N 9 --steps 30 --dt 0.05 --out "$out/roll" >/dev/null
+    rows=$(wc -l < "$out/roll/rollup.csv")
+    [ "$rows" -eq 32 ] || { echo "lpi run rollup: expected 32 lines, got $rows"; exit 1; }
+    [ "$(head -1 "$out/roll/rollup_spectra.csv")" = "k,enstrophy_t0,enstrophy_t0.05,enstrophy_t0.15,enstrophy_t1.5" ] ||
+        { echo "lpi run rollup: spectra header:"; head -1 "$out/roll/rollup_spectra.csv"; exit 1; }
 fi
 
 # --checkpoint then --resume with the same options: the CSV (every row, to

@@ -373,6 +373,18 @@ static int call_lpi_sine_euler_get_planning(lpi_system *s, const args *a, lpi_sy
     const char *rigor;
     return lpi_sine_euler_get_planning(s, PTR(P1, &rigor));
 }
+static int call_lpi_sine_euler_set_hamiltonian(lpi_system *s, const args *a, lpi_system **o) {
+    (void)o;
+    return lpi_sine_euler_set_hamiltonian(s, PTR(P1, a->x), a->n, PTR(P2, (const double *)a->bytes), a->m);
+}
+static int call_lpi_sine_euler_get_stream(lpi_system *s, const args *a, lpi_system **o) {
+    (void)o;
+    return lpi_sine_euler_get_stream(s, PTR(P1, out_buf), a->n);
+}
+static int call_lpi_sine_euler_spectrum(lpi_system *s, const args *a, lpi_system **o) {
+    (void)o;
+    return lpi_sine_euler_spectrum(s, PTR(P1, out_buf), PTR(P2, out_buf + 4096), a->n, PTR(P3, &out_size));
+}
 static int call_lpi_set_threads(lpi_system *s, const args *a, lpi_system **o) {
     (void)o;
     return lpi_set_threads(s, (int32_t)a->k);
@@ -431,6 +443,11 @@ static const double kModesImaginaryW0[162] = {[1] = 1.0};   /* Im w_0 != 0 */
 static const double kGridNaN[81] = {[3] = NAN}, kGridInf[81] = {[80] = -INFINITY};
 static const double kGrid[81] = {0};
 static const double kModesOverflow[50] = {[2] = 1.7e308, [8] = 1.7e308}; /* N = 5: w_(0,1), w_(0,-1) */
+/* N = 9 Hamiltonians: lambda = 0 and f = 0 are valid, the others are not. */
+static const double kLambda[81] = {0}, kLambdaNaN[81] = {[7] = NAN};
+static const double kLambdaAsymmetric[81] = {[1] = 2.0}; /* lambda_(0,1) != lambda_(0,-1) */
+static const double kForce[162] = {0}, kForceInf[162] = {[9] = INFINITY};
+static const double kForceNotHermitian[162] = {[3] = 1.0}; /* Im f_(0,1) without its conjugate */
 static const unsigned char kNotCheckpoint[40] = "this is not a liepoisson checkpoint....";
 
 #define C(fn, input, expected, tgt, ...) \
@@ -667,6 +684,29 @@ static const bad_case kCases[] = {
     C(lpi_sine_euler_get_planning, "NULL handle", LPI_ERR_NULL, NONE),
     C(lpi_sine_euler_get_planning, "a generic system (wrong kind)", LPI_ERR_UNSUPPORTED, GEN),
     C(lpi_sine_euler_get_planning, "NULL rigor", LPI_ERR_NULL, SE, .nul = P1),
+    C(lpi_sine_euler_set_hamiltonian, "NULL handle", LPI_ERR_NULL, NONE, .x = kLambda, .n = 81, .bytes = kForce, .m = 162),
+    C(lpi_sine_euler_set_hamiltonian, "a rigid body (wrong kind)", LPI_ERR_UNSUPPORTED, RB, .x = kLambda, .n = 81, .bytes = kForce, .m = 162),
+    C(lpi_sine_euler_set_hamiltonian, "NULL lambda", LPI_ERR_NULL, SE, .nul = P1, .n = 81, .bytes = kForce, .m = 162),
+    C(lpi_sine_euler_set_hamiltonian, "NULL f with n_f = 162", LPI_ERR_NULL, SE, .nul = P2, .x = kLambda, .n = 81, .m = 162),
+    C(lpi_sine_euler_set_hamiltonian, "n_lambda = 80", LPI_ERR_SIZE, SE, .x = kLambda, .n = 80, .bytes = kForce, .m = 162),
+    C(lpi_sine_euler_set_hamiltonian, "n_lambda = SIZE_MAX", LPI_ERR_SIZE, SE, .x = kLambda, .n = SIZE_MAX, .bytes = kForce, .m = 162),
+    C(lpi_sine_euler_set_hamiltonian, "n_f = 81", LPI_ERR_SIZE, SE, .x = kLambda, .n = 81, .bytes = kForce, .m = 81),
+    C(lpi_sine_euler_set_hamiltonian, "NaN lambda", LPI_ERR_NONFINITE, SE, .x = kLambdaNaN, .n = 81, .bytes = kForce, .m = 162),
+    C(lpi_sine_euler_set_hamiltonian, "infinite f", LPI_ERR_NONFINITE, SE, .x = kLambda, .n = 81, .bytes = kForceInf, .m = 162),
+    C(lpi_sine_euler_set_hamiltonian, "lambda not symmetric", LPI_ERR_INVALID, SE, .x = kLambdaAsymmetric, .n = 81, .bytes = kForce, .m = 162),
+    C(lpi_sine_euler_set_hamiltonian, "f not Hermitian", LPI_ERR_INVALID, SE, .x = kLambda, .n = 81, .bytes = kForceNotHermitian, .m = 162),
+    C(lpi_sine_euler_get_stream, "NULL handle", LPI_ERR_NULL, NONE, .n = 81),
+    C(lpi_sine_euler_get_stream, "a pendulum (wrong kind)", LPI_ERR_UNSUPPORTED, PEND, .n = 81),
+    C(lpi_sine_euler_get_stream, "NULL buffer", LPI_ERR_NULL, SE, .nul = P1, .n = 81),
+    C(lpi_sine_euler_get_stream, "n = 162", LPI_ERR_SIZE, SE, .n = 162),
+    C(lpi_sine_euler_get_stream, "stream function of modes ~ 1e308 overflows", LPI_ERR_OVERFLOW, SE_HUGE, .n = 25),
+    C(lpi_sine_euler_spectrum, "NULL handle", LPI_ERR_NULL, NONE, .n = 6),
+    C(lpi_sine_euler_spectrum, "a rigid body (wrong kind)", LPI_ERR_UNSUPPORTED, RB, .n = 6),
+    C(lpi_sine_euler_spectrum, "NULL energy", LPI_ERR_NULL, SE, .nul = P1, .n = 6),
+    C(lpi_sine_euler_spectrum, "NULL enstrophy", LPI_ERR_NULL, SE, .nul = P2, .n = 6),
+    C(lpi_sine_euler_spectrum, "NULL shells", LPI_ERR_NULL, SE, .nul = P3, .n = 6),
+    C(lpi_sine_euler_spectrum, "n = 5 < 6 shells", LPI_ERR_SIZE, SE, .n = 5),
+    C(lpi_sine_euler_spectrum, "spectrum of modes ~ 1e308 overflows", LPI_ERR_OVERFLOW, SE_HUGE, .n = 3),
     C(lpi_set_threads, "NULL handle", LPI_ERR_NULL, NONE, .k = 2),
     C(lpi_set_threads, "n = 0", LPI_ERR_INVALID, SE, .k = 0),
     C(lpi_set_threads, "n < 0", LPI_ERR_INVALID, SE, .k = -2),

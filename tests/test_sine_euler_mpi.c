@@ -166,6 +166,89 @@ static void test_checkpoint(void **state) {
     lpi_destroy(spread), lpi_destroy(single), lpi_destroy(loaded), lpi_destroy(reloaded);
 }
 
+/* SQG over a topography (lambda = 1/|n|, f_n = -h_n / |n|^2 for a smooth h):
+ * the spread system follows the one-process system to 1e-12 after 40 steps of
+ * a 4th-order method, its energy is this H, its stream function and spectra
+ * agree, and a checkpoint carries lambda and f into lpi_load_mpi. */
+static void sqg_over_topography(int N, double *lambda, double *f) {
+    const int M = (N - 1) / 2;
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b) {
+            const int p = a > M ? a - N : a, q = b > M ? b - N : b;
+            const double n2 = (double)(p * p + q * q);
+            const size_t i = (size_t)a * N + b;
+            lambda[i] = n2 == 0 ? 0.0 : 1.0 / sqrt(n2);
+            /* h: real on the grid, so h_{-n} = conj(h_n); nonzero for |n| <= 2. */
+            const double h = n2 == 0 || n2 > 4 ? 0.0 : 0.3 / (1.0 + n2);
+            f[2 * i] = n2 == 0 ? 0.0 : -h / n2;
+            f[2 * i + 1] = n2 == 0 ? 0.0 : -0.1 * h * (p + 2 * q) / n2; /* odd in n */
+        }
+}
+
+static void test_hamiltonian(void **state) {
+    (void)state;
+    const int orders[] = {13, 15};
+    for (int k = 0; k < 2; ++k) {
+        const int N = orders[k];
+        const size_t n = (size_t)N * N;
+        double *x0 = malloc(n * sizeof *x0), *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b),
+               *lambda = malloc(n * sizeof *lambda), *f = malloc(2 * n * sizeof *f),
+               *e1 = malloc(n * sizeof *e1), *e2 = malloc(n * sizeof *e2);
+        assert_true(x0 && a && b && lambda && f && e1 && e2);
+        sqg_over_topography(N, lambda, f);
+        lpi_system *spread, *single, *reloaded;
+        make_pair(N, "suzuki-4", &spread, &single, x0);
+        assert_int_equal(lpi_sine_euler_set_hamiltonian(spread, lambda, n, f, 2 * n), LPI_OK);
+        assert_int_equal(lpi_sine_euler_set_hamiltonian(single, lambda, n, f, 2 * n), LPI_OK);
+        double h1, h2;
+        assert_int_equal(lpi_energy(spread, &h1), LPI_OK);
+        assert_int_equal(lpi_energy(single, &h2), LPI_OK);
+        assert_true(fabs(h1 - h2) <= 1e-13 * fabs(h2));
+        assert_int_equal(lpi_step(spread, 0.05, 40), LPI_OK);
+        assert_int_equal(lpi_step(single, 0.05, 40), LPI_OK);
+        assert_int_equal(lpi_get_state(spread, a, n), LPI_OK);
+        assert_int_equal(lpi_get_state(single, b, n), LPI_OK);
+        const double scale = max_abs(b, n), gap = max_diff(a, b, n);
+        if (rank_ == 0)
+            printf("SQG over topography, N = %d, P = %d: max |spread - one process| / max |w| = %.2e\n", N,
+                   size_, gap / scale);
+        assert_true(gap <= 1e-12 * scale);
+        assert_same_on_every_process(a, n);
+        assert_int_equal(lpi_energy(spread, &h1), LPI_OK);
+        assert_int_equal(lpi_energy(single, &h2), LPI_OK);
+        assert_true(fabs(h1 - h2) <= 1e-12 * fabs(h2));
+        assert_int_equal(lpi_sine_euler_get_stream(spread, e1, n), LPI_OK);
+        assert_int_equal(lpi_sine_euler_get_stream(single, e2, n), LPI_OK);
+        assert_true(max_diff(e1, e2, n) <= 1e-11 * max_abs(e2, n));
+        size_t shells1 = 0, shells2 = 0;
+        assert_int_equal(lpi_sine_euler_spectrum(spread, e1, a, n, &shells1), LPI_OK);
+        assert_int_equal(lpi_sine_euler_spectrum(single, e2, b, n, &shells2), LPI_OK);
+        assert_true(shells1 == shells2 && shells1 > 0);
+        assert_true(max_diff(e1, e2, shells1) <= 1e-12 * max_abs(e2, shells1));
+
+        char path[64];
+        snprintf(path, sizeof path, "test_sine_euler_mpi_h_%d.lpi", size_);
+        assert_int_equal(lpi_save(spread, path), LPI_OK);
+        assert_int_equal(lpi_load_mpi(&reloaded, path, MPI_COMM_WORLD), LPI_OK);
+        assert_int_equal(lpi_energy(reloaded, &h2), LPI_OK);
+        assert_true(h1 == h2);
+        assert_int_equal(lpi_step(spread, 0.05, 5), LPI_OK);
+        assert_int_equal(lpi_step(reloaded, 0.05, 5), LPI_OK);
+        assert_int_equal(lpi_get_state(spread, a, n), LPI_OK);
+        assert_int_equal(lpi_get_state(reloaded, b, n), LPI_OK);
+        assert_memory_equal(a, b, n * sizeof *a);
+        MPI_Barrier(MPI_COMM_WORLD);
+        if (rank_ == 0) remove(path);
+        /* Processes that pass different Hamiltonians: refused on all, unchanged. */
+        lambda[1] += rank_ == size_ - 1 && size_ > 1 ? 0.5 : 0.0;
+        lambda[N - 1] = lambda[1]; /* mode (0, -1) mirrors (0, 1) */
+        const int status = lpi_sine_euler_set_hamiltonian(spread, lambda, n, f, 2 * n);
+        assert_int_equal(status, size_ > 1 ? LPI_ERR_INVALID : LPI_OK);
+        lpi_destroy(spread), lpi_destroy(single), lpi_destroy(reloaded);
+        free(x0), free(a), free(b), free(lambda), free(f), free(e1), free(e2);
+    }
+}
+
 /* Bad input: the same status on every process, the state unchanged. */
 static void test_bad_input(void **state) {
     (void)state;
@@ -210,6 +293,7 @@ int main(void) {
         cmocka_unit_test(test_matches_one_process),
         cmocka_unit_test(test_threads_per_process),
         cmocka_unit_test(test_checkpoint),
+        cmocka_unit_test(test_hamiltonian),
         cmocka_unit_test(test_bad_input),
     };
     const int status = lpi_run_tests(tests);

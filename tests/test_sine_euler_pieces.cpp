@@ -2,6 +2,7 @@
 // projective line over Z_N) own every nonzero mode exactly once, so their
 // energies sum to H; their number is N prod_{p | N} (1 + 1/p). Small N
 // mode by mode, larger N (prime powers, large factors) by the sum.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -14,6 +15,12 @@
 namespace {
 
 const int kSizes[] = {3, 7, 9, 15, 25, 27, 45, 49};
+
+#if LPI_HAVE_FFTW
+const lpi::sine_euler::Hamiltonian &hamiltonian_of(const lpi::Model &model) {
+    return static_cast<const lpi::SineEulerModel &>(model).hamiltonian();
+}
+#endif
 
 #if LPI_HAVE_FFTW
 std::size_t projective_line_size(int N) {
@@ -56,7 +63,7 @@ void test_each_mode_has_one_owner(void **) {
             state[2 * minus] = 1.0;
             int owners = 0;
             for (std::size_t k = 0; k < model->piece_count(); ++k)
-                owners += lpi::sine_euler::piece_energy(line.at(k), N, state.data()) != 0.0;
+                owners += lpi::sine_euler::piece_energy(line.at(k), hamiltonian_of(*model), state.data()) != 0.0;
             if (owners != 1) fail_msg("N = %d, mode %d: %d pieces own it", N, i, owners);
         }
     }
@@ -80,12 +87,33 @@ void test_piece_energies_sum_to_h(void **) {
         std::vector<double> x(N * N);
         model->to_public(state.data(), x.data());
         model->from_public(x.data(), state.data());  // make it Hermitian
-        double sum = 0.0;
-        for (std::size_t k = 0; k < model->piece_count(); ++k) sum += lpi::sine_euler::piece_energy(line.at(k), N, state.data());
-        const double H = model->energy(state.data());
-        std::printf("N = %2d: %3zu pieces, sum of piece energies - H = %.1e\n", N,
-                    model->piece_count(), sum - H);
-        assert_true(std::fabs(sum - H) <= 1e-13 * H);
+        // Euler's H, then a general one: random symmetric lambda of both
+        // signs and Hermitian f (the linear term of H).
+        for (bool general : {false, true}) {
+            if (general) {
+                std::vector<double> lambda(N * N), f(2 * N * N), fx(N * N);
+                for (int i = 0; i < N * N; ++i) {
+                    const int a = i / N, b = i % N, minus = ((N - a) % N) * N + (N - b) % N;
+                    lambda[i] = lambda[minus] = std::cos(3.0 * std::min(i, minus)) + 0.5;
+                    seed = seed * 1103515245u + 12345u;
+                    fx[i] = (seed >> 8) / 16777216.0 - 0.5;
+                }
+                model->from_public(fx.data(), f.data());  // Hermitian
+                static_cast<lpi::SineEulerModel &>(*model).set_hamiltonian(lpi::sine_euler::Hamiltonian(
+                    N, lambda.data(), lambda.size(), f.data(), f.size()));
+            }
+            double sum = 0.0, terms = 0.0;
+            for (std::size_t k = 0; k < model->piece_count(); ++k) {
+                const double piece = lpi::sine_euler::piece_energy(line.at(k), hamiltonian_of(*model), state.data());
+                sum += piece;
+                terms += std::fabs(piece);
+            }
+            const double H = model->energy(state.data());
+            std::printf("N = %2d, %s H: %3zu pieces, sum of piece energies - H = %.1e\n", N,
+                        general ? "general" : "Euler's", model->piece_count(), sum - H);
+            assert_true(std::fabs(sum - H) <= 1e-13 * terms);
+            assert_true(H != 0.0);
+        }
     }
     // Larger N, composite with large or repeated factors (4097 = 17 x 241):
     // every energy term |w_m|^2 / |m|^2 is set to a random value in [1/4, 1],
@@ -115,7 +143,7 @@ void test_piece_energies_sum_to_h(void **) {
                 state[2 * (static_cast<std::size_t>(a) * N + b) + 1] *= norm;
             }
         double sum = 0.0;
-        for (std::size_t k = 0; k < model->piece_count(); ++k) sum += lpi::sine_euler::piece_energy(line.at(k), N, state.data());
+        for (std::size_t k = 0; k < model->piece_count(); ++k) sum += lpi::sine_euler::piece_energy(line.at(k), hamiltonian_of(*model), state.data());
         const double H = model->energy(state.data());
         assert_true(std::fabs(sum - H) < 0.1);
         assert_true(H > 0.25 * 0.5 * (static_cast<double>(N) * N - 1));

@@ -333,6 +333,29 @@ module liepoisson
             type(c_ptr), value :: sys
             type(c_ptr), intent(out) :: rigor
         end function
+        integer(c_int) function c_lpi_sine_euler_set_hamiltonian(sys, lambda, n_lambda, f, n_f) &
+                bind(C, name="lpi_sine_euler_set_hamiltonian")
+            import :: c_int, c_ptr, c_double, c_size_t
+            type(c_ptr), value :: sys
+            real(c_double), intent(in) :: lambda(*)
+            integer(c_size_t), value :: n_lambda
+            type(c_ptr), value :: f
+            integer(c_size_t), value :: n_f
+        end function
+        integer(c_int) function c_lpi_sine_euler_get_stream(sys, psi, n) bind(C, name="lpi_sine_euler_get_stream")
+            import :: c_int, c_ptr, c_double, c_size_t
+            type(c_ptr), value :: sys
+            real(c_double), intent(inout) :: psi(*)
+            integer(c_size_t), value :: n
+        end function
+        integer(c_int) function c_lpi_sine_euler_spectrum(sys, energy, enstrophy, n, shells) &
+                bind(C, name="lpi_sine_euler_spectrum")
+            import :: c_int, c_ptr, c_double, c_size_t
+            type(c_ptr), value :: sys
+            real(c_double), intent(inout) :: energy(*), enstrophy(*)
+            integer(c_size_t), value :: n
+            integer(c_size_t), intent(out) :: shells
+        end function
         integer(c_int) function c_lpi_set_threads(sys, n) bind(C, name="lpi_set_threads")
             import :: c_int, c_ptr, c_int32_t
             type(c_ptr), value :: sys
@@ -402,6 +425,7 @@ module liepoisson
         c_lpi_sine_euler_get_grid, c_lpi_sine_euler_enstrophy, c_lpi_sine_euler_casimir_traces, &
         c_lpi_sine_euler_fft_floor, c_lpi_sine_euler_set_planning, c_lpi_sine_euler_get_planning, &
         c_lpi_set_threads, c_lpi_fftw_wisdom_import_file, &
+        c_lpi_sine_euler_set_hamiltonian, c_lpi_sine_euler_get_stream, c_lpi_sine_euler_spectrum, &
         c_lpi_fftw_wisdom_export_file, c_lpi_fftw_wisdom_import_string, &
         c_lpi_fftw_wisdom_export_string, c_lpi_save, c_lpi_load, c_lpi_save_buffer, c_lpi_load_buffer
 
@@ -424,6 +448,7 @@ module liepoisson
         lpi_sine_euler_get_grid, lpi_sine_euler_enstrophy, lpi_sine_euler_casimir_traces, &
         lpi_sine_euler_fft_floor, lpi_sine_euler_set_planning, lpi_sine_euler_get_planning, &
         lpi_set_threads, lpi_fftw_wisdom_import_file, &
+        lpi_sine_euler_set_hamiltonian, lpi_sine_euler_get_stream, lpi_sine_euler_spectrum, &
         lpi_fftw_wisdom_export_file, lpi_fftw_wisdom_import_string, lpi_fftw_wisdom_export_string, &
         lpi_save, lpi_load, lpi_save_buffer, lpi_load_buffer
 
@@ -911,6 +936,65 @@ contains
         st = c_lpi_sine_euler_get_planning(sys, p)
         rigor = f_string(p)
         call finish(st, sys, status)
+    end subroutine
+
+    ! H = 1/2 sum lambda_n |w_n|^2 + sum conj(f_n) w_n: lambda(a, b) and
+    ! f(a, b) belong to mode (a-1, b-1), as in lpi_sine_euler_set_modes; f
+    ! absent for f = 0.
+    subroutine lpi_sine_euler_set_hamiltonian(sys, lambda, f, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(in) :: lambda(:, :)
+        complex(c_double_complex), intent(in), optional :: f(:, :)
+        integer, intent(out), optional :: status
+        real(c_double), allocatable :: t(:, :)
+        real(c_double), allocatable, target :: buf(:)
+        integer :: a, b, n2, q
+        allocate (t(size(lambda, 2), size(lambda, 1)))
+        t = transpose(lambda)
+        if (.not. present(f)) then
+            call finish(c_lpi_sine_euler_set_hamiltonian(sys, t, size(t, kind=c_size_t), c_null_ptr, &
+                                                         0_c_size_t), sys, status)
+            return
+        end if
+        n2 = size(f, 2)
+        allocate (buf(2 * size(f, 1) * n2))
+        do a = 1, size(f, 1)
+            do b = 1, n2
+                q = 2 * ((a - 1) * n2 + (b - 1))
+                buf(q + 1) = real(f(a, b), c_double)
+                buf(q + 2) = aimag(f(a, b))
+            end do
+        end do
+        call finish(c_lpi_sine_euler_set_hamiltonian(sys, t, size(t, kind=c_size_t), c_loc(buf), &
+                                                     size(buf, kind=c_size_t)), sys, status)
+    end subroutine
+
+    ! psi(a, b) is the stream function at (2 pi (a-1) / N, 2 pi (b-1) / N).
+    subroutine lpi_sine_euler_get_stream(sys, psi, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(inout) :: psi(:, :)
+        integer, intent(out), optional :: status
+        real(c_double), allocatable :: t(:, :)
+        integer(c_int) :: st
+        allocate (t(size(psi, 2), size(psi, 1)))
+        st = c_lpi_sine_euler_get_stream(sys, t, size(t, kind=c_size_t))
+        if (st == LPI_OK) psi = transpose(t)
+        call finish(st, sys, status)
+    end subroutine
+
+    ! energy(k), enstrophy(k): shell k (k - 1/2 <= |n| < k + 1/2), k = 1 ..
+    ! shells; the arrays need at least `shells` elements (LPI_ERR_SIZE, with
+    ! shells set, otherwise).
+    subroutine lpi_sine_euler_spectrum(sys, energy, enstrophy, shells, status)
+        type(c_ptr), intent(in) :: sys
+        real(c_double), intent(inout) :: energy(:), enstrophy(:)
+        integer, intent(out) :: shells
+        integer, intent(out), optional :: status
+        integer(c_size_t) :: count
+        count = 0
+        call finish(c_lpi_sine_euler_spectrum(sys, energy, enstrophy, &
+                        int(min(size(energy), size(enstrophy)), c_size_t), count), sys, status)
+        shells = int(count)
     end subroutine
 
     subroutine lpi_set_threads(sys, n, status)

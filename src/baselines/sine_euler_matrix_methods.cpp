@@ -1,10 +1,11 @@
 // Matrix-form baselines for sine-Euler (see the header).
 //
 // Conventions: W = sum_m w_m J_m is Hermitian,
-// eq. 5 is dW/dt = [B, W] with B = i f P, f = 1/(2 eps), eps = 2 pi/N and
-// P = sum_{n != 0} w_n / |n|^2 J_n (Hermitian, so B is anti-Hermitian).
-// The transforms are sine_euler::MatrixForm's. Matrices are stored
-// column-major, as BLAS wants them.
+// eq. 5 is dW/dt = [B, W] with B = i c P, c = 1/(2 eps), eps = 2 pi/N and
+// P = sum_{n != 0} (lambda_n w_n + f_n) J_n, the stream function of the
+// model's Hamiltonian (Hermitian, so B is anti-Hermitian), read from the
+// model at each advance. The transforms are sine_euler::MatrixForm's.
+// Matrices are stored column-major, as BLAS wants them.
 #include "sine_euler_matrix_methods.hpp"
 
 #include <algorithm>
@@ -15,7 +16,6 @@
 
 #include "../core/error.hpp"
 #include "../models/sine_euler.hpp"
-#include "../models/sine_euler/indexing.hpp"
 #include "../models/sine_euler/matrix_form.hpp"
 #include "fixed_point.hpp"
 #include "runge_kutta4.hpp"
@@ -32,21 +32,16 @@ using cplx = std::complex<double>;
 class DirectEq5 final : public Integrator {
 public:
     explicit DirectEq5(int N)
-        : N_(N), sine_(N), weight_(static_cast<std::size_t>(N) * N), size_(2 * weight_.size()),
-          stages_(size_) {
+        : N_(N), sine_(N), size_(2 * static_cast<std::size_t>(N) * N), psi_(size_), stages_(size_) {
         const double two_pi = 2.0 * std::acos(-1.0), eps = two_pi / N;
         // sin(eps m x n) depends on m x n only mod N.
         for (int j = 0; j < N; ++j) sine_[j] = std::sin(two_pi * j / N) / eps;
-        for (int a = 0; a < N; ++a)
-            for (int b = 0; b < N; ++b) {
-                const double norm2 = sine_euler::norm2(a, b, N);
-                weight_[static_cast<std::size_t>(a) * N + b] = norm2 != 0 ? 1.0 / norm2 : 0.0;
-            }
     }
 
     // The stages of rk4 on the modes, so the two agree to round-off.
-    bool advance(Model &, double *x, double dt, std::int64_t n) override {
-        auto rate = [this](const double *y, double *k) { this->rate(y, k); };
+    bool advance(Model &model, double *x, double dt, std::int64_t n) override {
+        const sine_euler::Hamiltonian &H = static_cast<const SineEulerModel &>(model).hamiltonian();
+        auto rate = [this, &H](const double *y, double *k) { this->rate(H, y, k); };
         return run_checked_steps(
             n, [&](std::int64_t) { stages_.step(x, dt, rate); },
             [&] { return all_finite(x, size_); });
@@ -55,12 +50,15 @@ public:
     std::size_t evaluations_per_step() const override { return 4; }
 
 private:
-    // dw_m/dt = sum_{n != 0} sin(eps m x n) / (eps |n|^2) w_{m+n} w_{-n}  (eq. 5)
-    void rate(const double *modes, double *out) const {
+    // dw_m/dt = sum_{n != 0} sin(eps m x n) / eps w_{m+n} psi_{-n}  (eq. 5),
+    // psi = lambda w + f (Euler: psi_{-n} = w_{-n} / |n|^2)
+    void rate(const sine_euler::Hamiltonian &H, const double *modes, double *out) {
         // int indices: N <= kDirectEq5MaxN, so none exceeds N^2 = 961, and
         // the remainders of this O(N^4) loop are cheaper in 32 bits.
         const int N = N_;
+        H.stream_function(modes, psi_.data());
         const cplx *w = reinterpret_cast<const cplx *>(modes);
+        const cplx *psi = reinterpret_cast<const cplx *>(psi_.data());
         cplx *r = reinterpret_cast<cplx *>(out);
         for (int m1 = 0; m1 < N; ++m1)
             for (int m2 = 0; m2 < N; ++m2) {
@@ -70,8 +68,7 @@ private:
                     // cross = m1 n2 - m2 n1 (mod N), advanced by m1 with n2.
                     int cross = (N - (m2 * n1) % N) % N;
                     for (int n2 = 0; n2 < N; ++n2) {
-                        const double c = sine_[cross] * weight_[n1 * N + n2];
-                        sum += c * w[row * N + (m2 + n2) % N] * w[minus1 * N + (N - n2) % N];
+                        sum += sine_[cross] * w[row * N + (m2 + n2) % N] * psi[minus1 * N + (N - n2) % N];
                         cross += m1;
                         if (cross >= N) cross -= N;
                     }
@@ -81,8 +78,9 @@ private:
     }
 
     int N_;
-    std::vector<double> sine_, weight_;
+    std::vector<double> sine_;
     std::size_t size_;
+    std::vector<double> psi_;
     RungeKutta4Stages<double> stages_;
 };
 
@@ -129,12 +127,13 @@ class MatrixIntegrator : public Integrator {
 protected:
     explicit MatrixIntegrator(int N)
         : N_(N), size_(static_cast<std::size_t>(N) * N), form_(N, sine_euler::MatrixForm::ColumnMajor), W_(size_), P_(size_),
-          X_(size_), f_(N / (4.0 * std::acos(-1.0))) {}
+          X_(size_), c_(N / (4.0 * std::acos(-1.0))) {}
 
     // One step of size dt on W_ (s: its index within the run).
     virtual void step(double dt, std::int64_t s) = 0;
 
-    bool run(double *state, double dt, std::int64_t n) {
+    bool run(const Model &model, double *state, double dt, std::int64_t n) {
+        hamiltonian_ = &static_cast<const SineEulerModel &>(model).hamiltonian();
         const double w0[2] = {state[0], state[1]};
         form_.to_matrix(state, W_.data());
         if (!run_checked_steps(n, [&](std::int64_t s) { step(dt, s); },
@@ -145,11 +144,11 @@ protected:
         return all_finite(state, 2 * size_);
     }
 
-    // Out = i f (X - X^dagger): the Hermitian [B, W] when X = P W, since
+    // Out = i c (X - X^dagger): the Hermitian [B, W] when X = P W, since
     // W P = (P W)^dagger for Hermitian P and W.
     void commutator(const cplx *X, cplx *out) const {
         const std::size_t N = static_cast<std::size_t>(N_);
-        const cplx factor(0.0, f_);
+        const cplx factor(0.0, c_);
         for (std::size_t j = 0; j < N; ++j)
             for (std::size_t i = 0; i < N; ++i)
                 out[i + j * N] = factor * (X[i + j * N] - std::conj(X[j + i * N]));
@@ -159,7 +158,8 @@ protected:
     std::size_t size_;
     sine_euler::MatrixForm form_;
     std::vector<cplx> W_, P_, X_;
-    double f_;  // 1 / (2 eps) = N / (4 pi)
+    double c_;  // 1 / (2 eps) = N / (4 pi)
+    const sine_euler::Hamiltonian *hamiltonian_ = nullptr;  // the model's, during a run
 };
 
 // Classical RK4 on dW/dt = [B(W), W]: one P(W) and one zgemm per stage.
@@ -167,14 +167,14 @@ class RungeKutta4Matrix final : public MatrixIntegrator {
 public:
     explicit RungeKutta4Matrix(int N) : MatrixIntegrator(N), stages_(size_) {}
 
-    bool advance(Model &, double *state, double dt, std::int64_t n) override {
-        return run(state, dt, n);
+    bool advance(Model &model, double *state, double dt, std::int64_t n) override {
+        return run(model, state, dt, n);
     }
     std::size_t evaluations_per_step() const override { return 4; }
 
 private:
     void rate(const cplx *W, cplx *out) {
-        form_.stream(W, P_.data());
+        form_.stream(*hamiltonian_, W, P_.data());
         multiply(N_, P_.data(), W, X_.data());
         commutator(X_.data(), out);
     }
@@ -202,9 +202,9 @@ public:
         : MatrixIntegrator(N), settings_(settings), mid_(size_), next_(size_), C_(size_),
           Y_(size_) {}
 
-    bool advance(Model &, double *state, double dt, std::int64_t n) override {
+    bool advance(Model &model, double *state, double dt, std::int64_t n) override {
         iterations_ = 0;
-        const bool ok = run(state, dt, n);
+        const bool ok = run(model, state, dt, n);
         average_iterations_ = static_cast<double>(iterations_) / static_cast<double>(n);
         return ok;
     }
@@ -228,13 +228,13 @@ private:
             std::copy(W, W + size_, mid);
         else
             for (std::size_t i = 0; i < size_; ++i) mid[i] = 2.0 * W[i] - mid[i];
-        // B Wt B = -f^2 P Wt P, symmetrised so Wt stays exactly Hermitian.
-        const double quad = -0.25 * h * h * f_ * f_;
+        // B Wt B = -c^2 P Wt P, symmetrised so Wt stays exactly Hermitian.
+        const double quad = -0.25 * h * h * c_ * c_;
         const std::size_t n = static_cast<std::size_t>(N);
         const FixedPointTest test(settings_, largest, "isomp", s);
         bool converged = false;
         for (int k = 0; k < settings_.max_iterations && !converged; ++k) {
-            form_.stream(mid, P_.data());
+            form_.stream(*hamiltonian_, mid, P_.data());
             multiply(N, P_.data(), mid, X_.data());
             multiply(N, X_.data(), P_.data(), Y_.data());
             commutator(X_.data(), C_.data());

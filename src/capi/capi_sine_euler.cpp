@@ -202,3 +202,66 @@ LPI_API int lpi_fftw_wisdom_export_string(char *buf, size_t size, size_t *length
 }
 
 }  // extern "C"
+
+// ---- the sine-bracket family: any quadratic Hamiltonian, and its diagnostics ----
+
+extern "C" {
+
+LPI_API int lpi_sine_euler_set_hamiltonian(lpi_system *sys, const double *lambda, size_t n_lambda,
+                                           const double *f, size_t n_f) {
+    return guarded(sys, "lpi_sine_euler_set_hamiltonian", [&] {
+        auto &model = sine_euler(sys);
+        require(lambda, "lambda");
+        // Validated in full before the model is touched.
+        model.set_hamiltonian(
+            lpi::sine_euler::Hamiltonian(model.truncation(), lambda, n_lambda, f, n_f));
+    });
+}
+
+LPI_API int lpi_sine_euler_get_stream(const lpi_system *sys, double *psi, size_t n) {
+    return guarded(sys, "lpi_sine_euler_get_stream", [&] {
+        const auto &model = sine_euler(sys);
+        require(psi, "stream function buffer");
+        const int N = model.truncation();
+        lpi::require_length("stream function buffer", n, squared(N));
+        std::vector<double> modes(2 * squared(N)), grid(n);
+        const std::vector<double> whole = model.whole_state(sys->system.working_state().data());
+        model.hamiltonian().stream_function(whole.data(), modes.data());
+        lpi::sine_euler::grid_from_modes(N, modes.data(), grid.data());
+        lpi::require_no_overflow(grid.data(), n, [&](std::size_t i) {
+            return entry_name("stream function value", i, N) + " of this state";
+        });
+        std::memcpy(psi, grid.data(), sizeof(double) * n);
+    });
+}
+
+LPI_API int lpi_sine_euler_spectrum(const lpi_system *sys, double *energy, double *enstrophy,
+                                    size_t n, size_t *shells) {
+    return guarded(sys, "lpi_sine_euler_spectrum", [&] {
+        const auto &model = sine_euler(sys);
+        require(shells, "shells");
+        if (n > 0) {
+            require(energy, "energy");
+            require(enstrophy, "enstrophy");
+        }
+        const std::size_t count = lpi::sine_euler::shell_count(model.truncation());
+        *shells = count;
+        if (n < count)
+            lpi::fail(LPI_ERR_SIZE, "spectrum buffers of " + std::to_string(n) + " entries are too "
+                                    "small: N = " + std::to_string(model.truncation()) + " has " +
+                                    std::to_string(count) + " shells");
+        std::vector<double> e(count), z(count);
+        const std::vector<double> whole = model.whole_state(sys->system.working_state().data());
+        lpi::sine_euler::shell_spectra(model.hamiltonian(), whole.data(), e.data(), z.data());
+        lpi::require_no_overflow(e.data(), count, [](std::size_t k) {
+            return "the energy of shell " + std::to_string(k + 1) + " of this state";
+        });
+        lpi::require_no_overflow(z.data(), count, [](std::size_t k) {
+            return "the enstrophy of shell " + std::to_string(k + 1) + " of this state";
+        });
+        std::copy(e.begin(), e.end(), energy);
+        std::copy(z.begin(), z.end(), enstrophy);
+    });
+}
+
+}  // extern "C"

@@ -20,8 +20,9 @@ void print_scenes(FILE *to) {
     std::fprintf(to, "scenes:\n");
     for (const Scene &s : builtin_scenes()) {
         std::string notes;
-        if (!s.create) notes += " (lpi report only)";
-        if (!s.in_default_report) notes += " (not in the default report)";
+        if (s.run_own) notes += " (lpi run only)";
+        else if (!s.create) notes += " (lpi report only)";
+        if (!s.in_default_report && !s.run_own) notes += " (not in the default report)";
         std::fprintf(to, "  %-16s %s%s\n", s.name.c_str(), s.description.c_str(), notes.c_str());
     }
 }
@@ -82,6 +83,7 @@ int report_command(int argc, char **argv) {
     for (const std::string &name : names) {
         auto it = std::find_if(all.begin(), all.end(), [&](const Scene &s) { return s.name == name; });
         if (it == all.end()) args.fail("unknown scene '" + name + "' (lpi --help lists them)");
+        if (it->run_own) args.fail("'" + name + "' is run by lpi run " + name + ", not reported");
         chosen.push_back(&*it);
     }
     if (chosen.empty())

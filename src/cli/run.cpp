@@ -109,6 +109,18 @@ int run_command(int argc, char **argv) {
         std::fprintf(stderr, "lpi run: unknown scene '%s' (lpi --help lists them)\n", o.scene.c_str());
         return 2;
     }
+    if (it->run_own) {
+        const std::string why = it->unavailable();
+        if (!why.empty()) {
+            std::fprintf(stderr, "lpi run: %s is not available in this build: %s\n", o.scene.c_str(), why.c_str());
+            return 1;
+        }
+        if (!o.method.empty() || !o.init.empty() || !o.resume.empty() || !o.checkpoint.empty() || o.until > 0.0) {
+            std::fprintf(stderr, "lpi run: %s takes --N, --steps, --dt and --out only\n", o.scene.c_str());
+            return 2;
+        }
+        return it->run_own({o.n_given ? o.scene_options.sine_euler_n : 0, o.steps, o.dt, o.out_dir});
+    }
     if (!it->create) {
         std::fprintf(stderr, "lpi run: %s is a report (lpi report %s)\n", o.scene.c_str(), o.scene.c_str());
         return 2;

@@ -31,6 +31,7 @@ void run_usage(FILE *to) {
                  "                    .npy array (N, N) (float64 or float32) or an HDF5 file's\n"
                  "                    /init (N, N) or /vorticity (the last snapshot of an lpi run)\n"
                  "  --inertia A,B,C   rigid-body inertias (default 1,2,3)\n"
+                 "  --kd K            qg: the deformation wavenumber k_d > 0 (default 1)\n"
                  "  --snapshots K     keep the state (sine-Euler: the vorticity grid, also drawn as\n"
                  "                    PNG and SVG) every K rows (default 10; 0: none)\n"
                  "  --format h5|npy   the data: one HDF5 file DIR/SCENE.h5 (default when built with\n"
@@ -69,6 +70,7 @@ void parse_run_options(int argc, char **argv, RunOptions &o) {
             if (o.planning != "estimate" && o.planning != "measure" && o.planning != "patient")
                 args.fail("--planning: '" + o.planning + "' is not estimate, measure or patient");
         } else if (arg == "--wisdom") o.wisdom = args.value(arg);
+        else if (arg == "--kd") o.scene_options.qg_kd = args.positive(arg);
         else if (arg == "--N") {
             o.scene_options.sine_euler_n = static_cast<int>(args.integer(arg, 3, int32_max));
             if (o.scene_options.sine_euler_n % 2 == 0) args.fail("--N must be odd");

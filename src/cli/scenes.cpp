@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "fields.hpp"
+#include "hamiltonians.hpp"
 #include "systems.hpp"
 
 namespace lpi_cli {
@@ -144,6 +145,46 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         s.description = long_run.description + ", " + long_run.setting;
         s.unavailable = sine_euler_spectrum_unavailable;
         s.custom_run = [long_run](const std::string &out_dir) { run_long_scene(long_run, out_dir); };
+        scenes.push_back(s);
+    }
+    {
+        // The sine-bracket family (lpi_sine_euler_set_hamiltonian): the
+        // sine-euler scene's field and sweep with other Hamiltonians.
+        const int N = options.sine_euler_n;
+        const double kd = options.qg_kd;
+        const struct {
+            const char *name;
+            std::string description;
+            std::function<Handle()> create;
+        } family[] = {
+            {"sqg", "surface quasi-geostrophy (lambda = 1/|n|), N = " + std::to_string(N),
+             [N] { return sqg_system(N); }},
+            {"qg", "quasi-geostrophy, lambda = 1/(|n|^2 + kd^2), kd = " + format_number(kd) + ", N = " +
+                       std::to_string(N) + " (--kd to change kd)",
+             [N, kd] { return qg_system(N, kd); }},
+            {"topography", "2D Euler over a smooth random topography h (q = w + h), N = " + std::to_string(N),
+             [N] { return topography_system(N); }},
+        };
+        for (const auto &member : family) {
+            Scene s = sweep_scene(member.name, member.description + ", smooth random field (--N to change N)",
+                                  member.create, 10.0, {0.4, 0.2, 0.1, 0.05, 0.025});
+            s.unavailable = sine_euler_unavailable;
+            s.excluded_methods = {"direct-eq5"};
+            s.exclusion_reason = "direct-eq5 (eq. 5 summed term by term, O(N^4): a cross-check of the fast methods) is left out";
+            s.reference_method = "kahan-li-8";
+            s.reference_step = 0.02;
+            s.in_default_report = false;
+            scenes.push_back(s);
+        }
+    }
+    {
+        Scene s;
+        s.name = "rollup";
+        s.description = "the paper's closing question: does a smooth sine-Euler field roll up into the "
+                        "highest modes? N = 63, 10^5 leapfrog steps of 0.05 (--N, --steps, --dt)";
+        s.unavailable = sine_euler_unavailable;
+        s.in_default_report = false;
+        s.run_own = run_rollup;
         scenes.push_back(s);
     }
     {

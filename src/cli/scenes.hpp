@@ -10,6 +10,15 @@
 
 namespace lpi_cli {
 
+// What `lpi run` gives a scene with run_own: --N, --steps and --dt (0 when not
+// given) and --out.
+struct OwnRun {
+    int N = 0;
+    int64_t steps = 0;
+    double dt = 0.0;
+    std::string out_dir;
+};
+
 struct Scene {
     std::string name;
     std::string description;
@@ -30,10 +39,14 @@ struct Scene {
     std::function<std::string()> unavailable = [] { return std::string(); };
     // A scene that is not a step-size sweep runs this instead (figure2).
     std::function<void(const std::string &out_dir)> custom_run;
+    // A scene `lpi run` integrates its own way (rollup); returns the exit status.
+    std::function<int(const OwnRun &)> run_own;
 };
+
 
 struct SceneOptions {
     int sine_euler_n = 31;  // lpi report sine-euler --N (both sine-Euler scenes)
+    double qg_kd = 1.0;     // lpi run qg --kd: the deformation wavenumber
     double long_run_time = 2000.0;  // lpi report sine-euler-long --T
     double inertia[3] = {1.0, 2.0, 3.0};  // lpi run rigid-body --inertia
 };
@@ -65,5 +78,11 @@ void run_long_scene(const LongRunScene &scene, const std::string &out_dir);
 // The Figure 2 scene: a long leapfrog run, energy error and Casimir drift
 // against time, written as CSV and PNG under out_dir.
 void run_figure2(const std::string &out_dir);
+
+// The roll-up scene: a smooth sine-Euler field run long (default N = 63,
+// 10^5 leapfrog steps of 0.05), the enstrophy fraction in the highest third of
+// the shells against time and the enstrophy spectrum at a few times, as CSV
+// and PNG under out_dir.
+int run_rollup(const OwnRun &run);
 
 }  // namespace lpi_cli

@@ -38,9 +38,11 @@ constexpr std::uint32_t kCheckpointVersion = 1;
 
 // How a checkpoint brings a model kind back. Each model kind that can be
 // saved (Model::checkpoint_parameters) has one, listed in checkpoint_kinds().
+// parameter_count kCheckedByKind: the count varies, state_size checks it.
+constexpr std::size_t kCheckedByKind = static_cast<std::size_t>(-1);
 struct CheckpointKind {
     const char *kind;  // Model::kind()
-    std::size_t parameter_count;
+    std::size_t parameter_count;  // or kCheckedByKind
     // The working-state length of the model these parameters (of the right
     // count) describe, without building it: a crafted file must not make the
     // library allocate a model far larger than the file. Throws lpi::Error

@@ -19,6 +19,7 @@
 #include <string>
 
 #include "../core/model.hpp"
+#include "sine_euler/hamiltonian.hpp"
 
 namespace lpi {
 
@@ -54,6 +55,10 @@ public:
     virtual void grid(const double *state, double *out) const = 0;
     virtual double enstrophy(const double *state) const = 0;
     virtual void casimir_traces(const double *state, int kmax, double *out) const = 0;
+    // The Hamiltonian every method, the energy and the diagnostics use
+    // (Euler's until set; see sine_euler/hamiltonian.hpp).
+    virtual const sine_euler::Hamiltonian &hamiltonian() const = 0;
+    virtual void set_hamiltonian(sine_euler::Hamiltonian H) = 0;
     // Runs the FFTs of `steps` steps of `flows_per_step` line flows each
     // (cycling over the pieces) on the model's own plans, buffers and
     // threads, on zeros, and times them: the floor under a splitting step.
@@ -78,10 +83,11 @@ std::mutex &fftw_planner_mutex();
 // ---- matrix form (sine_euler_matrix.cpp) ----------------------------------
 // W = sum_m w_m J_m, J_m = exp(2 pi i m1 m2 / N) g^m1 h^m2 (the transforms:
 // sine_euler/matrix_form.hpp). O(N^3) products, used only on request.
-// The vector field of eq. 5 through dW/dt = (i / (2 eps)) [P, W], exactly
-// Hermitian: the half plane is computed, the other half is its conjugate
-// and the inert mode w_0 does not move.
-void sine_euler_matrix_vector_field(int N, const double *modes, double *rate);
+// The vector field of eq. 5 through dW/dt = (i / (2 eps)) [P, W], P the
+// stream function of H, exactly Hermitian: the half plane is computed, the
+// other half is its conjugate and the inert mode w_0 does not move.
+void sine_euler_matrix_vector_field(const sine_euler::Hamiltonian &H, const double *modes,
+                                    double *rate);
 // (1/N) tr W^k, k = 1 .. kmax.
 void sine_euler_traces(int N, const double *modes, int kmax, double *out);
 // Sorted eigenvalues of the Hermitian W (LAPACK zheevd); LPI_ERR_OVERFLOW

@@ -4,7 +4,7 @@
 // So W = sum_m w_m J_m has W_{a,a+m2} = sum_m1 w_(m1,m2) exp(2 pi i m1 (2a + m2) / N),
 // and w_m = tr(W J_m^dagger) / N inverts it (the transforms are
 // sine_euler::MatrixForm's, by FFT). Eq. 5 is dW/dt = (i/(2 eps)) [P, W] with
-// P = sum_{n != 0} w_n / |n|^2 J_n. These serve diagnostics and the baseline
+// P = sum_{n != 0} (lambda_n w_n + f_n) J_n (Euler: w_n / |n|^2). These serve diagnostics and the baseline
 // methods, never the splitting's hot path; like the model, they need FFTW3.
 #include <algorithm>
 #include <cmath>
@@ -44,12 +44,14 @@ void multiply(int N, const cplx *A, const cplx *B, cplx *C) {
 
 }  // namespace
 
-void sine_euler_matrix_vector_field(int N, const double *modes, double *rate) {
+void sine_euler_matrix_vector_field(const sine_euler::Hamiltonian &H, const double *modes,
+                                    double *rate) {
+    const int N = H.truncation();
     const std::size_t n2 = static_cast<std::size_t>(N) * N;
     std::vector<cplx> W(n2), P(n2), PW(n2), WP(n2);
     sine_euler::MatrixForm form(N, sine_euler::MatrixForm::RowMajor);
     form.to_matrix(modes, W.data());
-    form.stream(W.data(), P.data());
+    form.stream(H, W.data(), P.data());
     multiply(N, P.data(), W.data(), PW.data());
     multiply(N, W.data(), P.data(), WP.data());
     const double eps = 2.0 * std::acos(-1.0) / N;

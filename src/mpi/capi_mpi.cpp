@@ -54,6 +54,8 @@ LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
         const int N = static_cast<const lpi::SineEulerModel &>(*cp.model).truncation();
         std::unique_ptr<lpi::Model> model = lpi::make_sine_euler_mpi(N, comm);
         model->set_split(cp.model->split());
+        static_cast<lpi::SineEulerModel &>(*model).set_hamiltonian(
+            static_cast<const lpi::SineEulerModel &>(*cp.model).hamiltonian());
         cp.state = lpi::local_state_of_modes(*model, cp.state.data());
         cp.model.reset();  // the whole field is not kept
         auto handle = std::make_unique<lpi_system>(std::move(model));

@@ -70,7 +70,27 @@ public:
     void set_split(const std::string &name) override { split_.select(name, kind()); }
     std::string split() const override { return split_.current(); }
     std::size_t piece_count() const override { return dirs_.size(); }
-    std::vector<double> checkpoint_parameters() const override { return {double(N_)}; }
+    // As the model of one process stores them: N, and lambda and f when they
+    // are not Euler's.
+    std::vector<double> checkpoint_parameters() const override {
+        std::vector<double> p = {double(N_)};
+        if (!hamiltonian_.is_default()) {
+            const std::vector<double> lambda_f = hamiltonian_.parameters();
+            p.insert(p.end(), lambda_f.begin(), lambda_f.end());
+        }
+        return p;
+    }
+    // Every process holds lambda and f whole: the line through the origin
+    // of each direction, whose spectrum drives the flow, meets every mode.
+    const Hamiltonian &hamiltonian() const override { return hamiltonian_; }
+    void set_hamiltonian(Hamiltonian H) override {
+        if (H.truncation() != N_)
+            fail(LPI_ERR_INTERNAL, "a Hamiltonian of N = " + std::to_string(H.truncation()) +
+                                       " given to a system of N = " + std::to_string(N_));
+        const std::vector<double> p = H.parameters();
+        require_same_input(p.data(), p.size(), "Hamiltonian (lambda and f)");
+        hamiltonian_ = std::move(H);
+    }
 
     void set_threads(int n) override {
         if (n < 1) fail(LPI_ERR_INVALID, "thread count must be >= 1, got " + std::to_string(n));
@@ -125,8 +145,8 @@ public:
         comm_->broadcast(out, static_cast<std::size_t>(kmax));
     }
     std::size_t casimir_count() const override { return static_cast<std::size_t>(N_); }
-    double energy(const double *state) const override { return 0.5 * sum_over_field(state, true); }
-    double enstrophy(const double *state) const override { return 0.5 * sum_over_field(state, false); }
+    double energy(const double *state) const override { return sum_over_field(state, true); }
+    double enstrophy(const double *state) const override { return sum_over_field(state, false); }
     // Only the baselines ask for it, and they are refused for a model spread
     // over processes (make_integrator).
     void vector_field(const double *, double *) const override {
@@ -172,6 +192,7 @@ private:
     int threads_ = 1;
     FftPlanning planning_ = FftPlanning::Estimate;
     std::unique_ptr<LineTransforms> transforms_;  // this process's lines, planned on the first flow
+    Hamiltonian hamiltonian_{N_};
 };
 
 LineTransforms &SineEulerMpi::transforms() {
@@ -241,42 +262,48 @@ std::vector<double> SineEulerMpi::local_state(const double *modes, std::size_t d
 // on every process.
 double SineEulerMpi::sum_over_field(const double *state, bool energy) const {
     const Direction &D = dirs_[static_cast<std::size_t>(state[0])];
-    auto weight = [&](int d, int s) {
-        if (!energy) return 1.0;
+    const double *lambda = hamiltonian_.weights(), *f = hamiltonian_.forcing();
+    // Mode (d, s) of D's lines: its term of H, or 1/2 |w|^2.
+    auto term = [&](int d, int s, const double *z) {
+        const double half_norm = 0.5 * (z[0] * z[0] + z[1] * z[1]);
+        if (!energy) return half_norm;
         int a, b;
         mpi::line_mode(D, N_, d, s, a, b);
-        const double m2 = norm2(a, b, N_);
-        return m2 == 0 ? 0.0 : 1.0 / m2;
+        const std::size_t m = mode_index(a, b, N_);
+        return lambda[m] * half_norm + (f ? f[2 * m] * z[0] + f[2 * m + 1] * z[1] : 0.0);
     };
     double sum = 0.0;
     const double *slab = state + mpi::slab_entry(N_);
+    // Lines d and -d are conjugate, with the same terms: the slab's count twice.
     for (int s = 0; s < N_; ++s)
-        for (int i = 0; i < mine_; ++i) {
-            const double *z = slab + 2 * (static_cast<std::size_t>(s) * mine_ + i);
-            sum += 2.0 * (z[0] * z[0] + z[1] * z[1]) * weight(first_ + i, s);
-        }
+        for (int i = 0; i < mine_; ++i)
+            sum += 2.0 * term(first_ + i, s, slab + 2 * (static_cast<std::size_t>(s) * mine_ + i));
     if (comm_->rank() == 0) {
         const double *line0 = state + mpi::line0_entry();
-        for (int s = 0; s < N_; ++s)
-            sum += (line0[2 * s] * line0[2 * s] + line0[2 * s + 1] * line0[2 * s + 1]) * weight(0, s);
+        for (int s = 0; s < N_; ++s) sum += term(0, s, line0 + 2 * s);
     }
     double total = 0.0;
     for (double part : comm_->allgather(sum)) total += part;
     return total;
 }
 
-// b_s = w_sk / |sk|^2 on the modes D owns, B = FFT(b), as the model of one
+// b_s = lambda_sk w_sk + f_sk on the modes D owns, B = FFT(b), as the model of one
 // process computes it. False when every b_s is zero.
 bool SineEulerMpi::line_spectrum(const Direction &D, const double *line0) {
     double *b = transforms_->spectrum();
+    const double *lambda = hamiltonian_.weights(), *f = hamiltonian_.forcing();
     bool active = false;
     for (int s = 0; s < N_; ++s) {
         if (D.owned[s]) {
             int a, c;
             mpi::line_mode(D, N_, 0, s, a, c);
-            const double scale = 1.0 / norm2(a, c, N_);
-            b[2 * s] = line0[2 * s] * scale;
-            b[2 * s + 1] = line0[2 * s + 1] * scale;
+            const std::size_t m = mode_index(a, c, N_);
+            b[2 * s] = line0[2 * s] * lambda[m];
+            b[2 * s + 1] = line0[2 * s + 1] * lambda[m];
+            if (f) {
+                b[2 * s] += f[2 * m];
+                b[2 * s + 1] += f[2 * m + 1];
+            }
             active = active || b[2 * s] != 0.0 || b[2 * s + 1] != 0.0;
         } else {
             b[2 * s] = b[2 * s + 1] = 0.0;

@@ -277,7 +277,8 @@ contains
         type(c_ptr) :: sys
         complex(c_double_complex) :: w(0:n - 1, 0:n - 1), back(0:n - 1, 0:n - 1), s
         real(c_double) :: grid(0:n - 1, 0:n - 1), grid2(0:n - 1, 0:n - 1), t0(4), t1(4), e
-        integer :: status, a, b, m1, m2, size_n
+        real(c_double) :: lambda(0:n - 1, 0:n - 1), energy(8), enstrophy(8), h
+        integer :: status, a, b, m1, m2, size_n, shells
         character(len=:), allocatable :: wisdom
         call lpi_sine_euler_create(sys, n, status)
         if (status == LPI_ERR_UNSUPPORTED) then
@@ -328,6 +329,29 @@ contains
         back(1, 2) = back(1, 2) + (0.0_c_double, 0.5_c_double)
         call lpi_sine_euler_set_modes(sys, back, status)
         call check(status == LPI_ERR_INVALID, "non-Hermitian modes refused")
+        ! SQG: lambda = 1/|m|; lpi_energy is then that H, and its shells add up to it.
+        do a = 0, n - 1
+            do b = 0, n - 1
+                m1 = merge(a - n, a, a > n / 2)
+                m2 = merge(b - n, b, b > n / 2)
+                lambda(a, b) = 0
+                if (a /= 0 .or. b /= 0) lambda(a, b) = 1 / sqrt(real(m1 * m1 + m2 * m2, c_double))
+            end do
+        end do
+        call lpi_sine_euler_set_hamiltonian(sys, lambda)
+        call lpi_sine_euler_get_modes(sys, w)
+        call lpi_energy(sys, e)
+        h = 0.5_c_double * sum(lambda * abs(w)**2)
+        call check(abs(e - h) < 1e-14_c_double, "SQG energy is 1/2 sum |w|^2 / |m|")
+        call lpi_sine_euler_spectrum(sys, energy, enstrophy, shells)
+        call check(shells == 4, "N = 7 has 4 shells (|m| up to 3 sqrt 2)")
+        call check(abs(sum(energy(1:shells)) - e) < 1e-14_c_double, "energy shells add up to H")
+        call lpi_sine_euler_get_stream(sys, grid2)
+        lambda(0, 1) = 2
+        call lpi_sine_euler_set_hamiltonian(sys, lambda, status=status)
+        call check(status == LPI_ERR_INVALID, "lambda not symmetric refused")
+        call lpi_energy(sys, h)
+        call check(h == e, "refused lambda changes nothing")
         call lpi_fftw_wisdom_export_string(wisdom)
         call check(index(wisdom, "fftw") > 0, "wisdom exported")
         call lpi_fftw_wisdom_import_string(wisdom)

@@ -1526,6 +1526,98 @@ class SineEuler(System):
         """
         self._call("lpi_sine_euler_set_planning", _c_string(rigor, "rigor"))
 
+    # ---- the sine-bracket family: any quadratic Hamiltonian ----
+
+    def set_hamiltonian(self, lam: Any, f: Any = None) -> None:
+        """Set H = 1/2 sum lambda_n |w_n|^2 + sum conj(f_n) w_n (n != 0).
+
+        Every method, `energy`, the diagnostics and checkpoints use it; the
+        state and the time are kept. Euler is lambda = 1/|n|^2, f = 0 (the
+        default); SQG is 1/|n|, QG 1/(|n|^2 + k_d^2), Euler over a topography
+        h is lambda = 1/|n|^2, f = -h/|n|^2 (see lpi_sine_euler_set_hamiltonian(3)).
+
+        Parameters
+        ----------
+        lam : array_like of float
+            N x N, in the modes' layout, symmetric (lambda_{-n} = lambda_n).
+        f : array_like of complex, optional
+            N x N, in the modes' layout, Hermitian (f_{-n} = conj(f_n));
+            None for f = 0.
+
+        Raises
+        ------
+        SizeError
+            lam or f not N x N.
+        NonFiniteError
+            An entry is not finite.
+        InvalidArgumentError
+            lam not symmetric or f not Hermitian; nothing is changed.
+        """
+        N = self.N
+        if np is not None:
+            a = _real_array(lam, "lam")
+            self._check_square(a.shape, "lam")
+            lam_ptr, n_lam, _keep_lam = _doubles_in(a.astype(np.float64).reshape(-1), "lam")
+        else:
+            rows = [list(row) for row in lam]
+            self._check_square(self._rows_shape(rows), "lam")
+            lam_ptr, n_lam, _keep_lam = _doubles_in([v for row in rows for v in row], "lam")
+        f_ptr, n_f, _keep_f = None, 0, None
+        if f is not None:
+            if np is not None:
+                b = np.ascontiguousarray(_real_array(f, "f", "iufc"), dtype=np.complex128)
+                self._check_square(b.shape, "f")
+                f_ptr, n_f, _keep_f = b.ctypes.data_as(_lib.c_double_p), 2 * b.size, b
+            else:
+                rows = [list(row) for row in f]
+                self._check_square(self._rows_shape(rows), "f")
+                flat = []
+                for z in (z for row in rows for z in row):
+                    if isinstance(z, (bool, str, bytes)) or not isinstance(z, numbers.Number):
+                        raise TypeError("f must be complex numbers, not %s" % type(z).__name__)
+                    flat.extend((complex(z).real, complex(z).imag))
+                f_ptr, n_f = (c_double * (2 * N * N))(*flat), 2 * N * N
+                _keep_f = f_ptr
+        self._call("lpi_sine_euler_set_hamiltonian", lam_ptr, n_lam, f_ptr, n_f)
+
+    def stream_function(self) -> Any:
+        """The stream function psi = sum (lambda_n w_n + f_n) exp(i n.x) on the grid.
+
+        Returns
+        -------
+        numpy.ndarray or list of list of float
+            N x N real values, laid out as `grid`.
+        """
+        N = self.N
+        if np is not None:
+            out = np.empty((N, N), dtype=np.float64)
+            self._call("lpi_sine_euler_get_stream", out.ctypes.data_as(_lib.c_double_p), N * N)
+            return out
+        buf = (c_double * (N * N))()
+        self._call("lpi_sine_euler_get_stream", buf, N * N)
+        return [list(buf[a * N:(a + 1) * N]) for a in range(N)]
+
+    def spectrum(self) -> Tuple[ArrayOut, ArrayOut]:
+        """Shell sums of the energy and enstrophy spectra.
+
+        Shell k = 1 .. K holds the modes with k - 1/2 <= |n| < k + 1/2;
+        the energy shells add up to H, the enstrophy shells to the
+        enstrophy less 1/2 w_0^2.
+
+        Returns
+        -------
+        tuple of (numpy.ndarray or list of float)
+            (energy, enstrophy), K values each; entry k - 1 is shell k.
+        """
+        shells = c_size_t()
+        status = lib.lpi_sine_euler_spectrum(self._h(), None, None, 0, byref(shells))
+        if status != STATUS["LPI_ERR_SIZE"]:  # the query fails only for its size
+            self._call("lpi_sine_euler_spectrum", None, None, 0, byref(shells))
+        energy_ptr, energy = _doubles_out(shells.value)
+        enstrophy_ptr, enstrophy = _doubles_out(shells.value)
+        self._call("lpi_sine_euler_spectrum", energy_ptr, enstrophy_ptr, shells.value, byref(shells))
+        return energy(), enstrophy()
+
 
 # ---- checkpoints ----------------------------------------------------------------
 

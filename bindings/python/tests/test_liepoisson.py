@@ -402,6 +402,35 @@ class TestSineEuler(unittest.TestCase):
             s.set_planning("exhaustive")
         self.assertEqual(s.planning, "measure")
 
+    def test_hamiltonian_stream_and_spectrum(self):
+        s, N = self.s, self.N
+        s.grid = self.random_grid()
+        c = lambda a: a - N if a > N // 2 else a
+        norm2 = [[c(a) ** 2 + c(b) ** 2 for b in range(N)] for a in range(N)]
+        sqg = [[1.0 / norm2[a][b] ** 0.5 if norm2[a][b] else 0.0 for b in range(N)] for a in range(N)]
+        f = [[0j] * N for _ in range(N)]
+        f[1][2], f[N - 1][N - 2] = 0.3 + 0.1j, 0.3 - 0.1j
+        s.set_hamiltonian(sqg, f)
+        modes = s.modes
+        expected = sum(0.5 * sqg[a][b] * abs(modes[a][b]) ** 2 + (f[a][b].conjugate() * modes[a][b]).real
+                       for a in range(N) for b in range(N))
+        self.assertLess(abs(s.energy() - expected), 1e-13)
+        energy, enstrophy = s.spectrum()
+        self.assertEqual(len(energy), int(((N - 1) // 2) * 2 ** 0.5 + 0.5))
+        self.assertLess(abs(sum(as_list(energy)) - s.energy()), 1e-13)
+        self.assertLess(abs(sum(as_list(enstrophy)) + 0.5 * modes[0][0].real ** 2 - s.enstrophy()), 1e-13)
+        psi = s.stream_function()
+        self.assertEqual(len(psi), N)
+        energy_before = s.energy()
+        bad = [row[:] for row in sqg]
+        bad[0][1] += 1.0  # not symmetric
+        with self.assertRaises(lp.InvalidArgumentError) as cm:
+            s.set_hamiltonian(bad)
+        self.assertIn("lpi_sine_euler_set_hamiltonian", cm.exception.message)
+        self.assertEqual(s.energy(), energy_before)
+        with self.assertRaises(lp.SizeError):
+            s.set_hamiltonian([[1.0] * N] * (N - 1))
+
     def test_wisdom(self):
         text = lp.fftw_wisdom_export_string()
         self.assertIn("fftw", text)

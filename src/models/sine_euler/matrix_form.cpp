@@ -5,7 +5,6 @@
 
 #include "../../core/error.hpp"
 #include "../sine_euler.hpp"
-#include "indexing.hpp"
 #include "lpi_config.h"
 
 #if LPI_HAVE_FFTW
@@ -19,19 +18,13 @@ struct MatrixForm::Plans {
 };
 
 MatrixForm::MatrixForm(int N, Layout layout)
-    : N_(N), index_(static_cast<std::size_t>(N) * N), inverse_laplacian_(index_.size()) {
+    : N_(N), index_(static_cast<std::size_t>(N) * N) {
     const std::size_t n = static_cast<std::size_t>(N);
     const std::size_t half = (n + 1) / 2;  // the inverse of 2 mod N (N odd)
     for (std::size_t m2 = 0; m2 < n; ++m2)
         for (std::size_t k = 0; k < n; ++k) {
             const std::size_t a = (k + n - m2) * half % n, b = (a + m2) % n;
             index_[m2 * n + k] = layout == ColumnMajor ? a + b * n : a * n + b;
-        }
-    for (std::size_t m2 = 0; m2 < n; ++m2)
-        for (std::size_t m1 = 0; m1 < n; ++m1) {
-            const double m_squared = norm2(static_cast<int>(m1), static_cast<int>(m2), N);
-            inverse_laplacian_[m2 * n + m1] =
-                m_squared != 0 ? 1.0 / (static_cast<double>(N) * m_squared) : 0.0;
         }
     std::lock_guard<std::mutex> lock(fftw_planner_mutex());
     plans_ = new Plans;
@@ -88,10 +81,20 @@ void MatrixForm::to_modes(const cplx *W, double *modes) {
         for (std::size_t m2 = 0; m2 < N; ++m2) w[m1 * N + m2] = scale * buffer_[m2 * N + m1];
 }
 
-void MatrixForm::stream(const cplx *W, cplx *P) {
+void MatrixForm::stream(const Hamiltonian &H, const cplx *W, cplx *P) {
+    const std::size_t N = static_cast<std::size_t>(N_);
     gather(W);
     fftw_execute(plans_->forward);
-    for (std::size_t i = 0; i < index_.size(); ++i) buffer_[i] *= inverse_laplacian_[i];
+    // The buffer holds N w_m at [m2 N + m1]; lambda_0 = f_0 = 0 drop the inert mode.
+    const double *lambda = H.weights();
+    const cplx *f = reinterpret_cast<const cplx *>(H.forcing());
+    const double inverse_n = 1.0 / N_;
+    for (std::size_t m2 = 0; m2 < N; ++m2)
+        for (std::size_t m1 = 0; m1 < N; ++m1) {
+            cplx &psi = buffer_[m2 * N + m1];
+            psi *= lambda[m1 * N + m2] * inverse_n;
+            if (f) psi += f[m1 * N + m2];
+        }
     fftw_execute(plans_->backward);
     scatter(P);
 }

@@ -1,16 +1,19 @@
 // The transforms between the sine-Euler modes and the matrix W = sum_m w_m J_m
 // (J_m = exp(2 pi i m1 m2 / N) g^m1 h^m2, g = diag(q^a), q = exp(4 pi i / N),
-// h e_a = e_{a-1}), and W -> P(W) = sum_{n != 0} w_n / |n|^2 J_n.
+// h e_a = e_{a-1}), and W -> P(W) = sum_{n != 0} (lambda_n w_n + f_n) J_n, the
+// stream function of a Hamiltonian (hamiltonian.hpp; Euler: w_n / |n|^2).
 // Entry (a, a + m2) of W is sum_m1 w_(m1,m2) exp(2 pi i m1 k / N) with
 // k = 2a + m2 (mod N): each cyclic diagonal m2 of W, indexed by k, is a DFT of
 // the modes with that m2. So modes <-> matrix is 2N FFTs of length N, and
-// P(W) is, diagonal by diagonal, a DFT, a division by |m|^2 and a DFT back.
+// P(W) is, diagonal by diagonal, a DFT, psi = lambda w + f and a DFT back.
 // Needs FFTW3 (as the sine-Euler model does).
 #pragma once
 
 #include <complex>
 #include <cstddef>
 #include <vector>
+
+#include "hamiltonian.hpp"
 
 namespace lpi {
 namespace sine_euler {
@@ -26,8 +29,8 @@ public:
 
     void to_matrix(const double *modes, cplx *W);
     void to_modes(const cplx *W, double *modes);
-    // P = sum_{n != 0} w_n / |n|^2 J_n for W = sum_n w_n J_n.
-    void stream(const cplx *W, cplx *P);
+    // P = sum_{n != 0} (lambda_n w_n + f_n) J_n for W = sum_n w_n J_n.
+    void stream(const Hamiltonian &H, const cplx *W, cplx *P);
 
 private:
     void gather(const cplx *W);
@@ -36,7 +39,6 @@ private:
 
     int N_;
     std::vector<std::size_t> index_;        // [m2 * N + k] -> entry (a, a + m2) of W
-    std::vector<double> inverse_laplacian_;  // [m2 * N + m1] = 1 / (N |m|^2), 0 at m = 0
     struct Plans;
     Plans *plans_ = nullptr;
     cplx *buffer_ = nullptr;

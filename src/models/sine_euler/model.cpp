@@ -3,11 +3,15 @@
 // geometry (projective_line), the transforms, the kernels and the
 // coordinates.
 //
-// The line flow. For a direction k, the piece H_k = 1/2 sum |w_sk|^2 / |sk|^2
-// (over the modes it owns) leaves the line sigma_k = {s k} fixed and moves
-// each parallel line {d j + s k}, c = (d j) x k, by the circulant system
-// dz_p/dt = sum_n a_n z_{p-n}, a_n = -sin(eps n c) / (eps |nk|^2) w_nk
-// (eq. 5 restricted to the piece). With b_n = w_nk / |nk|^2 and
+// The line flow. For a direction k, the piece
+// H_k = sum (1/2 lambda_sk |w_sk|^2 + conj(f_sk) w_sk) over the modes it owns
+// (Euler: lambda = 1/|n|^2, f = 0) leaves the line sigma_k = {s k} fixed (its
+// modes commute with one another: sk x s'k = 0) and moves each parallel line
+// {d j + s k}, c = (d j) x k, by the circulant system
+// dz_p/dt = sum_n a_n z_{p-n}, a_n = -sin(eps n c) / eps b_n with the stream
+// function b_n = dH_k/dw_{-nk} = lambda_nk w_nk + f_nk on the owned modes
+// (eq. 5 restricted to the piece); b is constant under the piece's own flow,
+// so the coefficients are. With
 // B_l = sum_n b_n exp(-2 pi i n l / N) (real, as b is Hermitian), the DFT
 // eigenvalues on line c are
 //     Lambda_l = (i / (2 eps)) (B_{l-c} - B_{l+c}),
@@ -81,7 +85,8 @@ int this_thread() {
 class SineEuler final : public SineEulerModel {
 public:
     explicit SineEuler(int N)
-        : N_(N), blocks_(N), eps_(2.0 * std::acos(-1.0) / N), dirs_(projective_line(N)) {}
+        : N_(N), blocks_(N), eps_(2.0 * std::acos(-1.0) / N), dirs_(projective_line(N)),
+          hamiltonian_(N) {}
 
     const char *kind() const override { return "sine-euler"; }
     int truncation() const override { return N_; }
@@ -93,8 +98,23 @@ public:
     std::string split() const override { return split_.current(); }
     std::size_t piece_count() const override { return dirs_.size(); }
     // The thread count is a runtime setting (results are identical for every
-    // count), so N is all a checkpoint needs.
-    std::vector<double> checkpoint_parameters() const override { return {double(N_)}; }
+    // count): N, and lambda and f when they are not Euler's (so that the
+    // checkpoints of Euler keep their bytes; sine_euler_checkpoint.cpp).
+    std::vector<double> checkpoint_parameters() const override {
+        std::vector<double> p{double(N_)};
+        if (!hamiltonian_.is_default()) {
+            const std::vector<double> lambda_f = hamiltonian_.parameters();
+            p.insert(p.end(), lambda_f.begin(), lambda_f.end());
+        }
+        return p;
+    }
+    const Hamiltonian &hamiltonian() const override { return hamiltonian_; }
+    void set_hamiltonian(Hamiltonian H) override {
+        if (H.truncation() != N_)
+            fail(LPI_ERR_INTERNAL, "a Hamiltonian of N = " + std::to_string(H.truncation()) +
+                                       " given to a system of N = " + std::to_string(N_));
+        hamiltonian_ = std::move(H);
+    }
 
     void set_threads(int n) override {
         if (n < 1) fail(LPI_ERR_INVALID, "thread count must be >= 1, got " + std::to_string(n));
@@ -117,17 +137,7 @@ public:
 
     void flow(std::size_t piece, double t, double *state) override;
 
-    double energy(const double *state) const override {
-        double sum = 0.0;
-        for (int a = 0; a < N_; ++a)
-            for (int b = 0; b < N_; ++b) {
-                const double m2 = norm2(a, b, N_);
-                if (m2 == 0) continue;
-                const double *z = state + 2 * mode_index(a, b, N_);
-                sum += (z[0] * z[0] + z[1] * z[1]) / m2;
-            }
-        return 0.5 * sum;
-    }
+    double energy(const double *state) const override { return hamiltonian_.energy(state); }
     double enstrophy(const double *state) const override {
         double sum = 0.0;
         for (std::size_t i = 0; i < 2 * dim(); ++i) sum += state[i] * state[i];
@@ -141,7 +151,7 @@ public:
         sine_euler_traces(N_, state, kmax, out);
     }
     void vector_field(const double *state, double *rate) const override {
-        sine_euler_matrix_vector_field(N_, state, rate);
+        sine_euler_matrix_vector_field(hamiltonian_, state, rate);
     }
 
     TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) override;
@@ -164,6 +174,7 @@ private:
     LineBlocks blocks_;
     double eps_;
     std::vector<Direction> dirs_;
+    Hamiltonian hamiltonian_;
     SplitChoice split_{{"directions"}};
     int threads_ = 1;
     FftPlanning planning_ = FftPlanning::Estimate;
@@ -176,18 +187,23 @@ LineTransforms &SineEuler::transforms() {
     return *transforms_;
 }
 
-// b_s = w_sk / |sk|^2 on the owned modes, B = FFT(b) (real). Returns false
-// when every b_s is zero.
+// b_s = lambda_sk w_sk + f_sk on the owned modes, B = FFT(b) (real).
+// Returns false when every b_s is zero.
 bool SineEuler::line_spectrum(const Direction &D, const double *w) {
     const int N = N_;
     double *b = transforms_->spectrum();
+    const double *lambda = hamiltonian_.weights(), *f = hamiltonian_.forcing();
     int a = 0, c = 0;
     bool active = false;
     for (int s = 0; s < N; ++s) {
         if (D.owned[s]) {
-            const double scale = 1.0 / norm2(a, c, N);
-            b[2 * s] = w[2 * mode_index(a, c, N)] * scale;
-            b[2 * s + 1] = w[2 * mode_index(a, c, N) + 1] * scale;
+            const std::size_t m = mode_index(a, c, N);
+            b[2 * s] = w[2 * m] * lambda[m];
+            b[2 * s + 1] = w[2 * m + 1] * lambda[m];
+            if (f) {
+                b[2 * s] += f[2 * m];
+                b[2 * s + 1] += f[2 * m + 1];
+            }
             active = active || b[2 * s] != 0.0 || b[2 * s + 1] != 0.0;
         } else {
             b[2 * s] = b[2 * s + 1] = 0.0;
@@ -225,7 +241,7 @@ void SineEuler::move_block(const Direction &D, int block, double *x, double *w) 
 void SineEuler::flow(std::size_t piece, double t, double *state) {
     transforms();
     const Direction &D = dirs_[piece];
-    // A piece whose modes are all zero has H_k = 0: its flow is the identity
+    // A piece whose stream function is zero on its line moves nothing: its flow is the identity
     // (taken exactly, not through a round trip of FFTs).
     if (!line_spectrum(D, state)) return;
     const int blocks = blocks_.count();
@@ -302,7 +318,8 @@ std::string gib(double bytes) {
 }
 
 // A sine-Euler system holds two working states of 2 N^2 doubles (the state
-// and the copy a failed step rolls back to), one byte per mode and direction
+// and the copy a failed step rolls back to), the N^2 doubles of lambda (the
+// Hamiltonian's f, 2 N^2 more, is allocated when set), one byte per mode and direction
 // to say which modes each piece owns, and for composite N one byte per mode
 // while the directions are built. Refused before anything is allocated when
 // that cannot be had: zero-filling vectors larger than the machine would
@@ -314,11 +331,11 @@ void require_memory(int N) {
     const std::size_t n = N;
     std::size_t modes = 0, states = 0, tables = 0, bytes = 0;
     const bool fits = checked_multiply(n, n, modes) &&
-                      checked_multiply(modes, 2 * 2 * sizeof(double), states) &&
+                      checked_multiply(modes, (2 * 2 + 1) * sizeof(double), states) &&
                       checked_multiply(classes + (prime ? 0 : n), n, tables) &&
                       states <= SIZE_MAX - tables;
     const std::string what = "sine-Euler N = " + std::to_string(N) + " needs ";
-    const std::string parts = " (two working states of 2 N^2 doubles and the direction tables)";
+    const std::string parts = " (two working states of 2 N^2 doubles, lambda and the direction tables)";
     if (!fits)
         fail(LPI_ERR_NO_MEMORY, what + "more than " + std::to_string(SIZE_MAX) + " bytes" + parts);
     bytes = states + tables;

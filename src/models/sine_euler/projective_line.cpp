@@ -124,16 +124,16 @@ std::vector<Direction> projective_line(int N) {
     return dirs;
 }
 
-double piece_energy(const Direction &D, int N, const double *modes) {
+double piece_energy(const Direction &D, const Hamiltonian &H, const double *modes) {
+    const int N = H.truncation();
     double sum = 0.0;
     for (int s = 1; s < N; ++s) {
         if (!D.owned[s]) continue;
         const int a = modulo(static_cast<std::int64_t>(s) * D.k1, N);
         const int b = modulo(static_cast<std::int64_t>(s) * D.k2, N);
-        const double *z = modes + 2 * mode_index(a, b, N);
-        sum += (z[0] * z[0] + z[1] * z[1]) / norm2(a, b, N);
+        sum += H.mode_energy(mode_index(a, b, N), modes);
     }
-    return 0.5 * sum;
+    return sum;
 }
 
 }  // namespace sine_euler

@@ -9,11 +9,13 @@
 #include <cstddef>
 #include <vector>
 
+#include "hamiltonian.hpp"
+
 namespace lpi {
 namespace sine_euler {
 
-// One direction k of Z_N^2. The piece H_k = 1/2 sum |w_sk|^2 / |sk|^2 over
-// the modes it owns leaves the line {s k} fixed and moves each parallel line
+// One direction k of Z_N^2. The piece H_k, the terms of H of the modes it
+// owns (1/2 sum |w_sk|^2 / |sk|^2 for Euler), leaves the line {s k} fixed and moves each parallel line
 // {d j + s k}, d = 1 .. M (M = (N-1)/2; the lines -d are their conjugates).
 struct Direction {
     int k1, k2;          // the direction
@@ -39,8 +41,8 @@ std::vector<Direction> projective_line(int N);
 // The odd primes dividing N.
 std::vector<int> prime_factors(int N);
 
-// The energy of piece D, H_k = 1/2 sum |w_sk|^2 / |sk|^2 over the modes it owns.
-double piece_energy(const Direction &D, int N, const double *modes);
+// The energy of piece D: the terms of H of the modes it owns.
+double piece_energy(const Direction &D, const Hamiltonian &H, const double *modes);
 
 // Lines d = 1 .. M of a direction, in blocks of kBlock. The block size is
 // fixed (not derived from the thread count), so each block meets the same

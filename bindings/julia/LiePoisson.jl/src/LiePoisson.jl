@@ -111,6 +111,14 @@ lpi_sine_euler_set_planning(sys, rigor) =
     ccall(_sym(:lpi_sine_euler_set_planning), Cint, (Sys, Cstring), sys, rigor)
 lpi_sine_euler_get_planning(sys, rigor) =
     ccall(_sym(:lpi_sine_euler_get_planning), Cint, (Sys, Ptr{Cstring}), sys, rigor)
+lpi_sine_euler_set_hamiltonian(sys, lambda, n_lambda, f, n_f) =
+    ccall(_sym(:lpi_sine_euler_set_hamiltonian), Cint, (Sys, Ptr{Cdouble}, Csize_t, Ptr{Cdouble}, Csize_t),
+          sys, lambda, n_lambda, f, n_f)
+lpi_sine_euler_get_stream(sys, psi, n) =
+    ccall(_sym(:lpi_sine_euler_get_stream), Cint, (Sys, Ptr{Cdouble}, Csize_t), sys, psi, n)
+lpi_sine_euler_spectrum(sys, energy, enstrophy, n, shells) =
+    ccall(_sym(:lpi_sine_euler_spectrum), Cint, (Sys, Ptr{Cdouble}, Ptr{Cdouble}, Csize_t, Ptr{Csize_t}),
+          sys, energy, enstrophy, n, shells)
 lpi_set_threads(sys, n) = ccall(_sym(:lpi_set_threads), Cint, (Sys, Int32), sys, n)
 lpi_fftw_wisdom_import_file(path) = ccall(_sym(:lpi_fftw_wisdom_import_file), Cint, (Cstring,), path)
 lpi_fftw_wisdom_export_file(path) = ccall(_sym(:lpi_fftw_wisdom_export_file), Cint, (Cstring,), path)
@@ -407,6 +415,36 @@ function planning(sys::System)
     out = Ref{Cstring}(C_NULL); _call(h -> C.lpi_sine_euler_get_planning(h, out), sys); unsafe_string(out[])
 end
 
+# The sine-bracket family: H = 1/2 sum lambda_n |w_n|^2 + sum conj(f_n) w_n
+# (lambda[a+1, b+1] and f[a+1, b+1] belong to mode (a, b); f = nothing for 0).
+function set_hamiltonian!(sys::System, lambda::AbstractMatrix{<:Real},
+                          f::Union{Nothing,AbstractMatrix{<:Number}} = nothing)
+    lam = Matrix{Float64}(permutedims(lambda))
+    if f === nothing
+        _call(h -> C.lpi_sine_euler_set_hamiltonian(h, lam, length(lam), C_NULL, 0), sys)
+    else
+        fbuf = Matrix{ComplexF64}(permutedims(f))
+        _call(h -> C.lpi_sine_euler_set_hamiltonian(h, lam, length(lam),
+                                                    Ptr{Cdouble}(pointer(fbuf)), 2 * length(fbuf)), sys)
+    end
+end
+"""stream_function(sys): psi = sum (lambda_n w_n + f_n) exp(i n.x) on the grid."""
+function stream_function(sys::System)
+    N = sine_euler_size(sys)
+    buf = Matrix{Float64}(undef, N, N)
+    _call(h -> C.lpi_sine_euler_get_stream(h, buf, N * N), sys)
+    permutedims(buf)
+end
+"""spectrum(sys): (energy, enstrophy) shell sums, entry k for k - 1/2 <= |n| < k + 1/2."""
+function spectrum(sys::System)
+    shells = Ref{Csize_t}(0)
+    st = GC.@preserve sys C.lpi_sine_euler_spectrum(_h(sys), C_NULL, C_NULL, 0, shells)
+    st == -3 || _call(h -> C.lpi_sine_euler_spectrum(h, C_NULL, C_NULL, 0, shells), sys)
+    e = Vector{Float64}(undef, shells[]); z = Vector{Float64}(undef, shells[])
+    _call(h -> C.lpi_sine_euler_spectrum(h, e, z, length(e), shells), sys)
+    (energy = e, enstrophy = z)
+end
+
 # ---- FFTW wisdom (process-wide) ------------------------------------------------------
 fftw_wisdom_import_file(path::AbstractString) = _check(C.lpi_fftw_wisdom_import_file(path))
 fftw_wisdom_export_file(path::AbstractString) = _check(C.lpi_fftw_wisdom_export_file(path))
@@ -426,6 +464,7 @@ export LiePoissonError, RigidBody, Pendulum, Generic, Moments, SineEuler, System
     set_method!, set_split!, set_composition!, flows_per_step, set_implicit_options!,
     set_threads!, dim, state, set_state!, step!, energy, casimir_count, casimirs, last_error,
     exact, poisson_rank, add_piece!, add_casimir!, add_product_piece!, sine_euler_size, modes,
-    set_modes!, grid, set_grid!, enstrophy, casimir_traces, fft_floor, set_planning!, planning
+    set_modes!, grid, set_grid!, enstrophy, casimir_traces, fft_floor, set_planning!, planning,
+    set_hamiltonian!, stream_function, spectrum
 
 end # module

@@ -1,0 +1,57 @@
+#include "hamiltonians.hpp"
+
+#include <cmath>
+#include <vector>
+
+#include "fields.hpp"
+#include "systems.hpp"
+
+namespace lpi_cli {
+
+namespace {
+
+// |n|^2 of mode (a, b) (representatives in -M..M), in the modes' FFT order.
+double norm2(int a, int b, int N) {
+    const double ra = a > N / 2 ? a - N : a, rb = b > N / 2 ? b - N : b;
+    return ra * ra + rb * rb;
+}
+
+// lambda_n = weight(|n|^2) for n != 0 (the zero mode's entry is ignored).
+template <class Weight>
+std::vector<double> lambda_of(int N, Weight weight) {
+    std::vector<double> lambda(static_cast<std::size_t>(N) * N, 0.0);
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b)
+            if (a || b) lambda[static_cast<std::size_t>(a) * N + b] = weight(norm2(a, b, N));
+    return lambda;
+}
+
+Handle with_hamiltonian(int N, const std::vector<double> &lambda, const std::vector<double> &f) {
+    Handle h = sine_euler(N, smooth_random_field(N, 3.0, 7));
+    check(lpi_sine_euler_set_hamiltonian(h.get(), lambda.data(), lambda.size(), f.empty() ? nullptr : f.data(),
+                                         f.size()),
+          h.get(), "set Hamiltonian");
+    return h;
+}
+
+}  // namespace
+
+Handle sqg_system(int N) {
+    return with_hamiltonian(N, lambda_of(N, [](double m2) { return 1.0 / std::sqrt(m2); }), {});
+}
+
+Handle qg_system(int N, double kd) {
+    return with_hamiltonian(N, lambda_of(N, [kd](double m2) { return 1.0 / (m2 + kd * kd); }), {});
+}
+
+Handle topography_system(int N) {
+    const std::vector<double> lambda = lambda_of(N, [](double m2) { return 1.0 / m2; });
+    std::vector<double> f = smooth_random_field(N, 2.0, 11);  // the modes of h
+    for (std::size_t i = 0; i < lambda.size(); ++i) {
+        f[2 * i] *= -lambda[i];
+        f[2 * i + 1] *= -lambda[i];
+    }
+    return with_hamiltonian(N, lambda, f);
+}
+
+}  // namespace lpi_cli
