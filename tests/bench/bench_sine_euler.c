@@ -82,7 +82,7 @@ int main(void) {
     printf("sine-Euler, leapfrog (time per step; floor = FFTW alone, same plans and transforms)\n");
     printf("%5s %10s %12s %12s %7s %12s %12s %9s\n", "N", "FFTs/step", "step 1T", "floor 1T",
            "ratio", "step 2T", "floor 2T", "speed-up");
-    const int Ns[] = {31, 61, 125, 127, 243, 251, 509};
+    const int Ns[] = {31, 61, 125, 127, 243, 251, 375, 509, 625};
     for (size_t i = 0; i < sizeof Ns / sizeof Ns[0]; ++i) {
         const int N = Ns[i];
         lpi_system *sys = make(N);

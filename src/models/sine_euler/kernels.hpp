@@ -17,12 +17,13 @@ void gather_block(const Direction &D, int N, int d0, int count, int first_lane, 
                   double *x);
 // Adds the increments x (as gathered) to those lines of w, in place, and
 // writes the conjugates of the sums to the mirror lines -d (which no block
-// gathers), so every mode is written once. x is overwritten with the sums.
-void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, double *x,
+// gathers), so every mode is written once.
+void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
                    double *w);
 // Multiplies the transformed block x (N rows of `count` lines) by the line
 // flows' increments (exp(t Lambda_l) - 1) / N; up and down point into the
-// phase tables at entry N + d0 (see the definition).
+// phase tables at entry N + d0 (up: v_l / N, down: v_l / N then v_l; see
+// the definition).
 void apply_phase(int N, int count, const double *up, const double *down, double sign, double *x);
 
 }  // namespace sine_euler

@@ -203,22 +203,28 @@ bool SineEuler::line_spectrum(const Direction &D, const double *w) {
 }
 
 // v_l = u_l - 1 = exp(i phi_l) - 1 = (-2 sin^2(phi_l / 2), sin phi_l), phi_l =
-// factor B_l with factor = t / (2 eps), stored three times over, forwards and
-// backwards, so that v_{l-c} and v_{l+c} need no reduction mod N and run
-// forwards along the lines of a block. Each l writes its own entries only, so
-// threads may share the loop over l.
+// factor B_l with factor = t / (2 eps), stored three times over, forwards
+// (up: v_l / N) and backwards (down: v_l / N, then v_l), so that v_{l-c} and
+// v_{l+c} need no reduction mod N and run forwards along the lines of a block
+// (see apply_phase). Each l writes its own entries only, so threads may share
+// the loop over l.
 void SineEuler::line_phase(int l, double factor) {
     const std::size_t N = N_;
     double *up = transforms_->up(), *down = transforms_->down();
     const double angle = factor * transforms_->spectrum()[2 * l];
     const double half = std::sin(0.5 * angle);
     const double re = -2.0 * half * half, im = std::sin(angle);
+    const double n_real = N_;
+    const double scaled_re = re / n_real, scaled_im = im / n_real;
     const std::size_t minus = l == 0 ? 0 : N - l;
     for (std::size_t copy = 0; copy < 3; ++copy) {
-        up[2 * (l + copy * N)] = re;
-        up[2 * (l + copy * N) + 1] = im;
-        down[2 * (minus + copy * N)] = re;
-        down[2 * (minus + copy * N) + 1] = im;
+        double *forwards = up + 2 * (l + copy * N), *backwards = down + 4 * (minus + copy * N);
+        forwards[0] = scaled_re;
+        forwards[1] = scaled_im;
+        backwards[0] = scaled_re;
+        backwards[1] = scaled_im;
+        backwards[2] = re;
+        backwards[3] = im;
     }
 }
 
@@ -231,8 +237,8 @@ void SineEuler::move_block(const Direction &D, int block, double *x, double *w) 
     const int first_lane = blocks_.first_lane(block);
     gather_block(D, N_, d0, count, first_lane, w, x);
     transforms_->forward(count, x);
-    const std::size_t phase0 = 2 * (static_cast<std::size_t>(N_) + d0);
-    apply_phase(N_, count, transforms_->up() + phase0, transforms_->down() + phase0, -D.sigma, x);
+    const std::size_t phase0 = static_cast<std::size_t>(N_) + d0;
+    apply_phase(N_, count, transforms_->up() + 2 * phase0, transforms_->down() + 4 * phase0, -D.sigma, x);
     transforms_->backward(count, x);
     scatter_block(D, N_, d0, count, first_lane, x, w);
 }
