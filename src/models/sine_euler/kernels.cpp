@@ -57,40 +57,36 @@ inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
     });
 }
 
-// Adds n increments to positions p0 .. p0+n-1 (p0 + n <= N) of a lane, keeps
-// the sums in `increment`, and writes their conjugates at positions
-// -(p0 + r) mod N of the mirror lane.
-inline void put_run(int N, std::size_t step, int p0, int n, double *__restrict increment, double *lane,
-                    double *mirror) {
+// Adds n increments to positions p0 .. p0+n-1 (p0 + n <= N) of a lane and
+// writes the conjugates of the sums at positions -(p0 + r) mod N of the
+// mirror lane, in one pass (the sums are not stored twice).
+inline void put_run(int N, std::size_t step, int p0, int n, const double *__restrict increment,
+                    double *lane, double *mirror) {
     if (n <= 0) return;
-    for (int r = 0; r < n; ++r) {
-        double *z = lane + 2 * step * (p0 + r);
-        const double re = z[0] + increment[2 * r], im = z[1] + increment[2 * r + 1];
-        z[0] = increment[2 * r] = re;
-        z[1] = increment[2 * r + 1] = im;
-    }
     int r0 = 0;
     if (p0 == 0) {  // position 0 is its own mirror position
-        mirror[0] = increment[0];
-        mirror[1] = -increment[1];
+        const double re = lane[0] + increment[0], im = lane[1] + increment[1];
+        lane[0] = mirror[0] = re;
+        lane[1] = im;
+        mirror[1] = -im;
         r0 = 1;
     }
-    // Upwards through the mirror lane: position N - p0 - r, r = n-1 .. r0.
-    double *m = mirror + 2 * step * (N - p0 - (n - 1));
-    const double *z = increment + 2 * (n - 1);
-    for (int q = 0; q < n - r0; ++q) {
-        m[2 * step * q] = z[-2 * q];
-        m[2 * step * q + 1] = -z[-2 * q + 1];
+    for (int r = r0; r < n; ++r) {
+        double *z = lane + 2 * step * (p0 + r), *m = mirror + 2 * step * (N - p0 - r);
+        const double re = z[0] + increment[2 * r], im = z[1] + increment[2 * r + 1];
+        z[0] = m[0] = re;
+        z[1] = im;
+        m[1] = -im;
     }
 }
 
 template <bool Rows, int Count>
-inline void scatter_runs(int N, int slope, int d0, int count, int first_lane, double *__restrict x,
-                         double *w) {
+inline void scatter_runs(int N, int slope, int d0, int count, int first_lane,
+                         const double *__restrict x, double *w) {
     const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
     const int n = Count > 0 ? Count : count;
     for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
-        double *src = x + 2 * static_cast<std::size_t>(s) * n;
+        const double *src = x + 2 * static_cast<std::size_t>(s) * n;
         double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
         if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
             put_run(N, step, o, n, src, dst, mirror);
@@ -133,7 +129,7 @@ inline void gather_general(const Direction &D, int N, int d0, int count, const d
     });
 }
 
-inline void scatter_general(const Direction &D, int N, int d0, int count, double *x, double *w) {
+inline void scatter_general(const Direction &D, int N, int d0, int count, const double *x, double *w) {
     for_each_block_mode(D, N, d0, count, [&](std::size_t e, int a, int b) {
         double *dst = w + 2 * mode_index(a, b, N);
         dst[0] += x[2 * e];
@@ -165,7 +161,7 @@ void gather_block(const Direction &D, int N, int d0, int count, int first_lane, 
 }
 
 LPI_SIMD_CLONES
-void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, double *x,
+void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
                    double *w) {
     switch (D.layout) {
         case Direction::Row:
@@ -184,25 +180,27 @@ void scatter_block(const Direction &D, int N, int d0, int count, int first_lane,
 // u_{l-c} conj(u_{l+c}) is e = u_{l+d} conj(u_{l-d}) for sigma = -1 and
 // conj(e) for sigma = +1: `sign` = -sigma multiplies Im e, an exact negation.
 // With p = v_{l+d}, q = v_{l-d} (v = u - 1), e - 1 = p + conj(q) + p conj(q):
-// no cancellation, each term as small as the angles. With up = &up[N + d0],
-// down = &down[N + d0], v_{l+d} = up[l + i] and v_{l-d} = down[i - l]: both
-// run forwards along a row of x, so the loop vectorises. Dividing by N, not
-// multiplying by a rounded 1/N, which would scale every increment by the
-// same N fl(1/N) != 1.
+// no cancellation, each term as small as the angles. The tables hold P = p / N
+// (up) and Q = q / N next to q (down), each divided once per flow, so that
+// (e - 1) / N = P + conj(Q) + P conj(q) needs no division here (dividing, not
+// multiplying by a rounded 1/N, which would scale every increment by the same
+// N fl(1/N) != 1). With up = &up[N + d0], down = &down[N + d0], P_{l+d} =
+// up[l + i] and (Q, q)_{l-d} = down[i - l]: both run forwards along a row of
+// x, so the loop vectorises.
 LPI_SIMD_CLONES
 void apply_phase(int N, int count, const double *up, const double *down, double sign, double *x) {
-    const double n_real = N;
     for (int l = 0; l < N; ++l) {
         double *z = x + 2 * static_cast<std::size_t>(l) * count;
         const double *p = up + 2 * l;
-        const double *q = down - 2 * l;
+        const double *q = down - 4 * l;
         for (int i = 0; i < count; ++i) {
-            const double pr = p[2 * i], pi = p[2 * i + 1], qr = q[2 * i], qi = q[2 * i + 1];
-            const double er = (pr + qr) + (pr * qr + pi * qi);
-            const double ei = sign * ((pi - qi) + (pi * qr - pr * qi));
+            const double pr = p[2 * i], pi = p[2 * i + 1];
+            const double Qr = q[4 * i], Qi = q[4 * i + 1], qr = q[4 * i + 2], qi = q[4 * i + 3];
+            const double er = (pr + Qr) + (pr * qr + pi * qi);
+            const double ei = sign * ((pi - Qi) + (pi * qr - pr * qi));
             const double zr = z[2 * i], zi = z[2 * i + 1];
-            z[2 * i] = (er * zr - ei * zi) / n_real;
-            z[2 * i + 1] = (er * zi + ei * zr) / n_real;
+            z[2 * i] = er * zr - ei * zi;
+            z[2 * i + 1] = er * zi + ei * zr;
         }
     }
 }

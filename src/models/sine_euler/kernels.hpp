@@ -20,31 +20,38 @@ void gather_block(const Direction &D, int N, int d0, int count, int first_lane, 
                   double *x);
 // Adds the increments x (as gathered) to those lines of w, in place, and
 // writes the conjugates of the sums to the mirror lines -d (which no block
-// gathers), so every mode is written once. x is overwritten with the sums.
-void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, double *x,
+// gathers), so every mode is written once.
+void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
                    double *w);
 // Multiplies the transformed block x (N rows of `count` lines) by the line
 // flows' increments (exp(t Lambda_l) - 1) / N; up and down point into the
-// phase tables at entry N + d0 (see the definition).
+// phase tables at entry N + d0 (up: v_l / N, down: v_l / N then v_l; see
+// the definition).
 void apply_phase(int N, int count, const double *up, const double *down, double sign, double *x);
 
 // v_l = u_l - 1 = exp(i phi_l) - 1 = (-2 sin^2(phi_l / 2), sin phi_l), phi_l =
-// factor B_l (B: the line spectrum, N complex, real parts used), stored three
-// times over in the phase tables (3N complex each), forwards in up and
-// backwards in down, so that v_{l-c} and v_{l+c} need no reduction mod N and
-// run forwards along the lines of a block. Each l writes its own entries only.
+// factor B_l (B: the transformed line spectrum, factor = t / (2 eps)), stored
+// three times over, forwards (up: v_l / N) and backwards (down: v_l / N, then
+// v_l), so that v_{l-c} and v_{l+c} need no reduction mod N and run forwards
+// along the lines of a block (see apply_phase). Each l writes its own entries
+// only, so threads may share the loop over l.
 inline void write_phase(int n, int l, double factor, const double *spectrum, double *up,
                         double *down) {
     const std::size_t N = n;
     const double angle = factor * spectrum[2 * l];
     const double half = std::sin(0.5 * angle);
     const double re = -2.0 * half * half, im = std::sin(angle);
+    const double n_real = n;
+    const double scaled_re = re / n_real, scaled_im = im / n_real;
     const std::size_t minus = l == 0 ? 0 : N - l;
     for (std::size_t copy = 0; copy < 3; ++copy) {
-        up[2 * (l + copy * N)] = re;
-        up[2 * (l + copy * N) + 1] = im;
-        down[2 * (minus + copy * N)] = re;
-        down[2 * (minus + copy * N) + 1] = im;
+        double *forwards = up + 2 * (l + copy * N), *backwards = down + 4 * (minus + copy * N);
+        forwards[0] = scaled_re;
+        forwards[1] = scaled_im;
+        backwards[0] = scaled_re;
+        backwards[1] = scaled_im;
+        backwards[2] = re;
+        backwards[3] = im;
     }
 }
 

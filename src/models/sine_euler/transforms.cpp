@@ -64,7 +64,7 @@ LineTransforms::LineTransforms(int N, int lines, FftPlanning planning)
     try {
         spectrum_ = reinterpret_cast<double *>(fftw_alloc_complex(N));
         up_ = static_cast<double *>(fftw_malloc(sizeof(double) * 6 * N));
-        down_ = static_cast<double *>(fftw_malloc(sizeof(double) * 6 * N));
+        down_ = static_cast<double *>(fftw_malloc(sizeof(double) * 12 * N));
         if (!spectrum_ || !up_ || !down_) throw std::bad_alloc();
         reserve_threads(1);
         std::lock_guard<std::mutex> lock(fftw_planner_mutex());

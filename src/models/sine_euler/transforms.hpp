@@ -33,7 +33,8 @@ public:
     // The line spectrum b: N complex (interleaved), transformed in place.
     double *spectrum() { return spectrum_; }
     void transform_spectrum();
-    // The phase tables: 3N complex each (see SineEuler::line_phase).
+    // The phase tables: 3N complex (up) and 3N complex pairs (down; see
+    // SineEuler::line_phase).
     double *up() { return up_; }
     double *down() { return down_; }
     // Block buffer of a thread, and its forward / backward transform in place
