@@ -43,4 +43,11 @@ close "$out/whole/sine-euler.csv" "$out/parts/sine-euler.csv" ||
     { echo "an MPI checkpoint resumed by one process differs"; exit 1; }
 rc=0; "$mpiexec" -n 2 --oversubscribe "$lpi" methods >/dev/null 2>&1 || rc=$?
 [ "$rc" -ne 0 ] || { echo "lpi methods under mpirun -n 2 did not refuse"; exit 1; }
+rc=0; "$mpiexec" -n 2 --oversubscribe "$lpi" run rollup --N 9 --steps 3 --out "$out/roll" >/dev/null 2>&1 || rc=$?
+[ "$rc" -ne 0 ] || { echo "lpi run rollup under mpirun -n 2 did not refuse"; exit 1; }
+# The family's scenes spread like sine-euler: SQG over P = 2 follows one process.
+"$lpi" run sqg --N 9 --dt 0.05 --steps 20 --every 10 --format npy --snapshots 0 --out "$out/sqg1" >/dev/null
+"$mpiexec" -n 2 --oversubscribe "$lpi" run sqg --N 9 --dt 0.05 --steps 20 --every 10 --format npy \
+    --snapshots 0 --out "$out/sqg2" >/dev/null
+close "$out/sqg1/sqg.csv" "$out/sqg2/sqg.csv" || { echo "lpi run sqg under mpirun -n 2 differs"; exit 1; }
 echo "lpi run under mpirun: P = 1..3 agree with one process, output once, resume bit for bit"

@@ -119,6 +119,10 @@ int run_command(int argc, char **argv) {
             std::fprintf(stderr, "lpi run: %s takes --N, --steps, --dt and --out only\n", o.scene.c_str());
             return 2;
         }
+        if (process_count() > 1) {
+            std::fprintf(stderr, "lpi run: %s runs on one process (not under mpirun)\n", o.scene.c_str());
+            return 2;
+        }
         return it->run_own({o.n_given ? o.scene_options.sine_euler_n : 0, o.steps, o.dt, o.out_dir});
     }
     if (!it->create) {
