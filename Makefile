@@ -53,7 +53,9 @@ run: build
 
 bench: build
 	@cmake --build $(BUILD) -j $(JOBS) $(BUILD_ARGS) --target benchmarks
-	@for b in $(BUILD)/tests/bench/bench_*; do [ -x "$$b" ] && "$$b"; done
+	@for b in $(BUILD)/tests/bench/bench_*; do [ -x "$$b" ] || continue; case "$$b" in \
+	    *_mpi) OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe -np 4 "$$b";; \
+	    *) "$$b";; esac || exit 1; done
 
 # Quiet, but says where the Python package went (and whether python3 finds it).
 install: build
