@@ -8,7 +8,6 @@
 // (getters, Casimirs, checkpoints).
 #include "sine_euler_mpi.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -20,14 +19,11 @@
 #include "../models/sine_euler/coordinates.hpp"
 #include "../models/sine_euler/indexing.hpp"
 #include "../models/sine_euler/kernels.hpp"
+#include "../models/sine_euler/line_flows.hpp"
 #include "../models/sine_euler/transforms.hpp"
 #include "communicator.hpp"
 #include "line_exchange.hpp"
 #include "lpi_config.h"
-
-#if LPI_HAVE_OPENMP
-#include <omp.h>
-#endif
 
 namespace lpi {
 
@@ -37,14 +33,6 @@ using namespace sine_euler;
 using mpi::Communicator;
 using mpi::LineExchange;
 using mpi::LineOwnership;
-
-int this_thread() {
-#if LPI_HAVE_OPENMP
-    return omp_get_thread_num();
-#else
-    return 0;
-#endif
-}
 
 // FNV-1a of the bytes of n doubles: the processes compare their inputs.
 long long fingerprint(const double *x, std::size_t n) {
@@ -179,7 +167,6 @@ private:
                 fail(LPI_ERR_INVALID, std::string("the ") + what +
                                           " differs between the processes (each must pass the same)");
     }
-    int blocks() const { return (mine_ + kBlock - 1) / kBlock; }
 
     int N_;
     double eps_;
@@ -318,7 +305,7 @@ bool SineEulerMpi::line_spectrum(const Direction &D, const double *line0) {
 // transformed, multiplied by the lines' (exp(t Lambda_l) - 1) / N, transformed
 // back and added to the modes.
 void SineEulerMpi::move_block(const Direction &D, int block, double *x, double *slab) {
-    const int i0 = block * kBlock, count = mine_ - i0 < kBlock ? mine_ - i0 : kBlock;
+    const int i0 = block * kBlock, count = lines_in_block(mine_, block);
     const int d0 = first_ + i0;
     const std::size_t row = 2 * static_cast<std::size_t>(mine_);
     for (int s = 0; s < N_; ++s)
@@ -343,51 +330,16 @@ void SineEulerMpi::flow(std::size_t piece, double t, double *state) {
     if (!line_spectrum(D, state + mpi::line0_entry())) return;
     const double factor = t / (2.0 * eps_);
     double *slab = state + mpi::slab_entry(N_);
-    const int count = blocks();
-#if LPI_HAVE_OPENMP
-#pragma omp parallel num_threads(threads_) if (threads_ > 1 && count > 1)
-#endif
-    {
-#if LPI_HAVE_OPENMP
-#pragma omp for schedule(static)
-#endif
-        for (int l = 0; l < N_; ++l)
-            write_phase(N_, l, factor, transforms_->spectrum(), transforms_->up(), transforms_->down());
-#if LPI_HAVE_OPENMP
-#pragma omp for schedule(static)
-#endif
-        for (int blk = 0; blk < count; ++blk) move_block(D, blk, transforms_->block(this_thread()), slab);
-    }
+    run_line_flows(*transforms_, N_, mine_, threads_, factor,
+                   [&](int block, double *x) { move_block(D, block, x, slab); });
 }
 
 // The transforms of this process's lines alone; the slowest process's time.
 TransformTiming SineEulerMpi::time_transforms(std::size_t flows_per_step, std::int64_t steps) {
-    if (steps < 1) fail(LPI_ERR_INVALID, "nsteps must be >= 1, got " + std::to_string(steps));
-    if (flows_per_step == 0 || static_cast<std::uint64_t>(steps) > SIZE_MAX / flows_per_step)
-        fail(LPI_ERR_OVERFLOW, "nsteps = " + std::to_string(steps) + " times " +
-                                   std::to_string(flows_per_step) + " flows per step overflows the flow count");
-    LineTransforms &T = transforms();
-    const int count = blocks();
-    std::memset(T.spectrum(), 0, sizeof(double) * 2 * N_);
-    for (int i = 0; i < threads_; ++i) std::memset(T.block(i), 0, sizeof(double) * 2 * N_ * kBlock);
-    const std::size_t flows = flows_per_step * static_cast<std::size_t>(steps);
-    const auto start = std::chrono::steady_clock::now();
-    for (std::size_t f = 0; f < flows; ++f) {
-        T.transform_spectrum();
-#if LPI_HAVE_OPENMP
-#pragma omp parallel for num_threads(threads_) schedule(static) if (threads_ > 1 && count > 1)
-#endif
-        for (int blk = 0; blk < count; ++blk) {
-            const int lines = mine_ - blk * kBlock < kBlock ? mine_ - blk * kBlock : kBlock;
-            double *x = T.block(this_thread());
-            T.forward(lines, x);
-            T.backward(lines, x);
-        }
-    }
-    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+    const std::size_t flows = flow_count(flows_per_step, steps);
+    const double seconds = time_line_transforms(transforms(), N_, mine_, threads_, flows);
     const double per_step = static_cast<double>(steps);
-    return {comm_->max(elapsed.count()) / per_step,
-            static_cast<double>(flows) * (1.0 + 2.0 * lines_.M) / per_step};
+    return {comm_->max(seconds) / per_step, static_cast<double>(flows) * (1.0 + 2.0 * lines_.M) / per_step};
 }
 
 }  // namespace

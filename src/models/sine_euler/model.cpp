@@ -33,7 +33,6 @@
 // sin phi_l) without cancellation, so the increment's own rounding scales
 // with the angles, not with the field.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -46,13 +45,11 @@
 #include "coordinates.hpp"
 #include "indexing.hpp"
 #include "kernels.hpp"
+#include "line_flows.hpp"
 #include "lpi_config.h"
 #include "projective_line.hpp"
 #include "transforms.hpp"
 
-#if LPI_HAVE_OPENMP
-#include <omp.h>
-#endif
 #if defined(__has_include)
 #if __has_include(<unistd.h>)
 #include <unistd.h>
@@ -73,14 +70,6 @@ std::unique_ptr<Model> make_sine_euler(int) {
 namespace {
 
 using namespace sine_euler;
-
-int this_thread() {
-#if LPI_HAVE_OPENMP
-    return omp_get_thread_num();
-#else
-    return 0;
-#endif
-}
 
 class SineEuler final : public SineEulerModel {
 public:
@@ -167,7 +156,6 @@ public:
 private:
     LineTransforms &transforms();
     bool line_spectrum(const Direction &D, const double *w);
-    void line_phase(int l, double factor);
     void move_block(const Direction &D, int block, double *x, double *w);
 
     int N_;
@@ -218,11 +206,6 @@ bool SineEuler::line_spectrum(const Direction &D, const double *w) {
     return true;
 }
 
-// The phase tables of DFT index l (write_phase, kernels.hpp).
-void SineEuler::line_phase(int l, double factor) {
-    write_phase(N_, l, factor, transforms_->spectrum(), transforms_->up(), transforms_->down());
-}
-
 // Lines d = d0 .. d0+count-1 of direction D: gather z_s = w_{d j + s k} into
 // x[s * count + (d - d0)], transform along s, multiply by the line's
 // (exp(t Lambda_l) - 1) / N, transform back, add the increments to the modes
@@ -244,54 +227,17 @@ void SineEuler::flow(std::size_t piece, double t, double *state) {
     // A piece whose stream function is zero on its line moves nothing: its flow is the identity
     // (taken exactly, not through a round trip of FFTs).
     if (!line_spectrum(D, state)) return;
-    const int blocks = blocks_.count();
-    const double factor = t / (2.0 * eps_);
-    // One parallel region per flow: the phases, then the blocks of lines (the
-    // implicit barrier between the two loops orders them).
-#if LPI_HAVE_OPENMP
-#pragma omp parallel num_threads(threads_) if (threads_ > 1 && blocks > 1)
-#endif
-    {
-#if LPI_HAVE_OPENMP
-#pragma omp for schedule(static)
-#endif
-        for (int l = 0; l < N_; ++l) line_phase(l, factor);
-#if LPI_HAVE_OPENMP
-#pragma omp for schedule(static)
-#endif
-        for (int blk = 0; blk < blocks; ++blk) move_block(D, blk, transforms_->block(this_thread()), state);
-    }
+    run_line_flows(*transforms_, N_, blocks_.M, threads_, t / (2.0 * eps_),
+                   [&](int block, double *x) { move_block(D, block, x, state); });
 }
 
 // The transforms of `flows_per_step * steps` flows alone, on the model's own
 // plans, buffers and threads, on zeros: what the splitting costs in FFTW.
 TransformTiming SineEuler::time_transforms(std::size_t flows_per_step, std::int64_t steps) {
-    if (steps < 1) fail(LPI_ERR_INVALID, "nsteps must be >= 1, got " + std::to_string(steps));
-    if (flows_per_step == 0 || static_cast<std::uint64_t>(steps) > SIZE_MAX / flows_per_step)
-        fail(LPI_ERR_OVERFLOW, "nsteps = " + std::to_string(steps) + " times " +
-                                   std::to_string(flows_per_step) +
-                                   " flows per step overflows the flow count");
-    LineTransforms &T = transforms();
-    const int blocks = blocks_.count();
-    std::memset(T.spectrum(), 0, sizeof(double) * 2 * N_);
-    for (int i = 0; i < threads_; ++i) std::memset(T.block(i), 0, sizeof(double) * 2 * N_ * kBlock);
-    const std::size_t flows = flows_per_step * static_cast<std::size_t>(steps);
-    const auto start = std::chrono::steady_clock::now();
-    for (std::size_t f = 0; f < flows; ++f) {
-        T.transform_spectrum();
-#if LPI_HAVE_OPENMP
-#pragma omp parallel for num_threads(threads_) schedule(static) if (threads_ > 1 && blocks > 1)
-#endif
-        for (int blk = 0; blk < blocks; ++blk) {
-            double *x = T.block(this_thread());
-            T.forward(blocks_.lines(blk), x);
-            T.backward(blocks_.lines(blk), x);
-        }
-    }
-    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+    const std::size_t flows = flow_count(flows_per_step, steps);
+    const double seconds = time_line_transforms(transforms(), N_, blocks_.M, threads_, flows);
     const double per_step = static_cast<double>(steps);
-    return {elapsed.count() / per_step,
-            static_cast<double>(flows) * (1.0 + 2.0 * blocks_.M) / per_step};
+    return {seconds / per_step, static_cast<double>(flows) * (1.0 + 2.0 * blocks_.M) / per_step};
 }
 
 // a * b, or false when it does not fit a std::size_t.
