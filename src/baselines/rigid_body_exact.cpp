@@ -129,6 +129,10 @@ void rigid_body_exact(const double inertia[3], const double m0[3], double t, dou
         m[k] = std::ldexp(m0[k], -m_exponent);
     }
     const double scaled_t = std::ldexp(t, m_exponent - i_exponent);
+    // Components below 2^-1074 of the largest vanish at this scale: what is
+    // left is a steady rotation to far below round-off (they would need
+    // t ~ 700 / rate to grow into view), and the amplitudes need two nonzero.
+    if ((m[0] == 0.0) + (m[1] == 0.0) + (m[2] == 0.0) >= 2) return;
 
     if (I[0] == I[1]) {
         symmetric_top(I, m, 2, scaled_t, out);
