@@ -5,6 +5,7 @@
  * file that both load, and bad input gets the same status on every process
  * with the state unchanged. */
 #include <liepoisson_mpi.h>
+#include <malloc.h>
 
 #include "lpi_test.h"
 
@@ -187,8 +188,9 @@ static void sqg_over_topography(int N, double *lambda, double *f) {
 
 static void test_hamiltonian(void **state) {
     (void)state;
-    const int orders[] = {13, 15};
-    for (int k = 0; k < 2; ++k) {
+    /* 45 = 9 x 5: pieces that own modes by the first later class (a squared prime). */
+    const int orders[] = {13, 15, 45};
+    for (int k = 0; k < 3; ++k) {
         const int N = orders[k];
         const size_t n = (size_t)N * N;
         double *x0 = malloc(n * sizeof *x0), *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b),
@@ -249,6 +251,57 @@ static void test_hamiltonian(void **state) {
     }
 }
 
+/* Bytes the allocator has handed out and not had back (small blocks and
+ * mmapped ones); 0 where the allocator is not glibc's (sanitizers, valgrind). */
+static size_t bytes_in_use(void) {
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 33))
+    const struct mallinfo2 info = mallinfo2();
+    return info.uordblks + info.hblkhd;
+#else
+    return 0;
+#endif
+}
+
+/* What a handle on comm holds after the whole field and a forced Hamiltonian
+ * were set (they are the caller's) and a few steps were taken. */
+static size_t bytes_held(int N, MPI_Comm comm, const double *x, const double *lambda, const double *f) {
+    const size_t n = (size_t)N * N;
+    lpi_system *sys;
+    const size_t before = bytes_in_use();
+    assert_int_equal(lpi_sine_euler_create_mpi(&sys, N, comm), LPI_OK);
+    assert_int_equal(lpi_set_state(sys, x, n), LPI_OK);
+    assert_int_equal(lpi_sine_euler_set_hamiltonian(sys, lambda, n, f, 2 * n), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.01, 2), LPI_OK);
+    double h;
+    assert_int_equal(lpi_energy(sys, &h), LPI_OK);
+    const size_t after = bytes_in_use();
+    lpi_destroy(sys);
+    return after > before ? after - before : 0;
+}
+
+/* While stepping a process holds O(N^2 / P) bytes: no table of the whole
+ * field (lambda, f, the pieces' ownership) is replicated. The same program
+ * spread over P processes holds at most 1/P of what one process holds, plus
+ * O(N) (the lines through the origin, the transforms' buffers). */
+static void test_memory_per_process(void **state) {
+    (void)state;
+    const int N = 255; /* 3 x 5 x 17 */
+    const size_t n = (size_t)N * N;
+    double *x = malloc(n * sizeof *x), *lambda = malloc(n * sizeof *lambda), *f = malloc(2 * n * sizeof *f);
+    assert_true(x && lambda && f);
+    random_field(x, n, 3);
+    sqg_over_topography(N, lambda, f);
+    const size_t alone = bytes_held(N, MPI_COMM_SELF, x, lambda, f);
+    bytes_held(N, MPI_COMM_WORLD, x, lambda, f); /* Open MPI's own buffers for this exchange */
+    const size_t spread = bytes_held(N, MPI_COMM_WORLD, x, lambda, f);
+    free(x), free(lambda), free(f);
+    if (alone < 16 * n / 2) LPI_SKIP("the allocator does not report its bytes in use (not glibc's malloc)");
+    const double share = (double)spread / (double)alone, allowed = 1.0 / size_ + 0.06;
+    printf("rank %d: N = %d, one process holds %zu bytes, one of %d holds %zu (%.3f of it; at most %.3f)\n",
+           rank_, N, alone, size_, spread, share, allowed);
+    assert_true(share <= allowed);
+}
+
 /* Bad input: the same status on every process, the state unchanged. */
 static void test_bad_input(void **state) {
     (void)state;
@@ -294,6 +347,7 @@ int main(void) {
         cmocka_unit_test(test_threads_per_process),
         cmocka_unit_test(test_checkpoint),
         cmocka_unit_test(test_hamiltonian),
+        cmocka_unit_test(test_memory_per_process),
         cmocka_unit_test(test_bad_input),
     };
     const int status = lpi_run_tests(tests);

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,7 @@ public:
 
     // The stages of rk4 on the modes, so the two agree to round-off.
     bool advance(Model &model, double *x, double dt, std::int64_t n) override {
-        const sine_euler::Hamiltonian &H = static_cast<const SineEulerModel &>(model).hamiltonian();
+        const sine_euler::Hamiltonian H = static_cast<const SineEulerModel &>(model).hamiltonian();
         auto rate = [this, &H](const double *y, double *k) { this->rate(H, y, k); };
         return run_checked_steps(
             n, [&](std::int64_t) { stages_.step(x, dt, rate); },
@@ -133,7 +134,7 @@ protected:
     virtual void step(double dt, std::int64_t s) = 0;
 
     bool run(const Model &model, double *state, double dt, std::int64_t n) {
-        hamiltonian_ = &static_cast<const SineEulerModel &>(model).hamiltonian();
+        hamiltonian_.emplace(static_cast<const SineEulerModel &>(model).hamiltonian());
         const double w0[2] = {state[0], state[1]};
         form_.to_matrix(state, W_.data());
         if (!run_checked_steps(n, [&](std::int64_t s) { step(dt, s); },
@@ -159,7 +160,7 @@ protected:
     sine_euler::MatrixForm form_;
     std::vector<cplx> W_, P_, X_;
     double c_;  // 1 / (2 eps) = N / (4 pi)
-    const sine_euler::Hamiltonian *hamiltonian_ = nullptr;  // the model's, during a run
+    std::optional<sine_euler::Hamiltonian> hamiltonian_;  // the model's, during a run
 };
 
 // Classical RK4 on dW/dt = [B(W), W]: one P(W) and one zgemm per stage.

@@ -56,8 +56,9 @@ public:
     virtual double enstrophy(const double *state) const = 0;
     virtual void casimir_traces(const double *state, int kmax, double *out) const = 0;
     // The Hamiltonian every method, the energy and the diagnostics use
-    // (Euler's until set; see sine_euler/hamiltonian.hpp).
-    virtual const sine_euler::Hamiltonian &hamiltonian() const = 0;
+    // (Euler's until set; see sine_euler/hamiltonian.hpp): a copy, which a
+    // model spread over processes assembles on request (none holds it whole).
+    virtual sine_euler::Hamiltonian hamiltonian() const = 0;
     virtual void set_hamiltonian(sine_euler::Hamiltonian H) = 0;
     // Runs the FFTs of `steps` steps of `flows_per_step` line flows each
     // (cycling over the pieces) on the model's own plans, buffers and

@@ -92,8 +92,11 @@ int as_count(std::size_t n) {
 }  // namespace
 
 void LineExchange::move(const Direction &from, std::size_t from_index, const Direction &to,
-                        std::size_t to_index, double *state) {
-    if (from_index == to_index) return;
+                        std::size_t to_index, double *state, Riders *riders) {
+    if (from_index == to_index) {
+        if (riders) exchange_riders(*riders);
+        return;
+    }
     const LineOwnership &L = lines_;
     const int N = L.N, P = L.P, me = comm_.rank(), mine = L.count(me);
     const Transition T(from, to, N);
@@ -126,7 +129,8 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
         im = mirrored ? -z[1] : z[1];
     };
 
-    // Pack: for each process, the new line 0's modes held here, then its lines' modes.
+    // Pack: for each process, the new line 0's modes held here, the riders,
+    // then its lines' modes.
     send_.clear();
     send_counts_.assign(P, 0);
     send_offsets_.assign(P, 0);
@@ -139,6 +143,7 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
             send_.push_back(re);
             send_.push_back(im);
         }
+        if (riders) send_.insert(send_.end(), riders->own.begin(), riders->own.end());
         for_each_exchanged(T, L, q, me, [&](int, int, int d, int e, bool mirrored) {
             const double *z = slab + 2 * (static_cast<std::size_t>(e) * mine + (d - L.first[me]));
             send_.push_back(z[0]);
@@ -152,9 +157,14 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
     targets_.clear();
     receive_counts_.assign(P, 0);
     receive_offsets_.assign(P, 0);
+    rider_offsets_.assign(P, 0);
     for (int r = 0; r < P; ++r) {
         const std::size_t start = targets_.size();
         for (int i = origin_first[r]; i < origin_first[r + 1]; ++i) targets_.push_back(origin_order[i]);
+        if (riders) {
+            rider_offsets_[r] = targets_.size();
+            targets_.insert(targets_.end(), static_cast<std::size_t>(riders->counts[r]), kRider);
+        }
         for_each_exchanged(T, L, me, r, [&](int d_new, int s_new, int, int, bool) {
             targets_.push_back(N + static_cast<std::uint64_t>(s_new) * mine + (d_new - L.first[me]));
         });
@@ -169,9 +179,11 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
 
     double *entries = state + line0_entry();
     for (std::size_t i = 0; i < targets_.size(); ++i) {
+        if (targets_[i] == kRider) continue;
         entries[2 * targets_[i]] = receive_[2 * i];
         entries[2 * targets_[i] + 1] = receive_[2 * i + 1];
     }
+    if (riders) gather_riders(*riders);
     // Modes on the old line 0: from the copy held here.
     for (int s = 1; s < N; ++s)
         if (origin_source[s] < 0) {
@@ -189,6 +201,38 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
         });
     }
     state[0] = static_cast<double>(to_index);
+}
+
+void LineExchange::exchange_riders(Riders &riders) {
+    const int P = lines_.P;
+    send_.clear();
+    send_counts_.assign(P, 0);
+    send_offsets_.assign(P, 0);
+    receive_counts_.assign(P, 0);
+    receive_offsets_.assign(P, 0);
+    rider_offsets_.assign(P, 0);
+    std::size_t received = 0;
+    for (int q = 0; q < P; ++q) {
+        send_offsets_[q] = as_count(send_.size() / 2);
+        send_.insert(send_.end(), riders.own.begin(), riders.own.end());
+        send_counts_[q] = as_count(riders.own.size() / 2);
+        rider_offsets_[q] = received;
+        receive_offsets_[q] = as_count(received);
+        receive_counts_[q] = riders.counts[q];
+        received += static_cast<std::size_t>(riders.counts[q]);
+    }
+    receive_.resize(2 * received);
+    comm_.alltoallv(send_.data(), send_counts_, send_offsets_, receive_.data(), receive_counts_,
+                    receive_offsets_);
+    gather_riders(riders);
+}
+
+void LineExchange::gather_riders(Riders &riders) const {
+    riders.gathered.clear();
+    for (int r = 0; r < lines_.P; ++r) {
+        const double *first = receive_.data() + 2 * rider_offsets_[r];
+        riders.gathered.insert(riders.gathered.end(), first, first + 2 * static_cast<std::size_t>(riders.counts[r]));
+    }
 }
 
 }  // namespace mpi

@@ -25,7 +25,9 @@
 // sides enumerate the modes from process r to process q in one order (by d'
 // in q's lines, then d in r's lines, then v = d, -d, then s' solving
 // gamma s' = v - delta(d') mod N), so nothing but values is sent, and the
-// work is O(N^2 / P) per process.
+// work is O(N^2 / P) per process. Values every process needs from a few
+// (the Hamiltonian's weights on the new line 0, hamiltonian_share.hpp) ride
+// along in the same collective.
 #pragma once
 
 #include <cstddef>
@@ -59,21 +61,38 @@ inline void line_mode(const sine_euler::Direction &D, int N, int d, int s, int &
     b = static_cast<int>((static_cast<std::int64_t>(d) * D.j2 + static_cast<std::int64_t>(s) * D.k2) % N);
 }
 
+// Values that travel with an exchange: each process sends its own to every
+// process and receives everyone's, in rank order (an allgather inside the
+// exchange's one collective). Complex entries: 2 doubles each.
+struct Riders {
+    std::vector<double> own;       // this process's values
+    std::vector<int> counts;       // entries each process sends (every process knows all)
+    std::vector<double> gathered;  // after the exchange: every process's, in rank order
+};
+
 // Moves a process's working state from one direction's layout to another's,
 // with buffers kept between flows.
 class LineExchange {
 public:
     LineExchange(const Communicator &comm, const LineOwnership &lines) : comm_(comm), lines_(lines) {}
-    // state holds the layout of `from`; afterwards that of `to`.
+    // state holds the layout of `from`; afterwards that of `to`. With riders,
+    // their values travel in the same collective; when from and to are the
+    // same direction only they travel.
     void move(const sine_euler::Direction &from, std::size_t from_index,
-              const sine_euler::Direction &to, std::size_t to_index, double *state);
+              const sine_euler::Direction &to, std::size_t to_index, double *state,
+              Riders *riders = nullptr);
 
 private:
+    void exchange_riders(Riders &riders);       // the riders alone
+    void gather_riders(Riders &riders) const;   // from receive_, after the collective
+    static constexpr std::uint64_t kRider = UINT64_MAX;  // a target: a rider, not a state entry
+
     const Communicator &comm_;
     const LineOwnership &lines_;
     std::vector<double> send_, receive_, old_line0_;
     std::vector<std::uint64_t> targets_;  // complex entry of the state for each value received
     std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
+    std::vector<std::size_t> rider_offsets_;  // where each process's riders start in receive_
 };
 
 }  // namespace mpi

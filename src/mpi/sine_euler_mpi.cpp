@@ -4,8 +4,9 @@
 // held here block by block exactly as the model of one process does: gather,
 // forward transform, phase (apply_phase), backward transform, and the
 // increment added to the modes. While stepping a process holds its lines,
-// line 0 and O(N) tables; the whole field is gathered only on request
-// (getters, Casimirs, checkpoints).
+// line 0, its share of the Hamiltonian (hamiltonian_share.hpp) and O(N)
+// tables; the whole field is gathered only on request (getters, Casimirs,
+// checkpoints).
 #include "sine_euler_mpi.hpp"
 
 #include <cmath>
@@ -22,6 +23,7 @@
 #include "../models/sine_euler/line_flows.hpp"
 #include "../models/sine_euler/transforms.hpp"
 #include "communicator.hpp"
+#include "hamiltonian_share.hpp"
 #include "line_exchange.hpp"
 #include "lpi_config.h"
 
@@ -32,7 +34,10 @@ namespace {
 using namespace sine_euler;
 using mpi::Communicator;
 using mpi::LineExchange;
+using mpi::HamiltonianShare;
 using mpi::LineOwnership;
+using mpi::OriginLineWeights;
+using mpi::Riders;
 
 // FNV-1a of the bytes of n doubles: the processes compare their inputs.
 long long fingerprint(const double *x, std::size_t n) {
@@ -47,7 +52,14 @@ public:
     SineEulerMpi(int N, std::shared_ptr<const Communicator> comm)
         : N_(N), eps_(2.0 * std::acos(-1.0) / N), comm_(std::move(comm)),
           lines_(N, comm_->size()), mine_(lines_.count(comm_->rank())),
-          first_(lines_.first[comm_->rank()]), dirs_(projective_line(N)), exchange_(*comm_, lines_) {}
+          first_(lines_.first[comm_->rank()]), exchange_(*comm_, lines_), share_(N, lines_, comm_->rank()) {
+        // Each piece's ownership table is read for this process's modes, then dropped.
+        for_each_direction(N, [&](Direction &&D) {
+            share_.record_owners(dirs_.size(), D);
+            std::vector<unsigned char>().swap(D.owned);
+            dirs_.push_back(std::move(D));
+        });
+    }
 
     const char *kind() const override { return "sine-euler"; }
     int truncation() const override { return N_; }
@@ -62,22 +74,21 @@ public:
     // are not Euler's.
     std::vector<double> checkpoint_parameters() const override {
         std::vector<double> p = {double(N_)};
-        if (!hamiltonian_.is_default()) {
-            const std::vector<double> lambda_f = hamiltonian_.parameters();
+        if (!share_.is_default()) {
+            const std::vector<double> lambda_f = hamiltonian().parameters();
             p.insert(p.end(), lambda_f.begin(), lambda_f.end());
         }
         return p;
     }
-    // Every process holds lambda and f whole: the line through the origin
-    // of each direction, whose spectrum drives the flow, meets every mode.
-    const Hamiltonian &hamiltonian() const override { return hamiltonian_; }
+    Hamiltonian hamiltonian() const override { return share_.whole(*comm_); }
     void set_hamiltonian(Hamiltonian H) override {
         if (H.truncation() != N_)
             fail(LPI_ERR_INTERNAL, "a Hamiltonian of N = " + std::to_string(H.truncation()) +
                                        " given to a system of N = " + std::to_string(N_));
         const std::vector<double> p = H.parameters();
         require_same_input(p.data(), p.size(), "Hamiltonian (lambda and f)");
-        hamiltonian_ = std::move(H);
+        share_.assign(H);
+        origin_piece_ = kNoPiece;
     }
 
     void set_threads(int n) override {
@@ -133,8 +144,10 @@ public:
         comm_->broadcast(out, static_cast<std::size_t>(kmax));
     }
     std::size_t casimir_count() const override { return static_cast<std::size_t>(N_); }
-    double energy(const double *state) const override { return sum_over_field(state, true); }
-    double enstrophy(const double *state) const override { return sum_over_field(state, false); }
+    double energy(const double *state) const override;
+    double enstrophy(const double *state) const override {
+        return sum_over_field(state, [](std::size_t, const double *z) { return 0.5 * (z[0] * z[0] + z[1] * z[1]); });
+    }
     // Only the baselines ask for it, and they are refused for a model spread
     // over processes (make_integrator).
     void vector_field(const double *, double *) const override {
@@ -157,9 +170,10 @@ public:
 
 private:
     LineTransforms &transforms();
-    bool line_spectrum(const Direction &D, const double *line0);
+    bool line_spectrum(const double *line0);
     void move_block(const Direction &D, int block, double *x, double *slab);
-    double sum_over_field(const double *state, bool energy) const;
+    template <class Term>
+    double sum_over_field(const double *state, Term &&term) const;
     void require_same_input(const double *x, std::size_t n, const char *what) const {
         const std::vector<long long> prints = comm_->allgather(fingerprint(x, n));
         for (long long p : prints)
@@ -173,13 +187,18 @@ private:
     std::shared_ptr<const Communicator> comm_;
     LineOwnership lines_;
     int mine_, first_;  // this process's lines: first_ .. first_ + mine_ - 1
-    std::vector<Direction> dirs_;
-    LineExchange exchange_;
+    std::vector<Direction> dirs_;  // without their ownership tables (share_ keeps this process's)
+    mutable LineExchange exchange_;  // its buffers only change in a const call (energy)
+    HamiltonianShare share_;
+    // The weights of line 0 of piece origin_piece_, fetched with the exchange.
+    static constexpr std::size_t kNoPiece = SIZE_MAX;
+    std::size_t origin_piece_ = kNoPiece;
+    OriginLineWeights origin_;
+    Riders riders_;
     SplitChoice split_{{"directions"}};
     int threads_ = 1;
     FftPlanning planning_ = FftPlanning::Estimate;
     std::unique_ptr<LineTransforms> transforms_;  // this process's lines, planned on the first flow
-    Hamiltonian hamiltonian_{N_};
 };
 
 LineTransforms &SineEulerMpi::transforms() {
@@ -243,53 +262,45 @@ std::vector<double> SineEulerMpi::local_state(const double *modes, std::size_t d
     return state;
 }
 
-// sum |w_m|^2 / |m|^2 (energy) or sum |w_m|^2 (enstrophy) over the field:
-// this process's lines count twice (their conjugates -d are not held), line
-// 0 is counted by rank 0; the partial sums are added in rank order, the same
-// on every process.
-double SineEulerMpi::sum_over_field(const double *state, bool energy) const {
-    const Direction &D = dirs_[static_cast<std::size_t>(state[0])];
-    const double *lambda = hamiltonian_.weights(), *f = hamiltonian_.forcing();
-    // Mode (d, s) of D's lines: its term of H, or 1/2 |w|^2.
-    auto term = [&](int d, int s, const double *z) {
-        const double half_norm = 0.5 * (z[0] * z[0] + z[1] * z[1]);
-        if (!energy) return half_norm;
-        int a, b;
-        mpi::line_mode(D, N_, d, s, a, b);
-        const std::size_t m = mode_index(a, b, N_);
-        return lambda[m] * half_norm + (f ? f[2 * m] * z[0] + f[2 * m + 1] * z[1] : 0.0);
-    };
+// The sum of term(e, z) over the modes z of the field held in `state` (e:
+// the complex entry after the index): this process's lines count twice
+// (their conjugates -d are not held), line 0 is counted by rank 0; the
+// partial sums are added in rank order, the same on every process.
+template <class Term>
+double SineEulerMpi::sum_over_field(const double *state, Term &&term) const {
+    const double *entries = state + mpi::line0_entry();
     double sum = 0.0;
-    const double *slab = state + mpi::slab_entry(N_);
-    // Lines d and -d are conjugate, with the same terms: the slab's count twice.
-    for (int s = 0; s < N_; ++s)
-        for (int i = 0; i < mine_; ++i)
-            sum += 2.0 * term(first_ + i, s, slab + 2 * (static_cast<std::size_t>(s) * mine_ + i));
-    if (comm_->rank() == 0) {
-        const double *line0 = state + mpi::line0_entry();
-        for (int s = 0; s < N_; ++s) sum += term(0, s, line0 + 2 * s);
-    }
+    for (std::size_t e = N_; e < static_cast<std::size_t>(N_) * (1 + mine_); ++e) sum += 2.0 * term(e, entries + 2 * e);
+    if (comm_->rank() == 0)
+        for (std::size_t e = 0; e < static_cast<std::size_t>(N_); ++e) sum += term(e, entries + 2 * e);
     double total = 0.0;
     for (double part : comm_->allgather(sum)) total += part;
     return total;
 }
 
-// b_s = lambda_sk w_sk + f_sk on the modes D owns, B = FFT(b), as the model of one
-// process computes it. False when every b_s is zero.
-bool SineEulerMpi::line_spectrum(const Direction &D, const double *line0) {
+// H in the layout of the reference direction, where the share of the
+// Hamiltonian is held: a copy of the state is moved there.
+double SineEulerMpi::energy(const double *state) const {
+    std::vector<double> reference(state, state + state_size());
+    const std::size_t held = static_cast<std::size_t>(state[0]);
+    exchange_.move(dirs_[held], held, dirs_[0], 0, reference.data());
+    return sum_over_field(reference.data(), [&](std::size_t e, const double *z) { return share_.term(e, z); });
+}
+
+// b_s = lambda_sk w_sk + f_sk on the modes the flow's piece owns (origin_),
+// B = FFT(b), as the model of one process computes it. False when every b_s
+// is zero.
+bool SineEulerMpi::line_spectrum(const double *line0) {
     double *b = transforms_->spectrum();
-    const double *lambda = hamiltonian_.weights(), *f = hamiltonian_.forcing();
+    const double *lambda = origin_.lambda.data(), *f = origin_.f.empty() ? nullptr : origin_.f.data();
     bool active = false;
     for (int s = 0; s < N_; ++s) {
-        if (D.owned[s]) {
-            int a, c;
-            mpi::line_mode(D, N_, 0, s, a, c);
-            const std::size_t m = mode_index(a, c, N_);
-            b[2 * s] = line0[2 * s] * lambda[m];
-            b[2 * s + 1] = line0[2 * s + 1] * lambda[m];
+        if (origin_.owned[s]) {
+            b[2 * s] = line0[2 * s] * lambda[s];
+            b[2 * s + 1] = line0[2 * s + 1] * lambda[s];
             if (f) {
-                b[2 * s] += f[2 * m];
-                b[2 * s + 1] += f[2 * m + 1];
+                b[2 * s] += f[2 * s];
+                b[2 * s + 1] += f[2 * s + 1];
             }
             active = active || b[2 * s] != 0.0 || b[2 * s + 1] != 0.0;
         } else {
@@ -326,8 +337,16 @@ void SineEulerMpi::flow(std::size_t piece, double t, double *state) {
     transforms();
     const std::size_t held = static_cast<std::size_t>(state[0]);
     const Direction &D = dirs_[piece];
-    exchange_.move(dirs_[held], held, D, piece, state);
-    if (!line_spectrum(D, state + mpi::line0_entry())) return;
+    // The weights of D's line 0 travel with the exchange, unless held already.
+    const bool fetch = origin_piece_ != piece;
+    if (fetch) share_.origin_line_riders(D, piece, riders_);
+    exchange_.move(dirs_[held], held, D, piece, state, fetch ? &riders_ : nullptr);
+    if (fetch) {
+        origin_piece_ = kNoPiece;
+        share_.read_origin_line(D, piece, riders_, origin_);
+        origin_piece_ = piece;
+    }
+    if (!line_spectrum(state + mpi::line0_entry())) return;
     const double factor = t / (2.0 * eps_);
     double *slab = state + mpi::slab_entry(N_);
     run_line_flows(*transforms_, N_, mine_, threads_, factor,

@@ -42,12 +42,14 @@ double mean(double x, double y) { return x == y ? x : 0.5 * x + 0.5 * y; }
 
 }  // namespace
 
+double Hamiltonian::euler_weight(int a, int b, int N) {
+    const double m2 = norm2(a, b, N);
+    return m2 != 0 ? 1.0 / m2 : 0.0;
+}
+
 Hamiltonian::Hamiltonian(int N) : N_(N), lambda_(squared(N)) {
     for (int a = 0; a < N; ++a)
-        for (int b = 0; b < N; ++b) {
-            const double m2 = norm2(a, b, N);
-            lambda_[mode_index(a, b, N)] = m2 != 0 ? 1.0 / m2 : 0.0;
-        }
+        for (int b = 0; b < N; ++b) lambda_[mode_index(a, b, N)] = euler_weight(a, b, N);
 }
 
 Hamiltonian::Hamiltonian(int N, const double *lambda, std::size_t n_lambda, const double *f,

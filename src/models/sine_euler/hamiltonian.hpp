@@ -19,6 +19,8 @@ class Hamiltonian {
 public:
     // Euler: lambda_n = 1/|n|^2 (computed as 1.0 / |n|^2), f = 0.
     explicit Hamiltonian(int N);
+    // Euler's lambda of mode (a, b): 1.0 / |n|^2, 0 for the zero mode.
+    static double euler_weight(int a, int b, int N);
     // Validates and stores lambda (n_lambda = N^2) and f (n_f = 2 N^2
     // interleaved re, im; or f = nullptr with n_f = 0). LPI_ERR_SIZE for a
     // wrong length, LPI_ERR_NONFINITE for an entry that is not finite,

@@ -97,7 +97,7 @@ public:
         }
         return p;
     }
-    const Hamiltonian &hamiltonian() const override { return hamiltonian_; }
+    Hamiltonian hamiltonian() const override { return hamiltonian_; }
     void set_hamiltonian(Hamiltonian H) override {
         if (H.truncation() != N_)
             fail(LPI_ERR_INTERNAL, "a Hamiltonian of N = " + std::to_string(H.truncation()) +

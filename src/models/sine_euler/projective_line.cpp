@@ -50,8 +50,7 @@ std::vector<int> prime_factors(int N) {
 //   mode lies on its own class only); for a non-unit s, by (0,1) or (1,m) as
 //   above, or, when neither, by the first later class met (one byte per
 //   mode, for these modes only: N with a squared prime factor).
-std::vector<Direction> projective_line(int N) {
-    std::vector<Direction> dirs;
+void for_each_direction(int N, const std::function<void(Direction &&)> &visit) {
     std::vector<int> gcd_with_n(N);
     for (int x = 0; x < N; ++x) gcd_with_n[x] = std::gcd(x, N);
     auto unit = [&](int x) { return gcd_with_n[x] == 1; };
@@ -106,7 +105,7 @@ std::vector<Direction> projective_line(int N) {
             D.j1 = modulo(static_cast<std::int64_t>(D.j1) * inverse, N);
             D.j2 = modulo(static_cast<std::int64_t>(D.j2) * inverse, N);
         }
-        dirs.push_back(std::move(D));
+        visit(std::move(D));
     };
     add(0, 1);
     for (int m = 0; m < N; ++m) add(1, m);
@@ -121,6 +120,11 @@ std::vector<Direction> projective_line(int N) {
             add(g, k2);
         }
     }
+}
+
+std::vector<Direction> projective_line(int N) {
+    std::vector<Direction> dirs;
+    for_each_direction(N, [&](Direction &&D) { dirs.push_back(std::move(D)); });
     return dirs;
 }
 

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "hamiltonian.hpp"
@@ -37,6 +38,10 @@ struct Direction {
 // prime N ((0,1), then (1,m), m = 0..N-1), then, for composite N, the other
 // classes in lexicographic order. Every nonzero mode is owned by exactly one.
 std::vector<Direction> projective_line(int N);
+// The same directions, handed to visit one at a time in that order: a
+// caller that keeps only part of each (the MPI model keeps the ownership of
+// its own modes) never holds every direction's table at once.
+void for_each_direction(int N, const std::function<void(Direction &&)> &visit);
 
 // The odd primes dividing N.
 std::vector<int> prime_factors(int N);
