@@ -6,6 +6,7 @@
  * with the state unchanged. */
 #include <liepoisson_mpi.h>
 #include <malloc.h>
+#include <unistd.h>
 
 #include "lpi_test.h"
 
@@ -302,6 +303,59 @@ static void test_memory_per_process(void **state) {
     assert_true(share <= allowed);
 }
 
+/* Stops the run at step 2 on rank 0 alone. */
+static int stop_on_rank_0(const lpi_system *sys, int64_t step, double t, void *user) {
+    (void)sys, (void)t, (void)user;
+    return rank_ == 0 && step == 2;
+}
+
+/* Processes that pass different arguments to a call: refused on every
+ * process with LPI_ERR_INVALID before anything else (a value that one
+ * process alone refused would leave the others waiting in a collective), the
+ * state unchanged. Thread counts may differ; an observer that stops on one
+ * process stops every process at the same step. */
+static void test_different_arguments(void **state) {
+    (void)state;
+    if (size_ == 1) LPI_SKIP("needs 2 or more processes");
+    const int N = 13;
+    const size_t n = (size_t)N * N;
+    double x[169], y[169], c[13], lambda[169], f[338];
+    lpi_system *spread, *single;
+    make_pair(N, "leapfrog", &spread, &single, x);
+    const int last = rank_ == size_ - 1;
+    LPI_ASSERT_FAILS(spread, lpi_step(spread, last ? 0.02 : 0.01, 3), LPI_ERR_INVALID, "lpi_step");
+    LPI_ASSERT_FAILS(spread, lpi_step(spread, 0.01, last ? 4 : 3), LPI_ERR_INVALID, "lpi_step");
+    LPI_ASSERT_FAILS(spread, lpi_step(spread, last ? NAN : 0.01, 3), LPI_ERR_INVALID, "lpi_step");
+    LPI_ASSERT_FAILS(spread, lpi_set_state(spread, last ? NULL : x, n), LPI_ERR_INVALID, "lpi_set_state");
+    LPI_ASSERT_FAILS(spread, lpi_set_state(spread, x, last ? n - 1 : n), LPI_ERR_INVALID, "lpi_set_state");
+    LPI_ASSERT_FAILS(spread, lpi_get_state(spread, y, last ? n + 1 : n), LPI_ERR_INVALID, "lpi_get_state");
+    LPI_ASSERT_FAILS(spread, lpi_casimirs(spread, c, last ? 3 : 13), LPI_ERR_INVALID, "lpi_casimirs");
+    LPI_ASSERT_FAILS(spread, lpi_energy(spread, last ? NULL : c), LPI_ERR_INVALID, "lpi_energy");
+    LPI_ASSERT_FAILS(spread, lpi_set_method(spread, last ? "suzuki-4" : "leapfrog"), LPI_ERR_INVALID,
+                     "lpi_set_method");
+    const double gammas[3][3] = {{1.0, -1.0, 1.0}, {1.0 / 3, 1.0 / 3, 1.0 / 3}};
+    LPI_ASSERT_FAILS(spread, lpi_set_composition(spread, 3, gammas[last]), LPI_ERR_INVALID,
+                     "lpi_set_composition");
+    sqg_over_topography(N, lambda, f);
+    lambda[1] = last ? NAN : lambda[1]; /* refused as not finite on one process alone */
+    LPI_ASSERT_FAILS(spread, lpi_sine_euler_set_hamiltonian(spread, lambda, n, f, 2 * n), LPI_ERR_INVALID,
+                     "lpi_sine_euler_set_hamiltonian");
+    LPI_ASSERT_FAILS(spread, lpi_save(spread, last ? NULL : "never_written.lpi"), LPI_ERR_INVALID, "lpi_save");
+    assert_int_equal(access("never_written.lpi", F_OK), -1);
+
+    /* Threads per process may differ: the same bits. */
+    const int threads = lpi_set_threads(spread, 1 + rank_ % 2);
+    assert_true(threads == LPI_OK || threads == LPI_ERR_UNSUPPORTED);
+    assert_int_equal(lpi_set_observer(spread, 1, stop_on_rank_0, NULL), LPI_OK);
+    assert_int_equal(lpi_step(spread, 0.01, 5), LPI_STOPPED);
+    assert_true(lpi_time(spread) == 2 * 0.01);
+    assert_int_equal(lpi_step(single, 0.01, 2), LPI_OK);
+    assert_int_equal(lpi_get_state(spread, x, n), LPI_OK);
+    assert_int_equal(lpi_get_state(single, y, n), LPI_OK);
+    assert_true(max_diff(x, y, n) <= 1e-14 * max_abs(y, n));
+    lpi_destroy(spread), lpi_destroy(single);
+}
+
 /* Bad input: the same status on every process, the state unchanged. */
 static void test_bad_input(void **state) {
     (void)state;
@@ -349,6 +403,7 @@ int main(void) {
         cmocka_unit_test(test_hamiltonian),
         cmocka_unit_test(test_memory_per_process),
         cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_different_arguments),
     };
     const int status = lpi_run_tests(tests);
     MPI_Finalize();

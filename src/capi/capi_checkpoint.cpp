@@ -7,8 +7,10 @@
 #include "../core/checkpoint.hpp"
 #include "handle.hpp"
 
+using lpi::capi::Arguments;
 using lpi::capi::guarded;
 using lpi::capi::require;
+using lpi::capi::Text;
 
 namespace {
 
@@ -45,7 +47,7 @@ int load(lpi_system **out, const char *function, const char *path, Read &&read) 
 extern "C" {
 
 LPI_API int lpi_save(const lpi_system *sys, const char *path) {
-    return guarded(sys, "lpi_save", [&] {
+    return guarded(sys, "lpi_save", Arguments(Text{path}), [&] {
         require(sys, "system");
         require(path, "path");
         if (!*path) lpi::fail(LPI_ERR_INVALID, "path is empty");
@@ -65,7 +67,7 @@ LPI_API int lpi_load(lpi_system **out, const char *path) {
 }
 
 LPI_API int lpi_save_buffer(const lpi_system *sys, void *buf, size_t capacity, size_t *size) {
-    return guarded(sys, "lpi_save_buffer", [&] {
+    return guarded(sys, "lpi_save_buffer", Arguments(buf, capacity, size), [&] {
         require(sys, "system");
         require(size, "size");
         if (!buf && capacity > 0)

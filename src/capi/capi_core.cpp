@@ -8,8 +8,10 @@
 #include "handle.hpp"
 
 using lpi::capi::create;
+using lpi::capi::Arguments;
 using lpi::capi::guarded;
 using lpi::capi::require;
+using lpi::capi::Text;
 
 namespace lpi::capi {
 std::string &thread_error() {
@@ -72,7 +74,7 @@ LPI_API int lpi_destroy(lpi_system *sys) {
 }
 
 LPI_API int lpi_set_method(lpi_system *sys, const char *name) {
-    return guarded(sys, "lpi_set_method", [&] {
+    return guarded(sys, "lpi_set_method", Arguments(Text{name}), [&] {
         require(sys, "system");
         require(name, "method name");
         sys->system.set_method(name);
@@ -80,7 +82,7 @@ LPI_API int lpi_set_method(lpi_system *sys, const char *name) {
 }
 
 LPI_API int lpi_set_split(lpi_system *sys, const char *name) {
-    return guarded(sys, "lpi_set_split", [&] {
+    return guarded(sys, "lpi_set_split", Arguments(Text{name}), [&] {
         require(sys, "system");
         require(name, "split name");
         sys->system.set_split(name);
@@ -88,7 +90,7 @@ LPI_API int lpi_set_split(lpi_system *sys, const char *name) {
 }
 
 LPI_API int lpi_set_threads(lpi_system *sys, int32_t n) {
-    return guarded(sys, "lpi_set_threads", [&] {
+    return guarded(sys, "lpi_set_threads", Arguments(), [&] {
         require(sys, "system");
         sys->system.set_threads(n);  // bounded in the System, before the model sees n
     });
@@ -109,7 +111,7 @@ LPI_API const char *lpi_get_split(const lpi_system *sys) {
 LPI_API size_t lpi_dim(const lpi_system *sys) { return sys ? sys->system.dim() : 0; }
 
 LPI_API int lpi_set_state(lpi_system *sys, const double *x, size_t n) {
-    return guarded(sys, "lpi_set_state", [&] {
+    return guarded(sys, "lpi_set_state", Arguments(x, n), [&] {
         require(sys, "system");
         require(x, "state");
         sys->system.set_state(x, n);
@@ -117,7 +119,7 @@ LPI_API int lpi_set_state(lpi_system *sys, const double *x, size_t n) {
 }
 
 LPI_API int lpi_get_state(const lpi_system *sys, double *x, size_t n) {
-    return guarded(sys, "lpi_get_state", [&] {
+    return guarded(sys, "lpi_get_state", Arguments(x, n), [&] {
         require(sys, "system");
         require(x, "state buffer");
         sys->system.get_state(x, n);
@@ -125,14 +127,14 @@ LPI_API int lpi_get_state(const lpi_system *sys, double *x, size_t n) {
 }
 
 LPI_API int lpi_step(lpi_system *sys, double dt, int64_t nsteps) {
-    return guarded(sys, "lpi_step", [&] {
+    return guarded(sys, "lpi_step", Arguments(dt, nsteps), [&] {
         require(sys, "system");
         return sys->system.step(dt, nsteps) ? LPI_OK : LPI_STOPPED;
     });
 }
 
 LPI_API int lpi_set_observer(lpi_system *sys, int64_t every, lpi_observer_fn fn, void *user) {
-    return guarded(sys, "lpi_set_observer", [&] {
+    return guarded(sys, "lpi_set_observer", Arguments(every, fn), [&] {
         require(sys, "system");
         if (!fn) return sys->system.set_observer(0, nullptr);
         // While fn runs the handle is Observing: fn may read it, not change it.
@@ -148,7 +150,7 @@ LPI_API double lpi_time(const lpi_system *sys) {
 }
 
 LPI_API int lpi_energy(const lpi_system *sys, double *out) {
-    return guarded(sys, "lpi_energy", [&] {
+    return guarded(sys, "lpi_energy", Arguments(out), [&] {
         require(sys, "system");
         require(out, "out");
         *out = sys->system.energy();
@@ -160,7 +162,7 @@ LPI_API size_t lpi_casimir_count(const lpi_system *sys) {
 }
 
 LPI_API int lpi_casimirs(const lpi_system *sys, double *out, size_t n) {
-    return guarded(sys, "lpi_casimirs", [&] {
+    return guarded(sys, "lpi_casimirs", Arguments(out, n), [&] {
         require(sys, "system");
         require(out, "out");
         sys->system.casimirs(out, n);

@@ -5,7 +5,9 @@
 #include "handle.hpp"
 
 using lpi::capi::create;
+using lpi::capi::Arguments;
 using lpi::capi::guarded;
+using lpi::capi::guarded_local_read;
 using lpi::capi::require;
 
 extern "C" {
@@ -25,7 +27,7 @@ LPI_API int lpi_generic_create(lpi_system **out, size_t dim, size_t nnz, const i
 
 LPI_API int lpi_add_piece(lpi_system *sys, size_t n, const int32_t *indices,
                           lpi_gradient_fn grad, lpi_energy_fn energy, void *user) {
-    return guarded(sys, "lpi_add_piece", [&] {
+    return guarded(sys, "lpi_add_piece", Arguments(n, indices, grad, energy), [&] {
         require(sys, "system");
         lpi::generic_model_of(sys->system);  // the kind first: a rigid body has no pieces to add
         require(indices, "indices");
@@ -34,14 +36,14 @@ LPI_API int lpi_add_piece(lpi_system *sys, size_t n, const int32_t *indices,
 }
 
 LPI_API int lpi_add_casimir(lpi_system *sys, lpi_casimir_fn fn, void *user) {
-    return guarded(sys, "lpi_add_casimir", [&] {
+    return guarded(sys, "lpi_add_casimir", Arguments(fn), [&] {
         require(sys, "system");
         lpi::generic_model_of(sys->system).add_casimir(fn, user);
     });
 }
 
 LPI_API int lpi_poisson_rank(const lpi_system *sys, const double *x, size_t n, size_t *rank) {
-    return guarded(sys, "lpi_poisson_rank", [&] {
+    return guarded_local_read(sys, "lpi_poisson_rank", [&] {
         require(sys, "system");
         const lpi::GenericModel &model = lpi::generic_model_of(sys->system);
         require(x, "x");
@@ -60,7 +62,7 @@ LPI_API int lpi_moments_create(lpi_system **out) {
 
 LPI_API int lpi_moments_add_product_piece(lpi_system *sys, lpi_scalar_fn h, lpi_scalar_fn dh,
                                           void *user) {
-    return guarded(sys, "lpi_moments_add_product_piece", [&] {
+    return guarded(sys, "lpi_moments_add_product_piece", Arguments(h, dh), [&] {
         require(sys, "system");
         lpi::add_moments_product_piece(sys->system, h, dh, user);
     });

@@ -6,7 +6,9 @@
 #include "../core/methods.hpp"
 #include "handle.hpp"
 
+using lpi::capi::Arguments;
 using lpi::capi::guarded;
+using lpi::capi::guarded_local_read;
 using lpi::capi::require;
 
 namespace {
@@ -48,7 +50,7 @@ LPI_API int lpi_method_is_poisson(int i) {
 }
 
 LPI_API int lpi_set_implicit_options(lpi_system *sys, double tolerance, int32_t max_iterations) {
-    return guarded(sys, "lpi_set_implicit_options", [&] {
+    return guarded(sys, "lpi_set_implicit_options", Arguments(tolerance, max_iterations), [&] {
         require(sys, "system");
         if (std::isnan(tolerance)) lpi::fail(LPI_ERR_NONFINITE, "tolerance is NaN");
         sys->system.set_implicit_settings({tolerance, max_iterations});
@@ -56,7 +58,7 @@ LPI_API int lpi_set_implicit_options(lpi_system *sys, double tolerance, int32_t 
 }
 
 LPI_API int lpi_set_composition(lpi_system *sys, size_t n, const double *gammas) {
-    return guarded(sys, "lpi_set_composition", [&] {
+    return guarded(sys, "lpi_set_composition", Arguments(n, gammas), [&] {
         require(sys, "system");
         require(gammas, "gammas");
         sys->system.set_composition(gammas, n);
@@ -64,7 +66,7 @@ LPI_API int lpi_set_composition(lpi_system *sys, size_t n, const double *gammas)
 }
 
 LPI_API int lpi_flows_per_step(const lpi_system *sys, size_t *out) {
-    return guarded(sys, "lpi_flows_per_step", [&] {
+    return guarded_local_read(sys, "lpi_flows_per_step", [&] {
         require(sys, "system");
         require(out, "out");
         *out = sys->system.flows_per_step();

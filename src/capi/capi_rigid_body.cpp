@@ -7,12 +7,13 @@
 #include "handle.hpp"
 
 using lpi::capi::guarded;
+using lpi::capi::guarded_local_read;
 using lpi::capi::require;
 
 extern "C" {
 
 LPI_API int lpi_rigid_body_exact(const lpi_system *sys, double t, double *out) {
-    return guarded(sys, "lpi_rigid_body_exact", [&] {
+    return guarded_local_read(sys, "lpi_rigid_body_exact", [&] {
         require(sys, "system");
         require(out, "out");
         if (!std::isfinite(t)) lpi::fail(LPI_ERR_NONFINITE, "t is not finite");

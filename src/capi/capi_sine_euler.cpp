@@ -10,8 +10,11 @@
 #include "handle.hpp"
 
 using lpi::capi::create;
+using lpi::capi::Arguments;
 using lpi::capi::guarded;
+using lpi::capi::guarded_local_read;
 using lpi::capi::require;
+using lpi::capi::Text;
 
 namespace {
 
@@ -58,7 +61,7 @@ LPI_API int lpi_sine_euler_create(lpi_system **out, int32_t N) {
 }
 
 LPI_API int lpi_sine_euler_size(const lpi_system *sys, int32_t *N) {
-    return guarded(sys, "lpi_sine_euler_size", [&] {
+    return guarded_local_read(sys, "lpi_sine_euler_size", [&] {
         const auto &model = sine_euler(sys);
         require(N, "N");
         *N = model.truncation();
@@ -66,7 +69,7 @@ LPI_API int lpi_sine_euler_size(const lpi_system *sys, int32_t *N) {
 }
 
 LPI_API int lpi_sine_euler_set_modes(lpi_system *sys, const double *re_im, size_t n) {
-    return guarded(sys, "lpi_sine_euler_set_modes", [&] {
+    return guarded(sys, "lpi_sine_euler_set_modes", Arguments(re_im, n), [&] {
         set_converted(sys, re_im, n, "modes", 2, [&](const lpi::SineEulerModel &model, double *x) {
             model.public_from_modes(re_im, x);
         });
@@ -74,7 +77,7 @@ LPI_API int lpi_sine_euler_set_modes(lpi_system *sys, const double *re_im, size_
 }
 
 LPI_API int lpi_sine_euler_get_modes(const lpi_system *sys, double *re_im, size_t n) {
-    return guarded(sys, "lpi_sine_euler_get_modes", [&] {
+    return guarded(sys, "lpi_sine_euler_get_modes", Arguments(re_im, n), [&] {
         const auto &model = sine_euler(sys);
         require(re_im, "modes buffer");
         lpi::require_length("modes buffer", n, 2 * squared(model.truncation()));
@@ -84,7 +87,7 @@ LPI_API int lpi_sine_euler_get_modes(const lpi_system *sys, double *re_im, size_
 }
 
 LPI_API int lpi_sine_euler_set_grid(lpi_system *sys, const double *w, size_t n) {
-    return guarded(sys, "lpi_sine_euler_set_grid", [&] {
+    return guarded(sys, "lpi_sine_euler_set_grid", Arguments(w, n), [&] {
         set_converted(sys, w, n, "grid", 1, [&](const lpi::SineEulerModel &model, double *x) {
             model.public_from_grid(w, x);
         });
@@ -92,7 +95,7 @@ LPI_API int lpi_sine_euler_set_grid(lpi_system *sys, const double *w, size_t n) 
 }
 
 LPI_API int lpi_sine_euler_get_grid(const lpi_system *sys, double *w, size_t n) {
-    return guarded(sys, "lpi_sine_euler_get_grid", [&] {
+    return guarded(sys, "lpi_sine_euler_get_grid", Arguments(w, n), [&] {
         const auto &model = sine_euler(sys);
         require(w, "grid buffer");
         lpi::require_length("grid buffer", n, squared(model.truncation()));
@@ -106,7 +109,7 @@ LPI_API int lpi_sine_euler_get_grid(const lpi_system *sys, double *w, size_t n) 
 }
 
 LPI_API int lpi_sine_euler_enstrophy(const lpi_system *sys, double *out) {
-    return guarded(sys, "lpi_sine_euler_enstrophy", [&] {
+    return guarded(sys, "lpi_sine_euler_enstrophy", Arguments(out), [&] {
         const auto &model = sine_euler(sys);
         require(out, "out");
         const double enstrophy = model.enstrophy(sys->system.working_state().data());
@@ -116,7 +119,7 @@ LPI_API int lpi_sine_euler_enstrophy(const lpi_system *sys, double *out) {
 }
 
 LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, double *out) {
-    return guarded(sys, "lpi_sine_euler_casimir_traces", [&] {
+    return guarded(sys, "lpi_sine_euler_casimir_traces", Arguments(kmax, out), [&] {
         const auto &model = sine_euler(sys);
         require(out, "out");
         if (kmax < 1) lpi::fail(LPI_ERR_INVALID, "kmax must be >= 1, got " + std::to_string(kmax));
@@ -131,7 +134,7 @@ LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, d
 
 LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *seconds_per_step,
                                      double *transforms_per_step) {
-    return guarded(sys, "lpi_sine_euler_fft_floor", [&] {
+    return guarded(sys, "lpi_sine_euler_fft_floor", Arguments(nsteps, seconds_per_step, transforms_per_step), [&] {
         auto &model = sine_euler(sys);
         require(seconds_per_step, "seconds_per_step");
         require(transforms_per_step, "transforms_per_step");
@@ -152,7 +155,7 @@ LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *se
 }
 
 LPI_API int lpi_sine_euler_set_planning(lpi_system *sys, const char *rigor) {
-    return guarded(sys, "lpi_sine_euler_set_planning", [&] {
+    return guarded(sys, "lpi_sine_euler_set_planning", Arguments(Text{rigor}), [&] {
         auto &model = sine_euler(sys);
         require(rigor, "rigor");
         model.set_planning(lpi::planning_from_name(rigor));
@@ -160,7 +163,7 @@ LPI_API int lpi_sine_euler_set_planning(lpi_system *sys, const char *rigor) {
 }
 
 LPI_API int lpi_sine_euler_get_planning(const lpi_system *sys, const char **rigor) {
-    return guarded(sys, "lpi_sine_euler_get_planning", [&] {
+    return guarded_local_read(sys, "lpi_sine_euler_get_planning", [&] {
         const auto &model = sine_euler(sys);
         require(rigor, "rigor");
         *rigor = lpi::planning_name(model.planning());
@@ -209,9 +212,14 @@ extern "C" {
 
 LPI_API int lpi_sine_euler_set_hamiltonian(lpi_system *sys, const double *lambda, size_t n_lambda,
                                            const double *f, size_t n_f) {
-    return guarded(sys, "lpi_sine_euler_set_hamiltonian", [&] {
+    return guarded(sys, "lpi_sine_euler_set_hamiltonian", Arguments(lambda, n_lambda, f, n_f), [&] {
         auto &model = sine_euler(sys);
         require(lambda, "lambda");
+        // The contents of arrays of the right length are compared between
+        // the processes of a spread system before they are validated.
+        const std::size_t modes = squared(model.truncation());
+        if (n_lambda == modes) model.require_same_on_every_process(lambda, sizeof(double) * modes, "lambda");
+        if (f && n_f == 2 * modes) model.require_same_on_every_process(f, sizeof(double) * n_f, "f");
         // Validated in full before the model is touched.
         model.set_hamiltonian(
             lpi::sine_euler::Hamiltonian(model.truncation(), lambda, n_lambda, f, n_f));
@@ -219,7 +227,7 @@ LPI_API int lpi_sine_euler_set_hamiltonian(lpi_system *sys, const double *lambda
 }
 
 LPI_API int lpi_sine_euler_get_stream(const lpi_system *sys, double *psi, size_t n) {
-    return guarded(sys, "lpi_sine_euler_get_stream", [&] {
+    return guarded(sys, "lpi_sine_euler_get_stream", Arguments(psi, n), [&] {
         const auto &model = sine_euler(sys);
         require(psi, "stream function buffer");
         const int N = model.truncation();
@@ -237,7 +245,7 @@ LPI_API int lpi_sine_euler_get_stream(const lpi_system *sys, double *psi, size_t
 
 LPI_API int lpi_sine_euler_spectrum(const lpi_system *sys, double *energy, double *enstrophy,
                                     size_t n, size_t *shells) {
-    return guarded(sys, "lpi_sine_euler_spectrum", [&] {
+    return guarded(sys, "lpi_sine_euler_spectrum", Arguments(energy, enstrophy, n, shells), [&] {
         const auto &model = sine_euler(sys);
         require(shells, "shells");
         if (n > 0) {

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -74,18 +76,74 @@ inline const char *refusal(const lpi_system *sys, bool mutates) {
                  "allowed there, and nothing was changed";
 }
 
+// A string argument compared by its contents (other pointers are compared
+// by whether they are NULL).
+struct Text {
+    const char *text;
+};
+
+// The arguments of a call, as words that every process of a handle spread
+// over processes must agree on before the call does anything (a value that
+// one process alone refuses would leave the others waiting in a collective):
+// numbers by their bits, pointers by whether they are NULL, Text by its
+// contents. What arrays hold is compared where it is first read, after its
+// length is checked (Model::require_same_on_every_process).
+class Arguments {
+public:
+    template <class... A>
+    explicit Arguments(const A &...arguments) noexcept {
+        (add(arguments), ...);
+    }
+    // FNV-1a of the words (nothing is allocated: a call may be refused for
+    // want of memory only inside its guard).
+    std::uint64_t fingerprint() const { return hash_; }
+
+private:
+    void mix(std::uint64_t word) noexcept {
+        for (int byte = 0; byte < 8; ++byte) hash_ = (hash_ ^ ((word >> (8 * byte)) & 0xff)) * 1099511628211ull;
+    }
+    template <class T>
+    void add(const T &x) noexcept {
+        if constexpr (std::is_pointer_v<T>) {
+            mix(x != nullptr);
+        } else if constexpr (std::is_floating_point_v<T>) {
+            const double d = x;
+            std::uint64_t bits;
+            std::memcpy(&bits, &d, sizeof bits);
+            mix(bits);
+        } else {
+            static_assert(std::is_integral_v<T>, "an argument is a number, a pointer or Text");
+            mix(static_cast<std::uint64_t>(x));
+        }
+    }
+    void add(const Text &t) noexcept {
+        mix(t.text != nullptr);
+        if (!t.text) return;
+        const std::size_t length = std::strlen(t.text);
+        mix(length);
+        for (std::size_t i = 0; i < length; ++i) mix(static_cast<unsigned char>(t.text[i]));
+    }
+    std::uint64_t hash_ = 1469598103934665603ull;
+};
+
 // Runs body() with sys marked Busy; maps lpi::Error to its status,
 // std::bad_alloc and std::length_error to LPI_ERR_NO_MEMORY and anything else
 // to LPI_ERR_INTERNAL, recording the message on sys (or the thread when sys
 // is NULL). A body may return a status of its own (LPI_STOPPED).
 template <class Body>
-int run_guarded(const lpi_system *sys, bool mutates, const char *function, Body &&body) noexcept {
+int run_guarded(const lpi_system *sys, bool mutates, const char *function, const Arguments *arguments,
+                Body &&body) noexcept {
     if (const char *why = refusal(sys, mutates)) {
         try { record(sys, std::string(function) + ": " + why); } catch (...) {}
         return LPI_ERR_BUSY;
     }
     ActivityScope scope(sys, Activity::Busy);
     try {
+        if (sys && arguments) {
+            const std::uint64_t fingerprint = arguments->fingerprint();
+            sys->system.model().require_same_on_every_process(&fingerprint, sizeof fingerprint,
+                                                              "arguments to this call");
+        }
         if constexpr (std::is_void_v<decltype(body())>) {
             body();
             return LPI_OK;
@@ -112,17 +170,25 @@ int run_guarded(const lpi_system *sys, bool mutates, const char *function, Body 
 
 // A function taking a mutable handle may change it; one taking a const handle
 // only reads it. The signature decides which calls an observer may make.
+// Every call that changes a handle, and every read that a spread handle
+// answers collectively (a getter of the field, energies, Casimirs, a save),
+// names its arguments; reads that stay on one process (sizes, names, the
+// time) do not, so a program may make them on one process alone.
 template <class Body>
-int guarded(lpi_system *sys, const char *function, Body &&body) noexcept {
-    return run_guarded(sys, true, function, std::forward<Body>(body));
+int guarded(lpi_system *sys, const char *function, const Arguments &arguments, Body &&body) noexcept {
+    return run_guarded(sys, true, function, &arguments, std::forward<Body>(body));
 }
 template <class Body>
-int guarded(const lpi_system *sys, const char *function, Body &&body) noexcept {
-    return run_guarded(sys, false, function, std::forward<Body>(body));
+int guarded(const lpi_system *sys, const char *function, const Arguments &arguments, Body &&body) noexcept {
+    return run_guarded(sys, false, function, &arguments, std::forward<Body>(body));
+}
+template <class Body>
+int guarded_local_read(const lpi_system *sys, const char *function, Body &&body) noexcept {
+    return run_guarded(sys, false, function, nullptr, std::forward<Body>(body));
 }
 template <class Body>
 int guarded(std::nullptr_t, const char *function, Body &&body) noexcept {
-    return run_guarded(nullptr, false, function, std::forward<Body>(body));
+    return run_guarded(nullptr, false, function, nullptr, std::forward<Body>(body));
 }
 
 // Rejects a NULL handle or pointer argument with LPI_ERR_NULL.

@@ -241,11 +241,15 @@ Method find_method(const std::string &requested) {
                               std::to_string(kMaxRecursiveOrder) + ")");
 }
 
-Method custom_composition(const double *gammas, std::size_t n) {
-    constexpr double kTolerance = 1e-14;
+void require_composition_count(std::size_t n) {
     if (n == 0) fail(LPI_ERR_INVALID, "a composition needs n >= 1 weights, got n = 0");
     if (n > static_cast<std::size_t>(std::numeric_limits<int>::max()))
         fail(LPI_ERR_INVALID, "n = " + std::to_string(n) + " weights is too many");
+}
+
+Method custom_composition(const double *gammas, std::size_t n) {
+    constexpr double kTolerance = 1e-14;
+    require_composition_count(n);
     for (std::size_t i = 0; i < n; ++i)
         if (!std::isfinite(gammas[i]))
             fail(LPI_ERR_NONFINITE, "gammas[" + std::to_string(i) + "] = " +

@@ -77,6 +77,9 @@ std::vector<double> suzuki_gammas(int order);
 // their mean so the stored composition is exactly symmetric. Throws
 // lpi::Error naming the offending weight otherwise.
 Method custom_composition(const double *gammas, std::size_t n);
+// LPI_ERR_INVALID for a weight count custom_composition refuses before
+// reading the weights (0, or more than an int counts).
+void require_composition_count(std::size_t n);
 
 // One exact piece flow of a splitting step: piece `piece` for weight * dt.
 struct Flow {

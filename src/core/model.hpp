@@ -68,6 +68,17 @@ public:
     // Runs action on one process (a file written once) and gives its outcome,
     // a return or an lpi::Error, to every process.
     virtual void on_one_process(const std::function<void()> &action) const { action(); }
+    // Whether `value` holds on any process (an observer that stops the run
+    // on one process stops it on all).
+    virtual bool on_any_process(bool value) const { return value; }
+    // Throws LPI_ERR_INVALID on every process when the processes passed
+    // different bytes (`what`, named in the message), before anything reads
+    // them otherwise: a value refused on one process alone would leave the
+    // others waiting in a collective. Nothing for a model of one process.
+    virtual void require_same_on_every_process(const void *bytes, std::size_t size,
+                                               const std::string &what) const {
+        (void)bytes, (void)size, (void)what;
+    }
 };
 
 }  // namespace lpi

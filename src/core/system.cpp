@@ -55,6 +55,8 @@ void System::set_method(const std::string &name) {
 }
 
 void System::set_composition(const double *gammas, std::size_t n) {
+    require_composition_count(n);
+    model_->require_same_on_every_process(gammas, n * sizeof(double), "composition weights");
     Method method = custom_composition(gammas, n);
     auto integrator = make_integrator(method, *model_, implicit_);
     method_ = std::move(method);
@@ -157,7 +159,7 @@ bool System::step(double dt, std::int64_t nsteps) {
         watch.every = observe_every_;
         watch.observe = [&](std::int64_t done) {
             time_ = start + dt * static_cast<double>(done);
-            return observer_(done, time_);
+            return model_->on_any_process(observer_(done, time_));
         };
     }
     saved_ = state_;

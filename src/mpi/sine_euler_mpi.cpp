@@ -39,11 +39,11 @@ using mpi::LineOwnership;
 using mpi::OriginLineWeights;
 using mpi::Riders;
 
-// FNV-1a of the bytes of n doubles: the processes compare their inputs.
-long long fingerprint(const double *x, std::size_t n) {
+// FNV-1a of `size` bytes: the processes compare their inputs.
+long long fingerprint(const void *data, std::size_t size) {
     std::uint64_t h = 1469598103934665603ull;
-    const auto *bytes = reinterpret_cast<const unsigned char *>(x);
-    for (std::size_t i = 0; i < n * sizeof(double); ++i) h = (h ^ bytes[i]) * 1099511628211ull;
+    const auto *bytes = static_cast<const unsigned char *>(data);
+    for (std::size_t i = 0; i < size; ++i) h = (h ^ bytes[i]) * 1099511628211ull;
     return static_cast<long long>(h);
 }
 
@@ -106,6 +106,14 @@ public:
     }
     std::vector<double> whole_state(const double *state) const override;
     void on_one_process(const std::function<void()> &action) const override { comm_->on_root(action); }
+    bool on_any_process(bool value) const override { return !comm_->all(!value); }
+    void require_same_on_every_process(const void *bytes, std::size_t size, const std::string &what) const override {
+        const std::vector<long long> prints = comm_->allgather(fingerprint(bytes, size));
+        for (long long p : prints)
+            if (p != prints[0])
+                fail(LPI_ERR_INVALID, "the processes passed different " + what +
+                                          " (every process must make the same calls with the same arguments)");
+    }
     std::vector<double> local_state(const double *modes, std::size_t direction) const;
 
     void to_public(const double *state, double *x) const override {
@@ -175,11 +183,7 @@ private:
     template <class Term>
     double sum_over_field(const double *state, Term &&term) const;
     void require_same_input(const double *x, std::size_t n, const char *what) const {
-        const std::vector<long long> prints = comm_->allgather(fingerprint(x, n));
-        for (long long p : prints)
-            if (p != prints[0])
-                fail(LPI_ERR_INVALID, std::string("the ") + what +
-                                          " differs between the processes (each must pass the same)");
+        require_same_on_every_process(x, n * sizeof(double), what);
     }
 
     int N_;
