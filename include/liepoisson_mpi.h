@@ -6,10 +6,13 @@
  * handles it makes are ordinary lpi_system handles: every function of
  * liepoisson.h works on them, collectively, when every process of the
  * communicator makes the same calls in the same order with the same
- * arguments: setters take the whole field on every process, getters return
- * it on every process, and a failure on any process returns the same status
- * and message on all of them. While stepping, each process holds only its
- * share of the field (about 16 N^2 / P bytes, see docs/scaling.md).
+ * arguments (compared first: arguments that differ give LPI_ERR_INVALID on
+ * every process; thread counts may differ, and reads that stay on one
+ * process, such as lpi_time, may be made by one alone): setters take the
+ * whole field on every process, getters return it on every process, and a
+ * failure on any process returns the same status and message on all of
+ * them. While stepping, each process holds only its share of the field and
+ * of the Hamiltonian (O(N^2 / P + N) bytes, see docs/scaling.md).
  * Splitting methods only: the baselines (rk4, implicit-midpoint and the
  * matrix methods) need the whole state on one process and are refused with
  * LPI_ERR_UNSUPPORTED. lpi_save writes one file, from rank 0, which
