@@ -50,7 +50,7 @@ void run_line_flows(LineTransforms &T, int N, int lines, int threads, double fac
 #if LPI_HAVE_OPENMP
 #pragma omp for schedule(static)
 #endif
-        for (int l = 0; l < N; ++l) write_phase(N, l, factor, T.spectrum(), T.up(), T.down());
+        for (int l = 0; l < N; ++l) write_phase(N, l, factor, T.spectrum(), T.phase());
 #if LPI_HAVE_OPENMP
 #pragma omp for schedule(static)
 #endif
