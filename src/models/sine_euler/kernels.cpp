@@ -20,6 +20,46 @@ namespace {
 #define LPI_SIMD_CLONES
 #endif
 
+// One or two complex numbers, interleaved (GCC's and Clang's vector
+// extensions: one instruction per operation where the target has it, pairs
+// of them where not). Every function taking them is inlined, so the warning
+// that their passing differs with and without AVX does not apply.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+typedef double Complex1 __attribute__((vector_size(16)));
+typedef double Complex2 __attribute__((vector_size(32)));
+#if defined(__clang__)
+#define LPI_SHUFFLE(v, ...) __builtin_shufflevector(v, v, __VA_ARGS__)
+#else
+typedef std::int64_t Mask1 __attribute__((vector_size(16)));
+typedef std::int64_t Mask2 __attribute__((vector_size(32)));
+template <class V> struct MaskOf;
+template <> struct MaskOf<Complex1> { typedef Mask1 type; };
+template <> struct MaskOf<Complex2> { typedef Mask2 type; };
+#define LPI_SHUFFLE(v, ...) __builtin_shuffle(v, typename MaskOf<decltype(v)>::type{__VA_ARGS__})
+#endif
+
+inline Complex2 reversed(Complex2 v) { return LPI_SHUFFLE(v, 2, 3, 0, 1); }
+inline Complex1 swap_parts(Complex1 v) { return LPI_SHUFFLE(v, 1, 0); }
+inline Complex2 swap_parts(Complex2 v) { return LPI_SHUFFLE(v, 1, 0, 3, 2); }
+inline Complex1 real_parts(Complex1 v) { return LPI_SHUFFLE(v, 0, 0); }
+inline Complex2 real_parts(Complex2 v) { return LPI_SHUFFLE(v, 0, 0, 2, 2); }
+inline Complex1 imaginary_parts(Complex1 v) { return LPI_SHUFFLE(v, 1, 1); }
+inline Complex2 imaginary_parts(Complex2 v) { return LPI_SHUFFLE(v, 1, 1, 3, 3); }
+#undef LPI_SHUFFLE
+
+template <class V>
+inline V load(const double *p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+template <class V>
+inline void store(double *p, V v) {
+    std::memcpy(p, &v, sizeof v);
+}
+
 // ---- Row and Column directions: runs along lanes --------------------------
 // A Row or Column direction's lines cross each lane (row s, or column s) in a
 // run: element s of line d0 + i is at position (o + i) mod N of lane s, with
@@ -60,41 +100,51 @@ inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
 
 // Adds n increments to positions p0 .. p0+n-1 (p0 + n <= N) of a lane and
 // writes the conjugates of the sums at positions -(p0 + r) mod N of the
-// mirror lane, in one pass (the sums are not stored twice).
-inline void put_run(int N, std::size_t step, int p0, int n, const double *__restrict increment,
-                    double *lane, double *mirror) {
+// mirror lane, in one pass (the sums are not stored twice). In a row the
+// mirrors of positions p, p + 1 are the pair N - p - 1, N - p: two sums are
+// stored at once, reversed and conjugated (exact) for the mirror.
+template <bool Rows>
+inline void put_run(int N, int p0, int n, const double *__restrict increment, double *lane,
+                    double *mirror) {
     if (n <= 0) return;
-    int r0 = 0;
+    const std::size_t step = Rows ? 1 : N;
+    int r = 0;
     if (p0 == 0) {  // position 0 is its own mirror position
-        const double re = lane[0] + increment[0], im = lane[1] + increment[1];
-        lane[0] = mirror[0] = re;
-        lane[1] = im;
-        mirror[1] = -im;
-        r0 = 1;
+        const Complex1 sum = load<Complex1>(lane) + load<Complex1>(increment);
+        store(lane, sum);
+        store(mirror, sum * Complex1{1.0, -1.0});
+        r = 1;
     }
-    for (int r = r0; r < n; ++r) {
+    if (Rows) {
+        for (; r + 2 <= n; r += 2) {
+            double *z = lane + 2 * (p0 + r), *m = mirror + 2 * (N - p0 - r - 1);
+            const Complex2 sum = load<Complex2>(z) + load<Complex2>(increment + 2 * r);
+            store(z, sum);
+            store(m, reversed(sum) * Complex2{1.0, -1.0, 1.0, -1.0});
+        }
+    }
+    for (; r < n; ++r) {
         double *z = lane + 2 * step * (p0 + r), *m = mirror + 2 * step * (N - p0 - r);
-        const double re = z[0] + increment[2 * r], im = z[1] + increment[2 * r + 1];
-        z[0] = m[0] = re;
-        z[1] = im;
-        m[1] = -im;
+        const Complex1 sum = load<Complex1>(z) + load<Complex1>(increment + 2 * r);
+        store(z, sum);
+        store(m, sum * Complex1{1.0, -1.0});
     }
 }
 
 template <bool Rows, int Count>
 inline void scatter_runs(int N, int slope, int d0, int count, int first_lane,
                          const double *__restrict x, double *w) {
-    const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
+    const std::size_t lane = Rows ? N : 1;
     const int n = Count > 0 ? Count : count;
     for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
         const double *src = x + 2 * static_cast<std::size_t>(s) * n;
         double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
         if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
-            put_run(N, step, o, n, src, dst, mirror);
+            put_run<Rows>(N, o, n, src, dst, mirror);
         } else {
             const int first = std::min(n, N - o);
-            put_run(N, step, o, first, src, dst, mirror);
-            put_run(N, step, 0, n - first, src + 2 * first, dst, mirror);
+            put_run<Rows>(N, o, first, src, dst, mirror);
+            put_run<Rows>(N, 0, n - first, src + 2 * first, dst, mirror);
         }
     });
 }
@@ -194,41 +244,6 @@ void scatter_block(const Direction &D, int N, int d0, int count, int first_lane,
 // a row of x.
 namespace {
 
-// One or two complex numbers, interleaved (GCC's and Clang's vector
-// extensions: one instruction per operation where the target has it, pairs
-// of them where not). Every function taking them is inlined, so the warning
-// that their passing differs with and without AVX does not apply.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
-typedef double Complex1 __attribute__((vector_size(16)));
-typedef double Complex2 __attribute__((vector_size(32)));
-#if defined(__clang__)
-#define LPI_SHUFFLE(v, ...) __builtin_shufflevector(v, v, __VA_ARGS__)
-#else
-typedef std::int64_t Mask1 __attribute__((vector_size(16)));
-typedef std::int64_t Mask2 __attribute__((vector_size(32)));
-template <class V> struct MaskOf;
-template <> struct MaskOf<Complex1> { typedef Mask1 type; };
-template <> struct MaskOf<Complex2> { typedef Mask2 type; };
-#define LPI_SHUFFLE(v, ...) __builtin_shuffle(v, typename MaskOf<decltype(v)>::type{__VA_ARGS__})
-#endif
-
-inline Complex1 swap_parts(Complex1 v) { return LPI_SHUFFLE(v, 1, 0); }
-inline Complex2 swap_parts(Complex2 v) { return LPI_SHUFFLE(v, 1, 0, 3, 2); }
-inline Complex1 real_parts(Complex1 v) { return LPI_SHUFFLE(v, 0, 0); }
-inline Complex2 real_parts(Complex2 v) { return LPI_SHUFFLE(v, 0, 0, 2, 2); }
-inline Complex1 imaginary_parts(Complex1 v) { return LPI_SHUFFLE(v, 1, 1); }
-inline Complex2 imaginary_parts(Complex2 v) { return LPI_SHUFFLE(v, 1, 1, 3, 3); }
-#undef LPI_SHUFFLE
-
-template <class V>
-inline V load(const double *p) {
-    V v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-}
-
 // x[0 .. n) times the increments, n = 1 or 2 complex numbers (V).
 template <class V>
 inline void phase_numbers(const double *const arrays[kPhaseArrays], std::size_t up, std::size_t down,
@@ -239,7 +254,7 @@ inline void phase_numbers(const double *const arrays[kPhaseArrays], std::size_t 
     const V e = (P + Q_conjugate) + (P * q_real + P_swapped * q_imaginary);
     const V z = load<V>(x);
     const V product = z * real_parts(e) + swap_parts(z) * (imaginary_parts(e) * negate_real);
-    std::memcpy(x, &product, sizeof product);
+    store(x, product);
 }
 
 }  // namespace
