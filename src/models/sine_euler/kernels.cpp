@@ -239,9 +239,9 @@ void scatter_block(const Direction &D, int N, int d0, int count, int first_lane,
 // P conj(q) = P (Re q, Re q) + swap(P) (Im q, -Im q), read from the tables
 // as they are, and the product with z = x[l, i] is z (Re e, Re e) + swap(z)
 // (-Im e, Im e). Every sum and product is the one the complex arithmetic
-// written out would form, in the same order. P_{l+d} is entry N + d + l of
-// its arrays, (Q, q)_{l-d} entry N + d - l of theirs: both run forwards along
-// a row of x.
+// written out would form, in the same order. P_{l+d} is entry d + l of its
+// arrays, (Q, q)_{l-d} entry N + d - l of theirs: both run forwards along a
+// row of x.
 namespace {
 
 // x[0 .. n) times the increments, n = 1 or 2 complex numbers (V).
@@ -261,7 +261,7 @@ inline void phase_numbers(const double *const arrays[kPhaseArrays], std::size_t 
 
 LPI_SIMD_CLONES
 void apply_phase(int N, int d0, int count, const double *tables, double sign, double *x) {
-    const std::size_t array = 6 * static_cast<std::size_t>(N);
+    const std::size_t array = 4 * static_cast<std::size_t>(N);
     const double *const arrays[kPhaseArrays] = {tables, tables + array, tables + 2 * array,
                                                 tables + 3 * array, tables + 4 * array};
     const Complex2 negate_real2 = {-sign, sign, -sign, sign};
@@ -269,7 +269,7 @@ void apply_phase(int N, int d0, int count, const double *tables, double sign, do
     const std::size_t pairs = static_cast<std::size_t>(count) / 2 * 2;
     for (std::size_t l = 0; l < static_cast<std::size_t>(N); ++l) {
         double *z = x + 2 * l * count;
-        const std::size_t up = 2 * (N + d0 + l), down = 2 * (N + d0 - l);
+        const std::size_t up = 2 * (d0 + l), down = 2 * (N + d0 - l);
         for (std::size_t i = 0; i < pairs; i += 2)
             phase_numbers(arrays, up + 2 * i, down + 2 * i, negate_real2, z + 2 * i);
         if (pairs < static_cast<std::size_t>(count))
