@@ -327,8 +327,7 @@ void SineEulerMpi::move_block(const Direction &D, int block, double *x, double *
         std::memcpy(x + 2 * static_cast<std::size_t>(s) * count, slab + s * row + 2 * i0,
                     sizeof(double) * 2 * count);
     transforms_->forward(count, x);
-    const std::size_t phase0 = static_cast<std::size_t>(N_) + d0;
-    apply_phase(N_, count, transforms_->up() + 2 * phase0, transforms_->down() + 4 * phase0, -D.sigma, x);
+    apply_phase(N_, d0, count, transforms_->phase(), -D.sigma, x);
     transforms_->backward(count, x);
     for (int s = 0; s < N_; ++s) {
         double *z = slab + s * row + 2 * i0;

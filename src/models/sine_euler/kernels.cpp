@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include "indexing.hpp"
 
@@ -18,6 +19,46 @@ namespace {
 #else
 #define LPI_SIMD_CLONES
 #endif
+
+// One or two complex numbers, interleaved (GCC's and Clang's vector
+// extensions: one instruction per operation where the target has it, pairs
+// of them where not). Every function taking them is inlined, so the warning
+// that their passing differs with and without AVX does not apply.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+typedef double Complex1 __attribute__((vector_size(16)));
+typedef double Complex2 __attribute__((vector_size(32)));
+#if defined(__clang__)
+#define LPI_SHUFFLE(v, ...) __builtin_shufflevector(v, v, __VA_ARGS__)
+#else
+typedef std::int64_t Mask1 __attribute__((vector_size(16)));
+typedef std::int64_t Mask2 __attribute__((vector_size(32)));
+template <class V> struct MaskOf;
+template <> struct MaskOf<Complex1> { typedef Mask1 type; };
+template <> struct MaskOf<Complex2> { typedef Mask2 type; };
+#define LPI_SHUFFLE(v, ...) __builtin_shuffle(v, typename MaskOf<decltype(v)>::type{__VA_ARGS__})
+#endif
+
+inline Complex2 reversed(Complex2 v) { return LPI_SHUFFLE(v, 2, 3, 0, 1); }
+inline Complex1 swap_parts(Complex1 v) { return LPI_SHUFFLE(v, 1, 0); }
+inline Complex2 swap_parts(Complex2 v) { return LPI_SHUFFLE(v, 1, 0, 3, 2); }
+inline Complex1 real_parts(Complex1 v) { return LPI_SHUFFLE(v, 0, 0); }
+inline Complex2 real_parts(Complex2 v) { return LPI_SHUFFLE(v, 0, 0, 2, 2); }
+inline Complex1 imaginary_parts(Complex1 v) { return LPI_SHUFFLE(v, 1, 1); }
+inline Complex2 imaginary_parts(Complex2 v) { return LPI_SHUFFLE(v, 1, 1, 3, 3); }
+#undef LPI_SHUFFLE
+
+template <class V>
+inline V load(const double *p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+template <class V>
+inline void store(double *p, V v) {
+    std::memcpy(p, &v, sizeof v);
+}
 
 // ---- Row and Column directions: runs along lanes --------------------------
 // A Row or Column direction's lines cross each lane (row s, or column s) in a
@@ -59,41 +100,51 @@ inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
 
 // Adds n increments to positions p0 .. p0+n-1 (p0 + n <= N) of a lane and
 // writes the conjugates of the sums at positions -(p0 + r) mod N of the
-// mirror lane, in one pass (the sums are not stored twice).
-inline void put_run(int N, std::size_t step, int p0, int n, const double *__restrict increment,
-                    double *lane, double *mirror) {
+// mirror lane, in one pass (the sums are not stored twice). In a row the
+// mirrors of positions p, p + 1 are the pair N - p - 1, N - p: two sums are
+// stored at once, reversed and conjugated (exact) for the mirror.
+template <bool Rows>
+inline void put_run(int N, int p0, int n, const double *__restrict increment, double *lane,
+                    double *mirror) {
     if (n <= 0) return;
-    int r0 = 0;
+    const std::size_t step = Rows ? 1 : N;
+    int r = 0;
     if (p0 == 0) {  // position 0 is its own mirror position
-        const double re = lane[0] + increment[0], im = lane[1] + increment[1];
-        lane[0] = mirror[0] = re;
-        lane[1] = im;
-        mirror[1] = -im;
-        r0 = 1;
+        const Complex1 sum = load<Complex1>(lane) + load<Complex1>(increment);
+        store(lane, sum);
+        store(mirror, sum * Complex1{1.0, -1.0});
+        r = 1;
     }
-    for (int r = r0; r < n; ++r) {
+    if (Rows) {
+        for (; r + 2 <= n; r += 2) {
+            double *z = lane + 2 * (p0 + r), *m = mirror + 2 * (N - p0 - r - 1);
+            const Complex2 sum = load<Complex2>(z) + load<Complex2>(increment + 2 * r);
+            store(z, sum);
+            store(m, reversed(sum) * Complex2{1.0, -1.0, 1.0, -1.0});
+        }
+    }
+    for (; r < n; ++r) {
         double *z = lane + 2 * step * (p0 + r), *m = mirror + 2 * step * (N - p0 - r);
-        const double re = z[0] + increment[2 * r], im = z[1] + increment[2 * r + 1];
-        z[0] = m[0] = re;
-        z[1] = im;
-        m[1] = -im;
+        const Complex1 sum = load<Complex1>(z) + load<Complex1>(increment + 2 * r);
+        store(z, sum);
+        store(m, sum * Complex1{1.0, -1.0});
     }
 }
 
 template <bool Rows, int Count>
 inline void scatter_runs(int N, int slope, int d0, int count, int first_lane,
                          const double *__restrict x, double *w) {
-    const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
+    const std::size_t lane = Rows ? N : 1;
     const int n = Count > 0 ? Count : count;
     for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
         const double *src = x + 2 * static_cast<std::size_t>(s) * n;
         double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
         if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
-            put_run(N, step, o, n, src, dst, mirror);
+            put_run<Rows>(N, o, n, src, dst, mirror);
         } else {
             const int first = std::min(n, N - o);
-            put_run(N, step, o, first, src, dst, mirror);
-            put_run(N, step, 0, n - first, src + 2 * first, dst, mirror);
+            put_run<Rows>(N, o, first, src, dst, mirror);
+            put_run<Rows>(N, 0, n - first, src + 2 * first, dst, mirror);
         }
     });
 }
@@ -181,27 +232,48 @@ void scatter_block(const Direction &D, int N, int d0, int count, int first_lane,
 // conj(e) for sigma = +1: `sign` = -sigma multiplies Im e, an exact negation.
 // With p = v_{l+d}, q = v_{l-d} (v = u - 1), e - 1 = p + conj(q) + p conj(q):
 // no cancellation, each term as small as the angles. The tables hold P = p / N
-// (up) and Q = q / N next to q (down), each divided once per flow, so that
-// (e - 1) / N = P + conj(Q) + P conj(q) needs no division here (dividing, not
+// and Q = q / N, each divided once per flow, so that (e - 1) / N =
+// (P + conj(Q)) + P conj(q) needs no division here (dividing, not
 // multiplying by a rounded 1/N, which would scale every increment by the same
-// N fl(1/N) != 1). With up = &up[N + d0], down = &down[N + d0], P_{l+d} =
-// up[l + i] and (Q, q)_{l-d} = down[i - l]: both run forwards along a row of
-// x, so the loop vectorises.
+// N fl(1/N) != 1). Two complex numbers at a time, in their interleaved parts:
+// P conj(q) = P (Re q, Re q) + swap(P) (Im q, -Im q), read from the tables
+// as they are, and the product with z = x[l, i] is z (Re e, Re e) + swap(z)
+// (-Im e, Im e). Every sum and product is the one the complex arithmetic
+// written out would form, in the same order. P_{l+d} is entry d + l of its
+// arrays, (Q, q)_{l-d} entry N + d - l of theirs: both run forwards along a
+// row of x.
+namespace {
+
+// x[0 .. n) times the increments, n = 1 or 2 complex numbers (V).
+template <class V>
+inline void phase_numbers(const double *const arrays[kPhaseArrays], std::size_t up, std::size_t down,
+                          V negate_real, double *x) {
+    const V P = load<V>(arrays[0] + up), P_swapped = load<V>(arrays[1] + up);
+    const V Q_conjugate = load<V>(arrays[2] + down), q_real = load<V>(arrays[3] + down),
+            q_imaginary = load<V>(arrays[4] + down);
+    const V e = (P + Q_conjugate) + (P * q_real + P_swapped * q_imaginary);
+    const V z = load<V>(x);
+    const V product = z * real_parts(e) + swap_parts(z) * (imaginary_parts(e) * negate_real);
+    store(x, product);
+}
+
+}  // namespace
+
 LPI_SIMD_CLONES
-void apply_phase(int N, int count, const double *up, const double *down, double sign, double *x) {
-    for (int l = 0; l < N; ++l) {
-        double *z = x + 2 * static_cast<std::size_t>(l) * count;
-        const double *p = up + 2 * l;
-        const double *q = down - 4 * l;
-        for (int i = 0; i < count; ++i) {
-            const double pr = p[2 * i], pi = p[2 * i + 1];
-            const double Qr = q[4 * i], Qi = q[4 * i + 1], qr = q[4 * i + 2], qi = q[4 * i + 3];
-            const double er = (pr + Qr) + (pr * qr + pi * qi);
-            const double ei = sign * ((pi - Qi) + (pi * qr - pr * qi));
-            const double zr = z[2 * i], zi = z[2 * i + 1];
-            z[2 * i] = er * zr - ei * zi;
-            z[2 * i + 1] = er * zi + ei * zr;
-        }
+void apply_phase(int N, int d0, int count, const double *tables, double sign, double *x) {
+    const std::size_t array = 4 * static_cast<std::size_t>(N);
+    const double *const arrays[kPhaseArrays] = {tables, tables + array, tables + 2 * array,
+                                                tables + 3 * array, tables + 4 * array};
+    const Complex2 negate_real2 = {-sign, sign, -sign, sign};
+    const Complex1 negate_real1 = {-sign, sign};
+    const std::size_t pairs = static_cast<std::size_t>(count) / 2 * 2;
+    for (std::size_t l = 0; l < static_cast<std::size_t>(N); ++l) {
+        double *z = x + 2 * l * count;
+        const std::size_t up = 2 * (d0 + l), down = 2 * (N + d0 - l);
+        for (std::size_t i = 0; i < pairs; i += 2)
+            phase_numbers(arrays, up + 2 * i, down + 2 * i, negate_real2, z + 2 * i);
+        if (pairs < static_cast<std::size_t>(count))
+            phase_numbers(arrays, up + 2 * pairs, down + 2 * pairs, negate_real1, z + 2 * pairs);
     }
 }
 

@@ -23,36 +23,41 @@ void gather_block(const Direction &D, int N, int d0, int count, int first_lane, 
 // gathers), so every mode is written once.
 void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
                    double *w);
-// Multiplies the transformed block x (N rows of `count` lines) by the line
-// flows' increments (exp(t Lambda_l) - 1) / N; up and down point into the
-// phase tables at entry N + d0 (up: v_l / N, down: v_l / N then v_l; see
-// the definition).
-void apply_phase(int N, int count, const double *up, const double *down, double sign, double *x);
+// The phase tables of one flow: kPhaseArrays arrays of 2N complex numbers,
+// array a at tables + 4 N a, written by write_phase and read by apply_phase.
+constexpr int kPhaseArrays = 5;
+inline std::size_t phase_table_doubles(int N) { return 4 * static_cast<std::size_t>(N) * kPhaseArrays; }
+
+// Multiplies the transformed block x (N rows of `count` lines d0 ..
+// d0+count-1) by the line flows' increments (exp(t Lambda_l) - 1) / N read
+// from the phase tables (see the definition).
+void apply_phase(int N, int d0, int count, const double *tables, double sign, double *x);
 
 // v_l = u_l - 1 = exp(i phi_l) - 1 = (-2 sin^2(phi_l / 2), sin phi_l), phi_l =
-// factor B_l (B: the transformed line spectrum, factor = t / (2 eps)), stored
-// three times over, forwards (up: v_l / N) and backwards (down: v_l / N, then
-// v_l), so that v_{l-c} and v_{l+c} need no reduction mod N and run forwards
-// along the lines of a block (see apply_phase). Each l writes its own entries
-// only, so threads may share the loop over l.
-inline void write_phase(int n, int l, double factor, const double *spectrum, double *up,
-                        double *down) {
-    const std::size_t N = n;
+// factor B_l (B: the transformed line spectrum, factor = t / (2 eps)), in the
+// forms apply_phase multiplies without shuffling complex parts: P = v_l / N
+// and P with its parts swapped at entry l, and at entry -l (the table read
+// backwards) conj(v_l) / N, (Re v_l, Re v_l) and (Im v_l, -Im v_l). Each
+// array holds its N entries twice over, so that l + d and N + d - l need no
+// reduction mod N and run forwards along the lines of a block (see
+// apply_phase). Each l writes its own entries only, so threads may share the
+// loop over l.
+inline void write_phase(int n, int l, double factor, const double *spectrum, double *tables) {
+    const std::size_t N = n, array = 4 * N;
     const double angle = factor * spectrum[2 * l];
     const double half = std::sin(0.5 * angle);
     const double re = -2.0 * half * half, im = std::sin(angle);
     const double n_real = n;
     const double scaled_re = re / n_real, scaled_im = im / n_real;
     const std::size_t minus = l == 0 ? 0 : N - l;
-    for (std::size_t copy = 0; copy < 3; ++copy) {
-        double *forwards = up + 2 * (l + copy * N), *backwards = down + 4 * (minus + copy * N);
-        forwards[0] = scaled_re;
-        forwards[1] = scaled_im;
-        backwards[0] = scaled_re;
-        backwards[1] = scaled_im;
-        backwards[2] = re;
-        backwards[3] = im;
-    }
+    const double entries[kPhaseArrays][2] = {
+        {scaled_re, scaled_im}, {scaled_im, scaled_re}, {scaled_re, -scaled_im}, {re, re}, {im, -im}};
+    for (std::size_t copy = 0; copy < 2; ++copy)
+        for (std::size_t a = 0; a < kPhaseArrays; ++a) {
+            double *entry = tables + a * array + 2 * ((a < 2 ? l : minus) + copy * N);
+            entry[0] = entries[a][0];
+            entry[1] = entries[a][1];
+        }
 }
 
 }  // namespace sine_euler

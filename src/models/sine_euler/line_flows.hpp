@@ -42,19 +42,25 @@ inline int lines_in_block(int lines, int b) { return lines - b * kBlock < kBlock
 template <class MoveBlock>
 void run_line_flows(LineTransforms &T, int N, int lines, int threads, double factor, MoveBlock &&move_block) {
     const int blocks = blocks_of(lines);
-    (void)threads;
-#if LPI_HAVE_OPENMP
-#pragma omp parallel num_threads(threads) if (threads > 1 && blocks > 1)
-#endif
-    {
+    // The loops' work sharing binds to the team that calls them: all of
+    // `threads`, or this thread alone, without starting a team of one.
+    auto flows = [&] {
 #if LPI_HAVE_OPENMP
 #pragma omp for schedule(static)
 #endif
-        for (int l = 0; l < N; ++l) write_phase(N, l, factor, T.spectrum(), T.up(), T.down());
+        for (int l = 0; l < N; ++l) write_phase(N, l, factor, T.spectrum(), T.phase());
 #if LPI_HAVE_OPENMP
 #pragma omp for schedule(static)
 #endif
         for (int b = 0; b < blocks; ++b) move_block(b, T.block(static_cast<std::size_t>(this_thread())));
+    };
+    if (threads > 1 && blocks > 1) {
+#if LPI_HAVE_OPENMP
+#pragma omp parallel num_threads(threads)
+#endif
+        flows();
+    } else {
+        flows();
     }
 }
 

@@ -215,8 +215,7 @@ void SineEuler::move_block(const Direction &D, int block, double *x, double *w) 
     const int first_lane = blocks_.first_lane(block);
     gather_block(D, N_, d0, count, first_lane, w, x);
     transforms_->forward(count, x);
-    const std::size_t phase0 = static_cast<std::size_t>(N_) + d0;
-    apply_phase(N_, count, transforms_->up() + 2 * phase0, transforms_->down() + 4 * phase0, -D.sigma, x);
+    apply_phase(N_, d0, count, transforms_->phase(), -D.sigma, x);
     transforms_->backward(count, x);
     scatter_block(D, N_, d0, count, first_lane, x, w);
 }

@@ -11,6 +11,7 @@
 #include "../../core/error.hpp"
 #include "../sine_euler.hpp"
 #include "lpi_config.h"
+#include "kernels.hpp"
 #include "projective_line.hpp"
 
 #if LPI_HAVE_FFTW
@@ -63,9 +64,8 @@ LineTransforms::LineTransforms(int N, int lines, FftPlanning planning)
     : N_(N), lines_(lines), plans_(new Plans) {
     try {
         spectrum_ = reinterpret_cast<double *>(fftw_alloc_complex(N));
-        up_ = static_cast<double *>(fftw_malloc(sizeof(double) * 6 * N));
-        down_ = static_cast<double *>(fftw_malloc(sizeof(double) * 12 * N));
-        if (!spectrum_ || !up_ || !down_) throw std::bad_alloc();
+        phase_ = static_cast<double *>(fftw_malloc(sizeof(double) * phase_table_doubles(N)));
+        if (!spectrum_ || !phase_) throw std::bad_alloc();
         reserve_threads(1);
         std::lock_guard<std::mutex> lock(fftw_planner_mutex());
         const unsigned flags = planner_flags(planning);
@@ -106,10 +106,9 @@ void LineTransforms::release() {
             if (p) fftw_destroy_plan(p);
     plans_.reset();
     fftw_free(spectrum_);
-    fftw_free(up_);
-    fftw_free(down_);
+    fftw_free(phase_);
     for (double *x : blocks_) fftw_free(x);
-    spectrum_ = up_ = down_ = nullptr;
+    spectrum_ = phase_ = nullptr;
     blocks_.clear();
 }
 

@@ -33,10 +33,8 @@ public:
     // The line spectrum b: N complex (interleaved), transformed in place.
     double *spectrum() { return spectrum_; }
     void transform_spectrum();
-    // The phase tables: 3N complex (up) and 3N complex pairs (down; see
-    // SineEuler::line_phase).
-    double *up() { return up_; }
-    double *down() { return down_; }
+    // The phase tables (phase_table_doubles(N); see write_phase).
+    double *phase() { return phase_; }
     // Block buffer of a thread, and its forward / backward transform in place
     // for a block of `lines` lines (kBlock, or the remainder M mod kBlock).
     double *block(std::size_t thread) { return blocks_[thread]; }
@@ -48,7 +46,7 @@ private:
     void release();
     int N_, lines_;
     std::unique_ptr<Plans> plans_;
-    double *spectrum_ = nullptr, *up_ = nullptr, *down_ = nullptr;
+    double *spectrum_ = nullptr, *phase_ = nullptr;
     std::vector<double *> blocks_;
 };
 
