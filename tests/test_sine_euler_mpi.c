@@ -343,6 +343,14 @@ static void test_different_arguments(void **state) {
                      "lpi_sine_euler_set_hamiltonian");
     LPI_ASSERT_FAILS(spread, lpi_save(spread, last ? NULL : "never_written.lpi"), LPI_ERR_INVALID, "lpi_save");
     assert_int_equal(access("never_written.lpi", F_OK), -1);
+    /* Making a handle: the arguments are compared before any is checked. */
+    lpi_system *none = NULL;
+    assert_int_equal(lpi_sine_euler_create_mpi(last ? NULL : &none, N, MPI_COMM_WORLD), LPI_ERR_INVALID);
+    assert_null(none);
+    assert_int_equal(lpi_load_mpi(&none, last ? NULL : "never_written.lpi", MPI_COMM_WORLD), LPI_ERR_INVALID);
+    assert_null(none);
+    assert_int_equal(lpi_load_mpi(last ? NULL : &none, "never_written.lpi", MPI_COMM_WORLD), LPI_ERR_INVALID);
+    assert_null(none);
 
     /* Threads per process may differ: the same bits. */
     const int threads = lpi_set_threads(spread, 1 + rank_ % 2);

@@ -11,22 +11,41 @@
 #include "liepoisson_mpi.h"
 #include "sine_euler_mpi.hpp"
 
-using lpi::capi::create;
+using lpi::capi::Arguments;
 using lpi::capi::guarded;
 using lpi::capi::require;
+using lpi::capi::Text;
+
+namespace {
+
+// The processes compare their arguments (as every call on a spread handle
+// does, src/capi/handle.hpp) before one of them can refuse them alone.
+void require_same_arguments(const lpi::mpi::Communicator &comm, const Arguments &arguments) {
+    comm.require_same(static_cast<long long>(arguments.fingerprint()), "arguments to this call");
+}
+
+}  // namespace
 
 extern "C" {
 
 LPI_API int lpi_sine_euler_create_mpi(lpi_system **out, int32_t N, MPI_Comm comm) {
-    return create(out, "lpi_sine_euler_create_mpi", [&] { return lpi::make_sine_euler_mpi(N, comm); });
+    if (out) *out = nullptr;
+    return guarded(nullptr, "lpi_sine_euler_create_mpi", [&] {
+        auto communicator = std::make_shared<const lpi::mpi::Communicator>(comm);
+        require_same_arguments(*communicator, Arguments(out));  // N: compared by the model, named
+        require(out, "out");
+        *out = new lpi_system(lpi::make_sine_euler_mpi(N, communicator));
+    });
 }
 
 LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
     if (out) *out = nullptr;
     return guarded(nullptr, "lpi_load_mpi", [&] {
+        const auto communicator = std::make_shared<const lpi::mpi::Communicator>(comm);
+        const lpi::mpi::Communicator &reader = *communicator;
+        require_same_arguments(reader, Arguments(out, Text{path}));
         require(out, "out");
         require(path, "path");
-        const lpi::mpi::Communicator reader(comm);
         // Rank 0 reads; every process decodes the same bytes.
         std::vector<unsigned char> bytes;
         double size = 0.0;
@@ -52,7 +71,7 @@ LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
                                                    " system; only sine-euler is spread over processes");
         });
         const int N = static_cast<const lpi::SineEulerModel &>(*cp.model).truncation();
-        std::unique_ptr<lpi::Model> model = lpi::make_sine_euler_mpi(N, comm);
+        std::unique_ptr<lpi::Model> model = lpi::make_sine_euler_mpi(N, communicator);
         model->set_split(cp.model->split());
         static_cast<lpi::SineEulerModel &>(*model).set_hamiltonian(
             static_cast<const lpi::SineEulerModel &>(*cp.model).hamiltonian());

@@ -101,6 +101,14 @@ std::vector<long long> Communicator::allgather(long long value) const {
     return values;
 }
 
+void Communicator::require_same(long long value, const std::string &what) const {
+    const std::vector<long long> values = allgather(value);
+    for (long long v : values)
+        if (v != values[0])
+            fail(LPI_ERR_INVALID, "the processes passed different " + what +
+                                      " (every process must make the same calls with the same arguments)");
+}
+
 double Communicator::max(double value) const {
     double result = 0.0;
     check(MPI_Allreduce(&value, &result, 1, MPI_DOUBLE, MPI_MAX, comm_), "MPI_Allreduce");

@@ -38,6 +38,9 @@ public:
     std::vector<double> allgather(double value) const;
     std::vector<long long> allgather(long long value) const;
     double max(double value) const;
+    // LPI_ERR_INVALID on every process, naming `what`, when the processes'
+    // values differ (fingerprints of what each process was given).
+    void require_same(long long value, const std::string &what) const;
     bool all(bool value) const;
     void broadcast(double *values, std::size_t n) const;  // from rank 0
 

@@ -108,11 +108,7 @@ public:
     void on_one_process(const std::function<void()> &action) const override { comm_->on_root(action); }
     bool on_any_process(bool value) const override { return !comm_->all(!value); }
     void require_same_on_every_process(const void *bytes, std::size_t size, const std::string &what) const override {
-        const std::vector<long long> prints = comm_->allgather(fingerprint(bytes, size));
-        for (long long p : prints)
-            if (p != prints[0])
-                fail(LPI_ERR_INVALID, "the processes passed different " + what +
-                                          " (every process must make the same calls with the same arguments)");
+        comm_->require_same(fingerprint(bytes, size), what);
     }
     std::vector<double> local_state(const double *modes, std::size_t direction) const;
 
@@ -366,8 +362,7 @@ TransformTiming SineEulerMpi::time_transforms(std::size_t flows_per_step, std::i
 
 }  // namespace
 
-std::unique_ptr<Model> make_sine_euler_mpi(int N, MPI_Comm comm) {
-    auto communicator = std::make_shared<const Communicator>(comm);
+std::unique_ptr<Model> make_sine_euler_mpi(int N, std::shared_ptr<const mpi::Communicator> communicator) {
     const std::vector<long long> orders = communicator->allgather(static_cast<long long>(N));
     for (long long n : orders)
         if (n != N)

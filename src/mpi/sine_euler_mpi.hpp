@@ -9,13 +9,13 @@
 #include <memory>
 
 #include "../core/model.hpp"
+#include "communicator.hpp"
 
 namespace lpi {
 
-// Collective. Throws as make_sine_euler does (the same status on every
-// process), LPI_ERR_INVALID when the processes pass different N or MPI is
-// not running.
-std::unique_ptr<Model> make_sine_euler_mpi(int N, MPI_Comm comm);
+// Collective over comm. Throws as make_sine_euler does (the same status on
+// every process), LPI_ERR_INVALID when the processes pass different N.
+std::unique_ptr<Model> make_sine_euler_mpi(int N, std::shared_ptr<const mpi::Communicator> comm);
 
 // The working state of this process, in the first direction's layout, of the
 // whole mode array `modes` (2 N^2 doubles) of a distributed model (a
