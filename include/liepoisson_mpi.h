@@ -13,7 +13,8 @@
  * failure on any process returns the same status and message on all of
  * them. While stepping, each process holds only its share of the field and
  * of the Hamiltonian (O(N^2 / P + N) bytes, see docs/scaling.md).
- * Splitting methods only: the baselines (rk4, implicit-midpoint and the
+ * Threads per process (lpi_set_threads) need MPI initialised with
+ * MPI_Init_thread at MPI_THREAD_FUNNELED or higher. Splitting methods only: the baselines (rk4, implicit-midpoint and the
  * matrix methods) need the whole state on one process and are refused with
  * LPI_ERR_UNSUPPORTED. lpi_save writes one file, from rank 0, which
  * lpi_load (one process) or lpi_load_mpi (spread) reads back. */

@@ -401,8 +401,29 @@ static void test_bad_input(void **state) {
     lpi_destroy(spread), lpi_destroy(single);
 }
 
-int main(void) {
-    MPI_Init(NULL, NULL);
+/* Run with --thread-single: MPI at MPI_THREAD_SINGLE, where no other thread
+ * may exist, so threads within a process are refused. */
+static void test_threads_need_funneled(void **state) {
+    (void)state;
+    lpi_system *sys;
+    assert_int_equal(lpi_sine_euler_create_mpi(&sys, 13, MPI_COMM_WORLD), LPI_OK);
+    assert_int_equal(lpi_set_threads(sys, 2), LPI_ERR_UNSUPPORTED);
+    const char *why = lpi_last_error(sys);
+    if (!strstr(why, "OpenMP")) assert_non_null(strstr(why, "MPI_THREAD_FUNNELED"));
+    assert_int_equal(lpi_set_threads(sys, 1), LPI_OK);
+    lpi_destroy(sys);
+}
+
+int main(int argc, char **argv) {
+    if (argc > 1 && strcmp(argv[1], "--thread-single") == 0) {
+        MPI_Init(NULL, NULL);
+        const struct CMUnitTest single[] = {cmocka_unit_test(test_threads_need_funneled)};
+        const int status = lpi_run_tests(single);
+        MPI_Finalize();
+        return status;
+    }
+    int provided;
+    MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
     const struct CMUnitTest tests[] = {

@@ -30,7 +30,8 @@ void finalize() { MPI_Finalize(); }
 
 void start_processes(int *argc, char ***argv) {
     if (!launched_by_mpi()) return;
-    MPI_Init(argc, argv);
+    int provided = MPI_THREAD_SINGLE;  // --threads: the library's threads make no MPI call
+    MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
     std::atexit(finalize);
     MPI_Comm_size(MPI_COMM_WORLD, &world_size);
     MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);

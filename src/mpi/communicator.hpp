@@ -26,6 +26,9 @@ public:
 
     int rank() const { return rank_; }  // local
     int size() const { return size_; }  // local
+    // Whether threads other than the caller may exist while it makes MPI
+    // calls (MPI initialised at MPI_THREAD_FUNNELED or higher). Local.
+    bool allows_threads() const;
 
     // Complex values (2 doubles each): counts and offsets in complex units.
     void alltoallv(const double *send, const std::vector<int> &send_counts,

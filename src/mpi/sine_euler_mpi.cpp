@@ -96,6 +96,10 @@ public:
 #if !LPI_HAVE_OPENMP
         if (n > 1) fail(LPI_ERR_UNSUPPORTED, "threads need OpenMP; this build has none (one thread only)");
 #endif
+        // The library's threads exist while this one makes MPI calls.
+        if (n > 1 && !comm_->allows_threads())
+            fail(LPI_ERR_UNSUPPORTED, "threads within a process need MPI initialised with MPI_Init_thread "
+                                      "at MPI_THREAD_FUNNELED or higher (MPI_Query_thread gives less)");
         threads_ = n;
     }
 
