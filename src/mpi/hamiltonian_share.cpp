@@ -38,6 +38,25 @@ void HamiltonianShare::record_owners(std::size_t index, const Direction &D) {
     }
 }
 
+void HamiltonianShare::read_pieces(const std::function<void(Direction &&)> &keep) {
+    // Whether a later class claimed a held mode (and, apart, its conjugate).
+    std::vector<unsigned char> claimed;
+    std::size_t index = 0;
+    sine_euler::for_each_direction(
+        N_,
+        [&](Direction &&D) {
+            record_owners(index++, D);
+            std::vector<unsigned char>().swap(D.owned);
+            keep(std::move(D));
+        },
+        [&](int a, int b) -> unsigned char * {
+            const Place p = place(a, b);
+            if (lines_.owner[p.line] != rank_) return nullptr;
+            if (claimed.empty()) claimed.assign(2 * owner_.size(), 0);
+            return &claimed[2 * (entry(p.line, p.element) - N_) + p.mirrored];
+        });
+}
+
 void HamiltonianShare::assign(const Hamiltonian &H) {
     const double *lambda = H.weights(), *f = H.forcing();
     std::vector<double> forcing(f ? lambda_.size() * 2 : 0);

@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "../models/sine_euler/hamiltonian.hpp"
@@ -39,9 +40,10 @@ public:
     // process `rank` holds. The owners come from record_owners.
     HamiltonianShare(int N, const LineOwnership &lines, int rank);
 
-    // Notes which of this process's modes piece `index` (direction D, with
-    // its ownership table) owns. Called for every piece, in order.
-    void record_owners(std::size_t index, const sine_euler::Direction &D);
+    // Goes through the pieces (for_each_direction), notes which piece owns
+    // each of this process's modes, and hands every direction, without its
+    // ownership table, to keep(), in order. Holds O(N^2 / P + N) meanwhile.
+    void read_pieces(const std::function<void(sine_euler::Direction &&)> &keep);
 
     // Keeps this process's share of H (given whole on every process).
     void assign(const sine_euler::Hamiltonian &H);
@@ -75,6 +77,7 @@ private:
         bool mirrored;
     };
     Place place(int a, int b) const;
+    void record_owners(std::size_t index, const sine_euler::Direction &D);
     // Complex entry of a held mode of line d (held here), element s.
     std::size_t entry(int d, int s) const {
         return static_cast<std::size_t>(N_) + static_cast<std::size_t>(s) * mine_ + (d - first_);

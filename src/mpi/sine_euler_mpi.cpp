@@ -53,12 +53,7 @@ public:
         : N_(N), eps_(2.0 * std::acos(-1.0) / N), comm_(std::move(comm)),
           lines_(N, comm_->size()), mine_(lines_.count(comm_->rank())),
           first_(lines_.first[comm_->rank()]), exchange_(*comm_, lines_), share_(N, lines_, comm_->rank()) {
-        // Each piece's ownership table is read for this process's modes, then dropped.
-        for_each_direction(N, [&](Direction &&D) {
-            share_.record_owners(dirs_.size(), D);
-            std::vector<unsigned char>().swap(D.owned);
-            dirs_.push_back(std::move(D));
-        });
+        share_.read_pieces([&](Direction &&D) { dirs_.push_back(std::move(D)); });
     }
 
     const char *kind() const override { return "sine-euler"; }

@@ -49,8 +49,10 @@ std::vector<int> prime_factors(int N) {
 // - on a later class's line, s k is owned there when s is a unit (a primitive
 //   mode lies on its own class only); for a non-unit s, by (0,1) or (1,m) as
 //   above, or, when neither, by the first later class met (one byte per
-//   mode, for these modes only: N with a squared prime factor).
-void for_each_direction(int N, const std::function<void(Direction &&)> &visit) {
+//   mode, for these modes only: N with a squared prime factor; `claims` may
+//   keep those bytes for the modes its caller tracks).
+void for_each_direction(int N, const std::function<void(Direction &&)> &visit,
+                        const std::function<unsigned char *(int a, int b)> &claims) {
     std::vector<int> gcd_with_n(N);
     for (int x = 0; x < N; ++x) gcd_with_n[x] = std::gcd(x, N);
     auto unit = [&](int x) { return gcd_with_n[x] == 1; };
@@ -75,10 +77,15 @@ void for_each_direction(int N, const std::function<void(Direction &&)> &visit) {
                 if (unit(s)) {
                     D.owned[s] = 1;
                 } else if (a != 0 && b % gcd_with_n[a] != 0) {
-                    if (claimed.empty()) claimed.assign(static_cast<std::size_t>(N) * N, 0);
-                    unsigned char &owner = claimed[mode_index(a, b, N)];
-                    D.owned[s] = !owner;
-                    owner = 1;
+                    unsigned char *owner = nullptr;
+                    if (claims) {
+                        owner = claims(a, b);
+                    } else {
+                        if (claimed.empty()) claimed.assign(static_cast<std::size_t>(N) * N, 0);
+                        owner = &claimed[mode_index(a, b, N)];
+                    }
+                    D.owned[s] = owner && !*owner;
+                    if (owner) *owner = 1;
                 }
                 a += k1;
                 if (a >= N) a -= N;

@@ -40,8 +40,13 @@ struct Direction {
 std::vector<Direction> projective_line(int N);
 // The same directions, handed to visit one at a time in that order: a
 // caller that keeps only part of each (the MPI model keeps the ownership of
-// its own modes) never holds every direction's table at once.
-void for_each_direction(int N, const std::function<void(Direction &&)> &visit);
+// its own modes) never holds every direction's table at once. The modes that
+// only a later class can own (N with a squared prime factor) are claimed in
+// a byte each: by default in a table of all N^2 modes; with `claims`, in the
+// byte it returns for mode (a, b), and a mode for which it returns nullptr
+// is left unowned in every table (its caller does not track it).
+void for_each_direction(int N, const std::function<void(Direction &&)> &visit,
+                        const std::function<unsigned char *(int a, int b)> &claims = {});
 
 // The odd primes dividing N.
 std::vector<int> prime_factors(int N);
