@@ -37,7 +37,7 @@ struct OriginLineWeights {
 class HamiltonianShare {
 public:
     // Euler's Hamiltonian, for the lines of the reference direction that
-    // process `rank` holds. The owners come from record_owners.
+    // process `rank` holds. The owners come from read_pieces.
     HamiltonianShare(int N, const LineOwnership &lines, int rank);
 
     // Goes through the pieces (for_each_direction), notes which piece owns
@@ -48,7 +48,6 @@ public:
     // Keeps this process's share of H (given whole on every process).
     void assign(const sine_euler::Hamiltonian &H);
     bool is_default() const { return euler_; }
-    bool forced() const { return !f_.empty(); }
     // The whole Hamiltonian on every process (collective; O(N^2) on request).
     sine_euler::Hamiltonian whole(const Communicator &comm) const;
 
