@@ -7,15 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "bench_common.h"
 
 static const double kT = 100.0;
 static const double kM0[3] = {1.0, 0.5, -0.3};
-
-static double now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 
 static void die(int status, lpi_system *sys, const char *what) {
     if (status == LPI_OK) return;

@@ -16,19 +16,8 @@
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
-
-static double now(void) {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static void check(int status, lpi_system *sys, const char *what) {
-    if (status != LPI_OK) {
-        fprintf(stderr, "bench_sine_euler: %s: %s\n", what, lpi_last_error(sys));
-        exit(1);
-    }
-}
+#define BENCH_NAME "bench_sine_euler"
+#include "bench_common.h"
 
 static lpi_system *make(int N) {
     lpi_system *sys = NULL;

@@ -33,18 +33,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#define BENCH_NAME "bench_sine_euler_baselines"
+#include "bench_common.h"
 
 static double cpu_now(void) {
     struct timespec t;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static void check(int status, lpi_system *sys, const char *what) {
-    if (status != LPI_OK) {
-        fprintf(stderr, "bench_sine_euler_baselines: %s: %s\n", what, lpi_last_error(sys));
-        exit(1);
-    }
 }
 
 static int rep(int a, int N) { return a > N / 2 ? a - N : a; }

@@ -19,15 +19,10 @@
 #include <unistd.h>
 
 #include "../lpi_test.h"
+#define BENCH_NAME "bench_sine_euler_drift"
+#include "bench_common.h"
 
 enum { kFields = 4, kMaxPoints = 8 };
-
-static void check(int status, lpi_system *sys, const char *what) {
-    if (status != LPI_OK) {
-        fprintf(stderr, "bench_sine_euler_drift: %s: %s\n", what, lpi_last_error(sys));
-        exit(1);
-    }
-}
 
 static double spectrum_change(int N, const double *before, const double *after) {
     double scale = 0, change = 0;

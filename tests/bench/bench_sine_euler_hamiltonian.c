@@ -8,19 +8,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
-
-static double now(void) {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static void check(int status, lpi_system *sys, const char *what) {
-    if (status != LPI_OK) {
-        fprintf(stderr, "bench_sine_euler_hamiltonian: %s: %s\n", what, lpi_last_error(sys));
-        exit(1);
-    }
-}
+#define BENCH_NAME "bench_sine_euler_hamiltonian"
+#include "bench_common.h"
 
 static int centred(int a, int N) { return a > N / 2 ? a - N : a; }
 
