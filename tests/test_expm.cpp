@@ -357,6 +357,12 @@ void test_refusals_leave_x_unchanged(void **) {
     assert_int_equal(static_cast<int>(series.path()), static_cast<int>(lpi::ExpmPath::Nilpotent));
     const double huge[2] = {1.0, 1e300};
     expect_refusal(series, huge, 1e10, x, LPI_ERR_NONFINITE, "component 2");
+    // A shear (depth 1: nodes 1 and 2 read the fixed 0 and 3 only), whose
+    // second node overflows.
+    const std::vector<lpi::SparseTerm> shear_terms = {{1, 0, 0, 1.0}, {2, 3, 1, 1.0}};
+    lpi::SparseExponential shear(4, shear_terms);
+    assert_int_equal(shear.depth(), 1);
+    expect_refusal(shear, huge, 1e10, x, LPI_ERR_NONFINITE, "component 2");
     // A rotation generator beyond 2^32 squarings, and a hyperbolic plane whose
     // exponential overflows.
     const std::vector<lpi::SparseTerm> plane = {{0, 3, 0, 1.0}, {3, 0, 1, 1.0}};
@@ -411,6 +417,35 @@ void test_deep_series_and_summed_terms(void **) {
     assert_true(error < 1e-14);
 }
 
+// Depth 1 (a shear: every moved index reads fixed ones only) is the sum
+// x_v + sum_j t (c_j g_pj) x_j, rounded as written; with two terms at one
+// position (the general sweep) it agrees to round-off.
+void test_shear(void **) {
+    const std::vector<lpi::SparseTerm> terms = {
+        {1, 0, 0, 0.75}, {1, 3, 1, -1.25}, {2, 0, 1, 2.5}, {4, 3, 0, -0.5}, {4, 0, 1, 0.3}};
+    lpi::SparseExponential shear(5, terms);
+    assert_int_equal(static_cast<int>(shear.path()), static_cast<int>(lpi::ExpmPath::Nilpotent));
+    assert_int_equal(shear.depth(), 1);
+    const double g[2] = {0.7, -1.9}, t = 0.3;
+    std::vector<double> x = {1.1, -0.4, 2.2, 0.9, -3.3}, y = x;
+    shear.apply(g, t, y.data());
+    std::vector<double> expected = x;
+    expected[1] = x[1] + (t * (0.75 * g[0]) * x[0] + t * (-1.25 * g[1]) * x[3]);
+    expected[2] = x[2] + t * (2.5 * g[1]) * x[0];
+    expected[4] = x[4] + (t * (0.3 * g[1]) * x[0] + t * (-0.5 * g[0]) * x[3]);
+    for (std::size_t i = 0; i < x.size(); ++i) assert_true(y[i] == expected[i]);
+
+    std::vector<lpi::SparseTerm> summed = terms;
+    summed.push_back({2, 0, 0, 1.5});  // a second term at (2, 0)
+    lpi::SparseExponential general(5, summed);
+    assert_int_equal(general.depth(), 1);
+    std::vector<double> z = x;
+    general.apply(g, t, z.data());
+    const double exact2 = x[2] + t * (2.5L * g[1] + 1.5L * g[0]) * x[0];
+    assert_true(std::fabs(z[2] - exact2) <= 4 * 2.2e-16 * std::fabs(exact2));
+    assert_true(z[1] == y[1] && z[4] == y[4]);
+}
+
 // The size of an n x n matrix is counted without wrapping: a dimension whose
 // bytes overflow a size_t is refused (LPI_ERR_NO_MEMORY), not allocated small.
 void test_square_entries_refuse_overflow(void **) {
@@ -441,6 +476,7 @@ int main() {
         cmocka_unit_test(test_sparse_nilpotent_scales_with_nonzeros),
         cmocka_unit_test(test_plane_closed_form),
         cmocka_unit_test(test_refusals_leave_x_unchanged),
+        cmocka_unit_test(test_shear),
         cmocka_unit_test(test_deep_series_and_summed_terms),
         cmocka_unit_test(test_square_entries_refuse_overflow),
     };

@@ -63,7 +63,7 @@ constexpr double kPadeTheta13 = 5.371920351148152e0;
 //    path): the finite series sum_k (tA)^k x / k!, in one sweep over the
 //    indices it moves in topological order, each index's terms k = 1..depth
 //    at once from those of the indices its row reads; work O(nnz * depth),
-//    nothing dense;
+//    nothing dense (depth 1, a shear: one sum a moved index, no series);
 //  - otherwise the block of the indices the pattern touches: of order 1 or 2
 //    in closed form (A = tau I + N with N^2 = delta I: exponentials,
 //    sines or hyperbolic sines), larger ones by the Pade exponential.
@@ -107,6 +107,7 @@ private:
     void scale_entries(const double *g, double t);  // scaled_ = entries of t A
     template <std::size_t Lanes>
     bool sweep(double *x);
+    bool shear(const double *g, double t, double *x);  // depth 1, x untouched on failure
     void apply_plane(double t, double *x);  // a block of order 1 or 2
     void apply_pade(double t, double *x);
     void check_norm(double norm, double t) const;
@@ -115,6 +116,7 @@ private:
 
     ExpmPath path_ = ExpmPath::Nilpotent;
     std::size_t depth_ = 0;
+    bool shear_ = false;  // depth 1, one term a position: shear() applies it
     // The increments' indices, local -> global (nilpotent: the nodes; block:
     // every index the pattern touches).
     std::vector<std::uint32_t> moved_;

@@ -154,6 +154,7 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
     }
     scaled_.resize(positions.size());
     increment_.resize(moved_.size());
+    shear_ = path_ == ExpmPath::Nilpotent && depth_ == 1 && further_terms_.empty();
 }
 
 void SparseExponential::fail_nonfinite() const {
@@ -238,7 +239,30 @@ bool SparseExponential::sweep(double *x) {
     return false;
 }
 
+// Depth 1 (every moved index reads fixed ones only: a shear, as the kick of
+// a pendulum): x_v += sum_j (t A)_vj x_j, the entries formed as read, one
+// term a position. The same sums, in the same order, as sweep<1>.
+inline bool SparseExponential::shear(const double *g, double t, double *x) {
+    const SparseTerm *term = first_terms_.data();
+    const std::uint32_t *column = columns_.data();
+    bool finite = true;
+    for (std::size_t v = 0; v < nodes_.size(); ++v) {
+        double sum = 0.0;
+        for (std::uint32_t i = 0; i < nodes_[v].fixed_columns; ++i, ++term, ++column)
+            sum += t * (term->coefficient * g[term->parameter]) * x[*column];
+        increment_[v] = sum;
+        finite &= std::isfinite(sum);
+    }
+    if (!finite) return false;
+    for (std::size_t v = 0; v < nodes_.size(); ++v) x[nodes_[v].global] += increment_[v];
+    return true;
+}
+
 void SparseExponential::apply(const double *g, double t, double *x) {
+    if (shear_) {
+        if (!shear(g, t, x)) fail_nonfinite();
+        return;
+    }
     scale_entries(g, t);
     if (path_ == ExpmPath::Plane) {
         apply_plane(t, x);

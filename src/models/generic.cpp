@@ -234,13 +234,20 @@ private:
     void gradient(const double *x) const {
         gather(x);
         const int rc = grad_(sigma_.size(), x_sigma_.data(), g_.data(), user_);
+        bool finite = true;
+        for (std::size_t p = 0; p < g_.size(); ++p) finite &= std::isfinite(g_[p]);
+        if (rc != 0 || !finite) fail_gradient(rc);
+    }
+
+    // Out of line, so that the messages cost the flows nothing.
+    [[noreturn, gnu::noinline, gnu::cold]] void fail_gradient(int rc) const {
         if (rc != 0)
             fail(LPI_ERR_CALLBACK, "the gradient callback of " + label() + " returned " +
                                        std::to_string(rc));
-        for (std::size_t p = 0; p < g_.size(); ++p)
-            if (!std::isfinite(g_[p]))
-                fail(LPI_ERR_CALLBACK, "the gradient callback of " + label() +
-                                           " gave a non-finite component " + std::to_string(p));
+        std::size_t p = 0;
+        while (std::isfinite(g_[p])) ++p;
+        fail(LPI_ERR_CALLBACK, "the gradient callback of " + label() +
+                                   " gave a non-finite component " + std::to_string(p));
     }
 
     const StructureConstants &constants_;
