@@ -3,10 +3,12 @@
  * same run: lpi_sine_euler_fft_floor), their ratio, the speed-up with two
  * threads and the share of the one-thread step that two threads did not
  * divide (Amdahl: 2 / speed-up - 1; the serial part of a flow, the line
- * spectrum and its FFT, plus waiting at the flow's barriers), and the peak
- * memory at N = 1021. Two-thread figures mean something only on an otherwise
- * idle machine: the bench prints the load average it started under. Prints
- * figures; asserts nothing. */
+ * spectrum and its FFT, plus waiting at the flow's barriers), then that
+ * speed-up split in two: of the FFTs alone (floor 1T / floor 2T) and of the
+ * rest of the step (gather, phase, scatter, the serial part: (step - floor)
+ * 1T over 2T), and the peak memory at N = 1021. Two-thread figures mean
+ * something only on an otherwise idle machine: the bench prints the load
+ * average it started under. Prints figures; asserts nothing. */
 #include <liepoisson.h>
 #include <math.h>
 #include <stdio.h>
@@ -77,8 +79,8 @@ int main(void) {
     getloadavg(load, 3);
     printf("sine-Euler, leapfrog (time per step; floor = FFTW alone, same plans and transforms;"
            " load average %.2f at start)\n", load[0]);
-    printf("%5s %10s %12s %12s %7s %12s %12s %9s %8s\n", "N", "FFTs/step", "step 1T", "floor 1T",
-           "ratio", "step 2T", "floor 2T", "speed-up", "serial");
+    printf("%5s %10s %12s %12s %7s %12s %12s %9s %8s %6s %6s\n", "N", "FFTs/step", "step 1T",
+           "floor 1T", "ratio", "step 2T", "floor 2T", "speed-up", "serial", "FFTs", "rest");
     /* Prime and composite N: FFTW is 2-3x faster at 125, 243, 375, 625. */
     const int Ns[] = {31, 61, 125, 127, 243, 251, 375, 509, 625};
     for (size_t i = 0; i < sizeof Ns / sizeof Ns[0]; ++i) {
@@ -93,9 +95,9 @@ int main(void) {
             floor2 = time_floor(sys, step2, budget, &transforms);
         }
         const double speed_up = step1 / step2;
-        printf("%5d %10.0f %10.3f ms %9.3f ms %7.2f %9.3f ms %9.3f ms %9.2f %7.1f%%\n", N,
-               transforms, 1e3 * step1, 1e3 * floor1, step1 / floor1, 1e3 * step2, 1e3 * floor2,
-               speed_up, 100 * (2 / speed_up - 1));
+        printf("%5d %10.0f %10.3f ms %9.3f ms %7.2f %9.3f ms %9.3f ms %9.2f %7.1f%% %6.2f %6.2f\n",
+               N, transforms, 1e3 * step1, 1e3 * floor1, step1 / floor1, 1e3 * step2, 1e3 * floor2,
+               speed_up, 100 * (2 / speed_up - 1), floor1 / floor2, (step1 - floor1) / (step2 - floor2));
         fflush(stdout);
         lpi_destroy(sys);
     }
