@@ -45,6 +45,9 @@ struct SparseTerm {
 
 enum class ExpmPath { Nilpotent, Plane, Pade };
 
+// LPI_ERR_NONFINITE: the exact flow's increment of `component` is not finite.
+[[noreturn]] void fail_flow_overflow(std::size_t component);
+
 // Most squarings a flow may take (||t A||_1 <= 5.37 * 2^32 ~ 2.3e10): the
 // Casimir error of the Pade path grows like 2^squarings unit round-offs. The
 // closed form of the plane path is held to the same bound, so whether a step

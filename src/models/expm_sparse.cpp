@@ -157,10 +157,14 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
     shear_ = path_ == ExpmPath::Nilpotent && depth_ == 1 && further_terms_.empty();
 }
 
+void fail_flow_overflow(std::size_t component) {
+    fail(LPI_ERR_NONFINITE, "the exact flow overflows (component " + std::to_string(component) + ")");
+}
+
 void SparseExponential::fail_nonfinite() const {
     std::size_t v = 0;
     while (v + 1 < moved_.size() && std::isfinite(increment_[v])) ++v;
-    fail(LPI_ERR_NONFINITE, "the exact flow overflows (component " + std::to_string(moved_[v]) + ")");
+    fail_flow_overflow(moved_[v]);
 }
 
 void SparseExponential::check_norm(double norm, double t) const {

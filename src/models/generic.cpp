@@ -4,6 +4,7 @@
 #include <cfloat>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <tuple>
 
 #include "../core/error.hpp"
@@ -182,17 +183,39 @@ namespace {
 
 class AbelianPiece final : public Piece {
 public:
+    // `compiled`: the compiled flow of this index set, or nullptr for the
+    // general plan.
     AbelianPiece(std::string label, const StructureConstants &constants,
                  std::vector<std::uint32_t> sigma, lpi_gradient_fn grad, lpi_energy_fn energy,
-                 void *user)
+                 void *user, CompiledFlow compiled)
         : Piece(std::move(label)), constants_(constants), sigma_(std::move(sigma)), grad_(grad),
           energy_(energy), user_(user), x_sigma_(sigma_.size()), g_(sigma_.size()),
-          exponential_(constants_.dim(), flow_terms(constants_, sigma_)) {}
+          compiled_(compiled), sorted_g_(sigma_.size()) {
+        if (!compiled_) {
+            exponential_.emplace(constants_.dim(), flow_terms(constants_, sigma_));
+            return;
+        }
+        // A compiled flow takes g in the order of the sorted index set.
+        if (std::is_sorted(sigma_.begin(), sigma_.end())) return;
+        for (std::size_t p = 0; p < sigma_.size(); ++p)
+            rank_.push_back(static_cast<std::uint32_t>(
+                std::count_if(sigma_.begin(), sigma_.end(), [&](std::uint32_t j) { return j < sigma_[p]; })));
+    }
 
     void flow(double t, double *x) override {
         gradient(x);
         try {
-            exponential_.apply(g_.data(), t, x);
+            if (compiled_) {
+                const double *g = g_.data();
+                if (!rank_.empty()) {
+                    for (std::size_t p = 0; p < rank_.size(); ++p) sorted_g_[rank_[p]] = g_[p];
+                    g = sorted_g_.data();
+                }
+                const long failed = compiled_(g, t, x);
+                if (failed >= 0) fail_flow_overflow(static_cast<std::size_t>(failed));
+            } else {
+                exponential_->apply(g_.data(), t, x);
+            }
         } catch (const Error &e) {
             fail(e.status(), label() + ": " + e.what());
         }
@@ -256,7 +279,10 @@ private:
     lpi_energy_fn energy_;
     void *user_;
     mutable std::vector<double> x_sigma_, g_;
-    SparseExponential exponential_;
+    CompiledFlow compiled_;
+    std::vector<std::uint32_t> rank_;  // compiled, sigma_ not sorted: sigma_[p]'s place in order
+    std::vector<double> sorted_g_;
+    std::optional<SparseExponential> exponential_;  // the general plan, without one
 };
 
 }  // namespace
@@ -344,8 +370,14 @@ void GenericModel::add_piece(std::size_t n, const std::int32_t *indices, lpi_gra
     std::string label = next_piece_name() + " (indices {";
     for (std::size_t p = 0; p < n; ++p) label += (p ? ", " : "") + std::to_string(sigma[p]);
     label += "})";
+    CompiledFlow compiled = nullptr;
+    if (compiled_flows_ && d <= 8 * sizeof(unsigned)) {
+        unsigned mask = 0;
+        for (std::uint32_t j : sigma) mask |= 1u << j;
+        compiled = compiled_flows_(mask);
+    }
     pieces_.push_back(std::make_unique<AbelianPiece>(std::move(label), *constants_,
-                                                     std::move(sigma), grad, energy, user));
+                                                     std::move(sigma), grad, energy, user, compiled));
 }
 
 void GenericModel::add_casimir(lpi_casimir_fn fn, void *user) {

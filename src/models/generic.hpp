@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "../core/model.hpp"
+#include "compiled_flows.hpp"
 #include "expm.hpp"
 #include "liepoisson.h"
 
@@ -109,6 +110,11 @@ public:
     // the state's scale (LPI_ERR_NONFINITE), not a failed callback.
     void add_builtin_casimir(lpi_casimir_fn fn, const std::string &name);
 
+    // Compiled flows for this model's structure constants (a built-in
+    // algebra's, compiled_flows.hpp): pieces added from now on whose index
+    // set has one use it instead of the general plan, with the same bits.
+    void set_compiled_flows(CompiledFlow (*lookup)(unsigned mask)) { compiled_flows_ = lookup; }
+
     // "piece 3" for the next piece to be added.
     std::string next_piece_name() const { return "piece " + std::to_string(pieces_.size()); }
 
@@ -121,6 +127,7 @@ private:
     std::unique_ptr<StructureConstants> constants_;
     std::vector<std::unique_ptr<Piece>> pieces_;
     std::vector<CasimirCallback> casimirs_;
+    CompiledFlow (*compiled_flows_)(unsigned mask) = nullptr;
     SplitChoice split_{{"pieces"}};
 };
 

@@ -22,21 +22,11 @@
 #include "../core/error.hpp"
 #include "../core/system.hpp"
 #include "generic.hpp"
+#include "moments_algebra.hpp"
 
 namespace lpi {
 
 namespace {
-
-// {x_i, x_j} = c x_k for i < j, read off the paper's 8x8 J (0-based).
-struct Bracket {
-    std::int32_t i, j, k;
-    double c;
-};
-constexpr Bracket kMomentBrackets[] = {
-    {0, 1, 0, 2},  {0, 2, 1, 4},  {0, 4, 3, 2},  {0, 5, 4, 4},  {0, 6, 5, 6},
-    {0, 7, 6, 8},  {1, 2, 2, 2},  {1, 3, 3, -4}, {1, 4, 4, -2}, {1, 6, 6, 2},
-    {1, 7, 7, 4},  {2, 3, 4, -8}, {2, 4, 5, -6}, {2, 5, 6, -4}, {2, 6, 7, -2},
-};
 
 // I and K are evaluated in long double: with x87 extended precision its
 // exponent range (1e4932) holds the products of entries up to 1e308, so a
@@ -208,18 +198,24 @@ private:
 
 }  // namespace
 
+CompiledFlow moment_piece_flow(unsigned mask) {
+    static constexpr compiled::Table<MomentAlgebra> table;
+    return mask < sizeof table.flows / sizeof table.flows[0] ? table.flows[mask] : nullptr;
+}
+
 std::unique_ptr<GenericModel> make_moments() {
-    constexpr std::size_t count = sizeof kMomentBrackets / sizeof kMomentBrackets[0];
+    constexpr std::size_t count = sizeof MomentAlgebra::brackets / sizeof MomentAlgebra::brackets[0];
     std::int32_t i[count], j[count], k[count];
     double c[count];
     for (std::size_t e = 0; e < count; ++e) {
-        i[e] = kMomentBrackets[e].i;
-        j[e] = kMomentBrackets[e].j;
-        k[e] = kMomentBrackets[e].k;
-        c[e] = kMomentBrackets[e].c;
+        i[e] = MomentAlgebra::brackets[e].i;
+        j[e] = MomentAlgebra::brackets[e].j;
+        k[e] = MomentAlgebra::brackets[e].k;
+        c[e] = MomentAlgebra::brackets[e].c;
     }
     auto model = std::make_unique<GenericModel>(
         std::make_unique<StructureConstants>(8, count, i, j, k, c), "moments");
+    model->set_compiled_flows(moment_piece_flow);
     model->add_builtin_casimir(casimir_I, "I = x4 x8 - 4 x5 x7 + 3 x6^2");
     model->add_builtin_casimir(casimir_K, "K = det [[x4,x5,x6],[x5,x6,x7],[x6,x7,x8]]");
     return model;

@@ -6,7 +6,10 @@
 //      V(x1, x4) and T(x3, x8), vs their closed forms written below, which
 //      call the same user gradient once a flow through a pointer, as the
 //      generic path does (the references of (a) and (b) are the library's
-//      models: built-in Hamiltonians, no callback, compensated sums);
+//      models: built-in Hamiltonians, no callback, compensated sums): in a
+//      moments system (the algebra's compiled flows), and in a generic system
+//      given the same structure constants (the general plan, made when the
+//      piece is added);
 //  (d) the moments' product piece H(x1 x3) (closed form), and what one
 //      leapfrog stage of the scene costs against one RK4 step;
 // then (e) the `moments` scene of `lpi report`: CPU time of the best splitting
@@ -106,6 +109,22 @@ lpi_system *generic_e2() {
     check(lpi_add_piece(sys, 1, &height, unit_gradient, unit_energy, nullptr), sys, "e(2) kick");
     check(lpi_add_piece(sys, 1, &momentum, axis_gradient, axis_energy, const_cast<double *>(&one)),
           sys, "e(2) rotation");
+    return sys;
+}
+
+// The moment algebra declared by its structure constants, with the scene's
+// V and T: a generic system, so the general plan (no compiled flows).
+lpi_system *moments_as_generic() {
+    // {x_i, x_j} = c x_k for i < j (0-based), as in the moments system.
+    const int32_t i[] = {0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 2, 2, 2, 2};
+    const int32_t j[] = {1, 2, 4, 5, 6, 7, 2, 3, 4, 6, 7, 3, 4, 5, 6};
+    const int32_t k[] = {0, 1, 3, 4, 5, 6, 2, 3, 4, 6, 7, 4, 5, 6, 7};
+    const double c[] = {2, 4, 2, 4, 6, 8, 2, -4, -2, 2, 4, -8, -6, -4, -2};
+    lpi_system *sys = nullptr;
+    check(lpi_generic_create(&sys, 8, 15, i, j, k, c), nullptr, "moment algebra as generic");
+    const int32_t potential[2] = {0, 3}, kinetic[2] = {2, 7};
+    check(lpi_add_piece(sys, 2, potential, quartic_gradient, quartic_energy, nullptr), sys, "V");
+    check(lpi_add_piece(sys, 2, kinetic, quartic_gradient, quartic_energy, nullptr), sys, "T");
     return sys;
 }
 
@@ -329,6 +348,13 @@ void piece_flows() {
                 [&quartic](double t, double *x) { potential_flow(quartic, t, x); }, mm, x0, 0.05);
     report_pair("(c) moments T(x3, x8)", kBefore.kinetic, piece_flow(mm, 1), mm,
                 [&quartic](double t, double *x) { kinetic_flow(quartic, t, x); }, mm, x0, 0.05);
+    lpi_system *declared = moments_as_generic();
+    lpi::Model &gm = model_of(declared);
+    report_pair("(c) V, generic: general plan", kBefore.potential, piece_flow(gm, 0), gm,
+                [&quartic](double t, double *x) { potential_flow(quartic, t, x); }, mm, x0, 0.05);
+    report_pair("(c) T, generic: general plan", kBefore.kinetic, piece_flow(gm, 1), gm,
+                [&quartic](double t, double *x) { kinetic_flow(quartic, t, x); }, mm, x0, 0.05);
+    lpi_destroy(declared);
 
     // (d) The product piece has no generic counterpart ({x1, x3} != 0): it
     // is timed against the linear pieces and, as the scene's splitting

@@ -1,0 +1,191 @@
+// Compiled flows of a built-in algebra's linear pieces, the way FFTW ships
+// codelets for small sizes: when the structure constants are known when the
+// library is compiled, the plan SparseExponential makes when a piece is added
+// (the pattern of A, the levels of its nilpotent series, the order of the
+// sums) is made by the compiler instead, for every abelian index set whose
+// pattern is nilpotent, and each flow is straight-line code with no tables
+// to read. The arithmetic is SparseExponential's sweep, operation for
+// operation (each row's fixed columns first, then its moved ones, each in
+// order of column; lanes k = 1..level; the increment summed in order of k),
+// so a compiled flow gives the same bits as the general one
+// (test_compiled_flows checks every index set).
+//
+// An algebra is a type with `static constexpr int dim` (at most 16) and
+// `static constexpr Bracket brackets[]`: {x_i, x_j} = c x_k for i < j, one
+// term per pair.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+#include <utility>
+
+namespace lpi {
+
+struct Bracket {
+    std::int32_t i, j, k;
+    double c;
+};
+
+// x <- exp(t A) x for the piece on the index set of its table entry, A_il =
+// sum_p c_{i sigma_p}^l g_p with g in the order of the sorted index set.
+// Returns -1, or, x untouched, the first component whose increment is not
+// finite.
+using CompiledFlow = long (*)(const double *g, double t, double *x);
+
+namespace compiled {
+
+constexpr int kMaxDim = 16;
+constexpr int kMaxEntries = 64;
+
+struct Entry {  // A_row,col += coefficient * g_parameter
+    int row, col, parameter;
+    double coefficient;
+};
+
+// What SparseExponential's constructor works out for one index set (`mask`:
+// bit j for index j), at compile time.
+struct Plan {
+    bool usable = false;  // abelian, nilpotent, A not zero, one term a position
+    int depth = 0;
+    int level[kMaxDim] = {};  // 0: not moved
+    int nodes = 0;
+    int order[kMaxDim] = {};      // moved indices by level, then index
+    int first[kMaxDim + 1] = {};  // entries of node n: first[n] .. first[n + 1]
+    int count = 0;
+    Entry entry[kMaxEntries] = {};
+};
+
+template <class Algebra>
+constexpr Plan plan(unsigned mask) {
+    constexpr int dim = Algebra::dim;
+    Plan P;
+    // Abelian: no bracket between two indices of the set.
+    for (const Bracket &b : Algebra::brackets)
+        if ((mask >> b.i & 1u) && (mask >> b.j & 1u)) return P;
+    // The terms of A: c_{i j}^k g_p for j the p-th index of the set.
+    Entry raw[kMaxEntries] = {};
+    int count = 0, parameter = 0;
+    for (int j = 0; j < dim; ++j) {
+        if (!(mask >> j & 1u)) continue;
+        for (const Bracket &b : Algebra::brackets) {
+            if (b.j == j) raw[count++] = {b.i, b.k, parameter, b.c};
+            if (b.i == j) raw[count++] = {b.j, b.k, parameter, -b.c};
+        }
+        ++parameter;
+    }
+    if (count == 0) return P;
+    for (int e = 0; e < count; ++e)
+        for (int f = e + 1; f < count; ++f)
+            if (raw[e].row == raw[f].row && raw[e].col == raw[f].col) return P;
+    // Levels: the longest path ending at each index; still growing after
+    // dim rounds means a cycle (no nilpotent series).
+    bool moved[kMaxDim] = {};
+    for (int e = 0; e < count; ++e) moved[raw[e].row] = true;
+    for (int round = 0; round <= dim; ++round) {
+        bool grew = false;
+        for (int e = 0; e < count; ++e) {
+            const int candidate = P.level[raw[e].col] + 1;
+            if (candidate > P.level[raw[e].row]) {
+                P.level[raw[e].row] = candidate;
+                grew = true;
+            }
+        }
+        if (!grew) break;
+        if (round == dim) return P;
+    }
+    for (int v = 0; v < dim; ++v)
+        if (P.level[v] > P.depth) P.depth = P.level[v];
+    for (int l = 1; l <= P.depth; ++l)
+        for (int v = 0; v < dim; ++v)
+            if (moved[v] && P.level[v] == l) P.order[P.nodes++] = v;
+    // Each node's entries: fixed columns first, then moved ones, each in
+    // order of column.
+    for (int n = 0; n < P.nodes; ++n) {
+        P.first[n] = P.count;
+        for (int pass = 0; pass < 2; ++pass)
+            for (int col = 0; col < dim; ++col)
+                for (int e = 0; e < count; ++e)
+                    if (raw[e].row == P.order[n] && raw[e].col == col &&
+                        (P.level[col] == 0) == (pass == 0))
+                        P.entry[P.count++] = raw[e];
+    }
+    P.first[P.nodes] = P.count;
+    P.usable = true;
+    return P;
+}
+
+template <int First, class F, int... I>
+inline void unroll(std::integer_sequence<int, I...>, F &&f) {
+    (f(std::integral_constant<int, First + I>{}), ...);
+}
+// f(integral_constant<int, i>) for i = First .. Last - 1, in order.
+template <int First, int Last, class F>
+inline void unroll(F &&f) {
+    unroll<First>(std::make_integer_sequence<int, Last - First>{}, f);
+}
+
+template <class Algebra, unsigned Mask>
+struct Piece {
+    static constexpr Plan P = plan<Algebra>(Mask);
+
+    static long flow(const double *g, double t, double *x) {
+        constexpr int depth = P.depth;
+        // c[v][k] = ((tA)^k x / k!)_v, written for k <= level(v) and read
+        // only there (the general sweep's lanes above are exact zeros).
+        double c[Algebra::dim][depth + 1];
+        unroll<0, Algebra::dim>([&](auto v) { c[v][0] = x[v]; });
+        double increment[Algebra::dim];
+        unroll<0, P.nodes>([&](auto n) {
+            constexpr int v = P.order[n], level = P.level[v];
+            double acc[level] = {};
+            unroll<P.first[n], P.first[n + 1]>([&](auto e) {
+                constexpr Entry E = P.entry[e];
+                constexpr int lanes = P.level[E.col] + 1 < level ? P.level[E.col] + 1 : level;
+                const double a = t * (E.coefficient * g[E.parameter]);
+                unroll<0, lanes>([&](auto k) { acc[k] += a * c[E.col][k]; });
+            });
+            double total = 0.0;
+            unroll<0, level>([&](auto k) {
+                const double term = acc[k] * (1.0 / static_cast<double>(k + 1));
+                total += term;
+                c[v][k + 1] = term;
+            });
+            increment[v] = total;
+        });
+        long failed = -1;
+        unroll<0, P.nodes>([&](auto n) {
+            if (failed < 0 && !std::isfinite(increment[P.order[n]])) failed = P.order[n];
+        });
+        if (failed >= 0) return failed;
+        unroll<0, P.nodes>([&](auto n) { x[P.order[n]] = c[P.order[n]][0] + increment[P.order[n]]; });
+        return -1;
+    }
+};
+
+template <class Algebra, unsigned Mask>
+constexpr CompiledFlow flow_of() {
+    if constexpr (Piece<Algebra, Mask>::P.usable)
+        return &Piece<Algebra, Mask>::flow;
+    else
+        return nullptr;
+}
+
+template <class Algebra, unsigned... Masks>
+constexpr void fill_table(CompiledFlow *table, std::integer_sequence<unsigned, Masks...>) {
+    ((table[Masks] = flow_of<Algebra, Masks>()), ...);
+}
+
+// The compiled flows of every index set of the algebra, by mask (nullptr
+// where there is none).
+template <class Algebra>
+struct Table {
+    static_assert(Algebra::dim <= kMaxDim, "a compiled algebra has at most kMaxDim indices");
+    CompiledFlow flows[1u << Algebra::dim] = {};
+    constexpr Table() { fill_table<Algebra>(flows, std::make_integer_sequence<unsigned, 1u << Algebra::dim>{}); }
+};
+
+}  // namespace compiled
+
+}  // namespace lpi

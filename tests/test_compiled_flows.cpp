@@ -1,0 +1,153 @@
+// The compiled flows of the moment algebra's linear pieces
+// (src/models/compiled_flows.hpp) against the general plan: for every abelian
+// index set, a moments system (compiled flow where there is one) and a
+// generic system declared with the same structure constants (always the
+// general SparseExponential) take the same flow, and must agree to the bit;
+// which index sets have a compiled flow; and a flow that overflows is refused
+// with x unchanged.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <vector>
+
+// Before cmocka.h (through lpi_test.h), whose fail() macro would rewrite lpi::fail.
+#include "core/error.hpp"
+#include "lpi_test.h"
+
+#include "models/moments_algebra.hpp"
+
+// `call` returns LPI_OK, or the test fails with the handle's message.
+#define EXPECT_OK(sys, call)                                                                   \
+    do {                                                                                       \
+        const int status_ = (call);                                                            \
+        if (status_ != LPI_OK) fail_msg("%s: %s", #call, lpi_last_error(sys));               \
+    } while (0)
+
+namespace {
+
+// H = sum_p (alpha_p x_p + beta_p x_p^2 / 2), alpha and beta from user.
+struct Quadratic {
+    double alpha[8], beta[8];
+};
+int quadratic_gradient(size_t n, const double *x, double *g, void *user) {
+    const Quadratic *q = static_cast<const Quadratic *>(user);
+    for (size_t p = 0; p < n; ++p) g[p] = q->alpha[p] + q->beta[p] * x[p];
+    return 0;
+}
+int quadratic_energy(size_t n, const double *x, double *h, void *user) {
+    const Quadratic *q = static_cast<const Quadratic *>(user);
+    *h = 0.0;
+    for (size_t p = 0; p < n; ++p) *h += q->alpha[p] * x[p] + 0.5 * q->beta[p] * x[p] * x[p];
+    return 0;
+}
+
+bool abelian(unsigned mask) {
+    for (const lpi::Bracket &b : lpi::MomentAlgebra::brackets)
+        if ((mask >> b.i & 1u) && (mask >> b.j & 1u)) return false;
+    return true;
+}
+
+lpi_system *moments_generic_twin() {
+    constexpr std::size_t count = sizeof lpi::MomentAlgebra::brackets / sizeof(lpi::Bracket);
+    int32_t i[count], j[count], k[count];
+    double c[count];
+    for (std::size_t e = 0; e < count; ++e) {
+        i[e] = lpi::MomentAlgebra::brackets[e].i;
+        j[e] = lpi::MomentAlgebra::brackets[e].j;
+        k[e] = lpi::MomentAlgebra::brackets[e].k;
+        c[e] = lpi::MomentAlgebra::brackets[e].c;
+    }
+    lpi_system *sys = nullptr;
+    EXPECT_OK(NULL, lpi_generic_create(&sys, 8, count, i, j, k, c));
+    return sys;
+}
+
+// One Lie-Trotter step of the single piece on `indices` from x, in a
+// moments system and in its generic twin.
+void flow_both(const std::vector<int32_t> &indices, Quadratic &h, const double *x, double dt,
+               double *moments_out, double *generic_out) {
+    lpi_system *moments = nullptr, *generic = moments_generic_twin();
+    EXPECT_OK(NULL, lpi_moments_create(&moments));
+    for (lpi_system *sys : {moments, generic}) {
+        EXPECT_OK(sys, lpi_add_piece(sys, indices.size(), indices.data(), quadratic_gradient,
+                                         quadratic_energy, &h));
+        EXPECT_OK(sys, lpi_set_method(sys, "lie-trotter"));
+        EXPECT_OK(sys, lpi_set_state(sys, x, 8));
+        EXPECT_OK(sys, lpi_step(sys, dt, 1));
+    }
+    EXPECT_OK(moments, lpi_get_state(moments, moments_out, 8));
+    EXPECT_OK(generic, lpi_get_state(generic, generic_out, 8));
+    lpi_destroy(moments);
+    lpi_destroy(generic);
+}
+
+void test_compiled_flows_match_the_general_plan(void **) {
+    std::mt19937_64 rng(18);
+    std::uniform_real_distribution<double> u(-1.5, 1.5);
+    int abelian_sets = 0, compiled = 0;
+    for (unsigned mask = 1; mask < 256; ++mask) {
+        if (!abelian(mask)) continue;
+        ++abelian_sets;
+        if (lpi::moment_piece_flow(mask)) ++compiled;
+        std::vector<int32_t> indices;
+        for (int32_t j = 0; j < 8; ++j)
+            if (mask >> j & 1u) indices.push_back(j);
+        if (mask % 3 == 0) std::swap(indices.front(), indices.back());  // any order of the set
+        for (int draw = 0; draw < 3; ++draw) {
+            Quadratic h;
+            for (int p = 0; p < 8; ++p) h.alpha[p] = u(rng), h.beta[p] = u(rng);
+            double x[8], a[8], b[8];
+            for (double &v : x) v = u(rng);
+            flow_both(indices, h, x, 0.37 * (draw + 1), a, b);
+            for (int q = 0; q < 8; ++q)
+                if (std::memcmp(&a[q], &b[q], sizeof(double)) != 0)
+                    fail_msg("index set 0x%02x, draw %d: component %d is %.17g compiled, %.17g "
+                             "general", mask, draw, q, a[q], b[q]);
+        }
+    }
+    std::printf("moment algebra: %d abelian index sets, %d with a compiled flow, all bit for bit "
+                "equal to the general plan\n", abelian_sets, compiled);
+    // The paper's pieces V(x1, x4) and T(x3, x8) (0-based {0, 3}, {2, 7})
+    // and every set of fourth moments are nilpotent: compiled. <qp> scales
+    // q and p ({1}, {1, 5}): not nilpotent, the general plan.
+    assert_non_null(lpi::moment_piece_flow(0x09));
+    assert_non_null(lpi::moment_piece_flow(0x84));
+    for (unsigned quartics = 1; quartics < 32; ++quartics)
+        assert_non_null(lpi::moment_piece_flow(quartics << 3));
+    assert_null(lpi::moment_piece_flow(0x02));
+    assert_null(lpi::moment_piece_flow(0x22));
+    assert_null(lpi::moment_piece_flow(0x03));  // {x0, x1} is not abelian
+    assert_int_equal(compiled, 35);
+}
+
+// A compiled flow that overflows is refused as the general one is: x
+// unchanged to the bit, LPI_ERR_NONFINITE naming the piece and a component.
+void test_compiled_flow_refuses_overflow(void **) {
+    lpi_system *sys = nullptr;
+    EXPECT_OK(NULL, lpi_moments_create(&sys));
+    Quadratic h = {};
+    h.alpha[0] = 1e300;
+    const int32_t indices[2] = {0, 3};
+    EXPECT_OK(sys, lpi_add_piece(sys, 2, indices, quadratic_gradient, quadratic_energy, &h));
+    EXPECT_OK(sys, lpi_set_method(sys, "lie-trotter"));
+    const double x[8] = {1.0, 0.2, 0.5, 2.5, 0.6, 0.6, 0.3, 0.8};
+    EXPECT_OK(sys, lpi_set_state(sys, x, 8));
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 1e10, 1), LPI_ERR_NONFINITE, "exact flow overflows (component");
+    assert_non_null(std::strstr(lpi_last_error(sys), "piece 0"));
+    double after[8];
+    EXPECT_OK(sys, lpi_get_state(sys, after, 8));
+    assert_memory_equal(after, x, sizeof x);
+    lpi_destroy(sys);
+}
+
+}  // namespace
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_compiled_flows_match_the_general_plan),
+        cmocka_unit_test(test_compiled_flow_refuses_overflow),
+    };
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
