@@ -2,6 +2,7 @@
 // independent computations: a finite long-double series for nilpotent A,
 // closed-form rotations (2x2 and Rodrigues' formula) for skew A, and a
 // long-double Taylor series with scaling and squaring for general A.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -417,6 +418,53 @@ void test_deep_series_and_summed_terms(void **) {
     assert_true(error < 1e-14);
 }
 
+// A diagonal D that commutes with an acyclic rest N (each entry of N joins
+// two indices with the same diagonal terms: a grading) is exp(tD) after the
+// series of N; against the long-double exponential of the dense t A. A
+// diagonal that does not commute goes to the Pade path.
+void test_diagonal_series(void **) {
+    const std::size_t n = 6;
+    // Weights 2, -2, none, 4, 2, -2 (parameter 0) and N within a weight
+    // (parameter 1): 0 -> 4 (weight 2) and 1 -> 5 (weight -2).
+    const std::vector<lpi::SparseTerm> terms = {
+        {0, 0, 0, 2.0}, {1, 1, 0, -2.0}, {3, 3, 0, 4.0}, {4, 4, 0, 2.0}, {5, 5, 0, -2.0},
+        {4, 0, 1, 1.5}, {5, 1, 1, -0.7}};
+    lpi::SparseExponential exponential(n, terms);
+    assert_int_equal(static_cast<int>(exponential.path()),
+                     static_cast<int>(lpi::ExpmPath::DiagonalSeries));
+    const double g[2] = {0.45, -1.3}, t = 0.8;
+    std::vector<double> A(n * n, 0.0);
+    for (const lpi::SparseTerm &term : terms) A[term.row * n + term.col] += t * term.coefficient * g[term.parameter];
+    const std::vector<double> x = {0.9, -1.7, 0.25, 1.1, -0.4, 2.3};
+    std::vector<double> y = x;
+    exponential.apply(g, t, y.data());
+    const double error = vector_error(y, long_apply(n, reference_expm1(n, A), x, true));
+    std::printf("diagonal series (weights 2, -2, 4 and N within them): rel. error %.2e\n", error);
+    assert_true(error < 4 * 2.2e-16);
+    assert_true(y[2] == x[2]);
+
+    // The same N with a diagonal that differs across an entry of N: not
+    // commuting, the general Pade path.
+    std::vector<lpi::SparseTerm> skewed = terms;
+    skewed[3].coefficient = 3.0;  // weight of index 4 no longer that of index 0
+    lpi::SparseExponential pade(n, skewed);
+    assert_int_equal(static_cast<int>(pade.path()), static_cast<int>(lpi::ExpmPath::Pade));
+
+    // An overflowing scaling is refused with x unchanged, the series of N
+    // undone.
+    const double huge[2] = {1e3, 1e200};
+    double z[n];
+    std::copy(x.begin(), x.end(), z);
+    try {
+        exponential.apply(huge, 1.0, z);
+        fail_msg("an overflowing scaling was not refused");
+    } catch (const lpi::Error &e) {
+        assert_int_equal(e.status(), LPI_ERR_NONFINITE);
+        assert_non_null(std::strstr(e.what(), "component"));
+    }
+    for (std::size_t i = 0; i < n; ++i) assert_true(z[i] == x[i]);
+}
+
 // Depth 1 (a shear: every moved index reads fixed ones only) is the sum
 // x_v + sum_j t (c_j g_pj) x_j, rounded as written; with two terms at one
 // position (the general sweep) it agrees to round-off.
@@ -477,6 +525,7 @@ int main() {
         cmocka_unit_test(test_plane_closed_form),
         cmocka_unit_test(test_refusals_leave_x_unchanged),
         cmocka_unit_test(test_shear),
+        cmocka_unit_test(test_diagonal_series),
         cmocka_unit_test(test_deep_series_and_summed_terms),
         cmocka_unit_test(test_square_entries_refuse_overflow),
     };

@@ -43,7 +43,7 @@ struct SparseTerm {
     double coefficient;
 };
 
-enum class ExpmPath { Nilpotent, Plane, Pade };
+enum class ExpmPath { Nilpotent, DiagonalSeries, Plane, Pade };
 
 // LPI_ERR_NONFINITE: the exact flow's increment of `component` is not finite.
 [[noreturn]] void fail_flow_overflow(std::size_t component);
@@ -67,6 +67,11 @@ constexpr double kPadeTheta13 = 5.371920351148152e0;
 //    indices it moves in topological order, each index's terms k = 1..depth
 //    at once from those of the indices its row reads; work O(nnz * depth),
 //    nothing dense (depth 1, a shear: one sum a moved index, no series);
+//  - a diagonal D that commutes with an acyclic rest N (each entry of N
+//    joins two indices with the same diagonal terms: the scalings of a
+//    graded algebra, such as the moment algebra's <qp>) in a block of three
+//    or more: exp(tD) exp(tN), the series of N then one expm1 per distinct
+//    diagonal entry;
 //  - otherwise the block of the indices the pattern touches: of order 1 or 2
 //    in closed form (A = tau I + N with N^2 = delta I: exponentials,
 //    sines or hyperbolic sines), larger ones by the Pade exponential.
@@ -101,6 +106,11 @@ private:
         std::uint32_t row;
         std::uint32_t col;
     };
+    struct Scaling {  // a diagonal position of the DiagonalSeries path
+        std::uint32_t global;
+        std::uint32_t position;
+        bool repeat;  // the same terms as the one before: the same expm1
+    };
     struct Term {  // a further term of a position with several
         std::uint32_t position;
         std::uint32_t parameter;
@@ -110,6 +120,8 @@ private:
     void scale_entries(const double *g, double t);  // scaled_ = entries of t A
     template <std::size_t Lanes>
     bool sweep(double *x);
+    bool sweep(double *x);                // in lanes_ lanes
+    void apply_scalings(double *x);       // DiagonalSeries: exp(tD) after the series
     bool shear(const double *g, double t, double *x);  // depth 1, x untouched on failure
     void apply_plane(double t, double *x);  // a block of order 1 or 2
     void apply_pade(double t, double *x);
@@ -135,6 +147,8 @@ private:
     std::size_t lanes_ = 1;
     std::vector<double> inverse_;  // 1 / (k + 1), k < lanes_
     std::vector<double> coefficients_, accumulator_;
+    std::vector<Scaling> scalings_;
+    std::vector<double> scaled_values_;
     std::vector<BlockEntry> block_;  // per position, block paths
     std::vector<double> scaled_, increment_, dense_, exp_, pade_scratch_;
 };

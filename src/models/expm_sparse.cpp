@@ -87,18 +87,21 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
     }
     const std::size_t m = touched.size();
 
-    // Levels by Kahn's algorithm on edges col -> row (x_col drives x_row):
-    // level[v] is the longest path ending at v. A cycle (a self-loop
-    // included) means the pattern does not force nilpotency.
+    // Levels by Kahn's algorithm on the edges col -> row (x_col drives x_row)
+    // off the diagonal: level[v] is the longest path ending at v. A cycle
+    // means the pattern does not force nilpotency.
+    auto diagonal = [](const Position &e) { return e.row == e.col; };
     std::vector<std::size_t> start(m + 1, 0), cursor;
     std::vector<std::uint32_t> indegree(m, 0), adjacency(positions.size()), queue;
     for (const Position &e : positions) {
+        if (diagonal(e)) continue;
         ++start[e.col + 1];
         ++indegree[e.row];
     }
     for (std::size_t v = 0; v < m; ++v) start[v + 1] += start[v];
     cursor.assign(start.begin(), start.end() - 1);
-    for (const Position &e : positions) adjacency[cursor[e.col]++] = e.row;
+    for (const Position &e : positions)
+        if (!diagonal(e)) adjacency[cursor[e.col]++] = e.row;
     for (std::uint32_t v = 0; v < m; ++v)
         if (indegree[v] == 0) queue.push_back(v);
     std::vector<std::size_t> level(m, 0);
@@ -111,15 +114,44 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
             if (--indegree[v] == 0) queue.push_back(v);
         }
     }
+    const bool acyclic = queue.size() == m;
 
-    if (queue.size() != m) {
+    // A diagonal D that commutes with the rest N (the diagonal terms of a
+    // position's row and column are the same: a grading, as the scalings of
+    // a graded algebra have) gives exp(tA) = exp(tD) exp(tN), N nilpotent.
+    std::vector<std::int64_t> diagonal_of(m, -1);  // local index -> its diagonal position
+    for (std::size_t p = 0; p < positions.size(); ++p)
+        if (diagonal(positions[p])) diagonal_of[positions[p].row] = static_cast<std::int64_t>(p);
+    auto same_terms = [&](const Position *a_or_none, const Position *b_or_none) {
+        if (!a_or_none || !b_or_none) return a_or_none == b_or_none;
+        const Position &a = *a_or_none, &b = *b_or_none;
+        if (a.end - a.first != b.end - b.first) return false;
+        for (std::size_t r = 0; r < a.end - a.first; ++r)
+            if (terms[a.first + r].parameter != terms[b.first + r].parameter ||
+                terms[a.first + r].coefficient != terms[b.first + r].coefficient)
+                return false;
+        return true;
+    };
+    auto diagonal_at = [&](std::uint32_t v) -> const Position * {
+        return diagonal_of[v] < 0 ? nullptr : &positions[static_cast<std::size_t>(diagonal_of[v])];
+    };
+    bool commuting = true, any_diagonal = false;
+    for (const Position &e : positions) {
+        any_diagonal = any_diagonal || diagonal(e);
+        if (!diagonal(e)) commuting = commuting && same_terms(diagonal_at(e.row), diagonal_at(e.col));
+    }
+
+    if (!acyclic || (any_diagonal && (m <= 2 || !commuting))) {
         path_ = m <= 2 ? ExpmPath::Plane : ExpmPath::Pade;
+        depth_ = 0;
         moved_ = std::move(touched);
         for (const Position &e : positions) block_.push_back({e.row, e.col});
     } else {
-        // Nilpotent: the moved indices (level >= 1) by level are in
+        // The series of N: the moved indices (level >= 1) by level are in
         // topological order; each position goes with the node of its row.
-        path_ = ExpmPath::Nilpotent;
+        // The diagonal positions, if any, follow, those with the same terms
+        // next to one another.
+        path_ = any_diagonal ? ExpmPath::DiagonalSeries : ExpmPath::Nilpotent;
         std::vector<std::uint32_t> order;
         for (std::uint32_t v = 0; v < m; ++v)
             if (level[v] >= 1) order.push_back(v);
@@ -131,21 +163,34 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
             moved_.push_back(touched[order[r]]);
             nodes_.push_back({touched[order[r]], 0, 0});
         }
+        std::vector<Position> series, scalings;
+        for (const Position &e : positions) (diagonal(e) ? scalings : series).push_back(e);
         auto fixed = [&](const Position &e) { return level[e.col] == 0; };
-        std::stable_sort(positions.begin(), positions.end(),
-                         [&](const Position &a, const Position &b) {
-                             return std::make_pair(node_of[a.row], !fixed(a)) <
-                                    std::make_pair(node_of[b.row], !fixed(b));
-                         });
-        for (const Position &e : positions) {
+        std::stable_sort(series.begin(), series.end(), [&](const Position &a, const Position &b) {
+            return std::make_pair(node_of[a.row], !fixed(a)) < std::make_pair(node_of[b.row], !fixed(b));
+        });
+        for (const Position &e : series) {
             SeriesNode &node = nodes_[node_of[e.row]];
             ++(fixed(e) ? node.fixed_columns : node.moved_columns);
             columns_.push_back(fixed(e) ? touched[e.col] : node_of[e.col]);
         }
+        // The diagonal, entries with the same terms (the same weight of a
+        // graded algebra) next to one another: they share one expm1.
+        std::stable_sort(scalings.begin(), scalings.end(), [&](const Position &a, const Position &b) {
+            return std::make_pair(terms[a.first].parameter, terms[a.first].coefficient) <
+                   std::make_pair(terms[b.first].parameter, terms[b.first].coefficient);
+        });
+        for (std::size_t d = 0; d < scalings.size(); ++d) {
+            const bool repeat = d > 0 && same_terms(&scalings[d], &scalings[d - 1]);
+            scalings_.push_back({touched[scalings[d].row], static_cast<std::uint32_t>(series.size() + d), repeat});
+        }
+        scaled_values_.resize(scalings_.size());
         lanes_ = depth_ <= 1 ? 1 : depth_ <= 2 ? 2 : depth_ <= 4 ? 4 : depth_ <= 8 ? 8 : depth_;
         for (std::size_t k = 0; k < lanes_; ++k) inverse_.push_back(1.0 / static_cast<double>(k + 1));
         coefficients_.resize(nodes_.size() * lanes_);
         accumulator_.resize(lanes_);
+        positions = series;
+        positions.insert(positions.end(), scalings.begin(), scalings.end());
     }
     for (std::uint32_t j = 0; j < positions.size(); ++j) {
         first_terms_.push_back(terms[positions[j].first]);
@@ -268,23 +313,47 @@ void SparseExponential::apply(const double *g, double t, double *x) {
         return;
     }
     scale_entries(g, t);
-    if (path_ == ExpmPath::Plane) {
-        apply_plane(t, x);
-        return;
+    switch (path_) {
+        case ExpmPath::Plane: apply_plane(t, x); return;
+        case ExpmPath::Pade: apply_pade(t, x); return;
+        case ExpmPath::Nilpotent:
+            if (!sweep(x)) fail_nonfinite();
+            return;
+        case ExpmPath::DiagonalSeries:
+            if (!sweep(x)) fail_nonfinite();
+            apply_scalings(x);
+            return;
     }
-    if (path_ == ExpmPath::Pade) {
-        apply_pade(t, x);
-        return;
-    }
-    bool finite = true;
+}
+
+bool SparseExponential::sweep(double *x) {
     switch (lanes_) {
-        case 1: finite = sweep<1>(x); break;
-        case 2: finite = sweep<2>(x); break;
-        case 4: finite = sweep<4>(x); break;
-        case 8: finite = sweep<8>(x); break;
-        default: finite = sweep<0>(x); break;
+        case 1: return sweep<1>(x);
+        case 2: return sweep<2>(x);
+        case 4: return sweep<4>(x);
+        case 8: return sweep<8>(x);
+        default: return sweep<0>(x);
     }
-    if (!finite) fail_nonfinite();
+}
+
+// x_i <- exp(d_i) x_i = x_i + expm1(d_i) x_i after the series of N, one
+// expm1 for each run of equal diagonal terms. When a result is not finite,
+// x goes back to what it was before the series too.
+void SparseExponential::apply_scalings(double *x) {
+    double growth = 0.0;
+    std::size_t failed = scalings_.size();
+    for (std::size_t d = 0; d < scalings_.size(); ++d) {
+        const Scaling &scaling = scalings_[d];
+        if (!scaling.repeat) growth = std::expm1(scaled_[scaling.position]);
+        const double z = x[scaling.global];
+        scaled_values_[d] = z + growth * z;
+        if (failed == scalings_.size() && !std::isfinite(scaled_values_[d])) failed = d;
+    }
+    if (failed < scalings_.size()) {
+        for (std::size_t v = 0; v < nodes_.size(); ++v) x[nodes_[v].global] = coefficients_[v * lanes_];
+        fail_flow_overflow(scalings_[failed].global);
+    }
+    for (std::size_t d = 0; d < scalings_.size(); ++d) x[scalings_[d].global] = scaled_values_[d];
 }
 
 void SparseExponential::apply_plane(double t, double *x) {
