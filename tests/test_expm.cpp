@@ -423,23 +423,24 @@ void test_deep_series_and_summed_terms(void **) {
 // series of N; against the long-double exponential of the dense t A. A
 // diagonal that does not commute goes to the Pade path.
 void test_diagonal_series(void **) {
-    const std::size_t n = 6;
-    // Weights 2, -2, none, 4, 2, -2 (parameter 0) and N within a weight
-    // (parameter 1): 0 -> 4 (weight 2) and 1 -> 5 (weight -2).
+    const std::size_t n = 8;
+    // Weights 2, -2, none, 4, 2, -2, -4, 6 (parameter 0: exponentials by
+    // powers of one expm1) and N within a weight (parameter 1): 0 -> 4
+    // (weight 2) and 1 -> 5 (weight -2).
     const std::vector<lpi::SparseTerm> terms = {
         {0, 0, 0, 2.0}, {1, 1, 0, -2.0}, {3, 3, 0, 4.0}, {4, 4, 0, 2.0}, {5, 5, 0, -2.0},
-        {4, 0, 1, 1.5}, {5, 1, 1, -0.7}};
+        {6, 6, 0, -4.0}, {7, 7, 0, 6.0}, {4, 0, 1, 1.5}, {5, 1, 1, -0.7}};
     lpi::SparseExponential exponential(n, terms);
     assert_int_equal(static_cast<int>(exponential.path()),
                      static_cast<int>(lpi::ExpmPath::DiagonalSeries));
     const double g[2] = {0.45, -1.3}, t = 0.8;
     std::vector<double> A(n * n, 0.0);
     for (const lpi::SparseTerm &term : terms) A[term.row * n + term.col] += t * term.coefficient * g[term.parameter];
-    const std::vector<double> x = {0.9, -1.7, 0.25, 1.1, -0.4, 2.3};
+    const std::vector<double> x = {0.9, -1.7, 0.25, 1.1, -0.4, 2.3, -0.6, 1.3};
     std::vector<double> y = x;
     exponential.apply(g, t, y.data());
     const double error = vector_error(y, long_apply(n, reference_expm1(n, A), x, true));
-    std::printf("diagonal series (weights 2, -2, 4 and N within them): rel. error %.2e\n", error);
+    std::printf("diagonal series (weights -4 .. 6 and N within them): rel. error %.2e\n", error);
     assert_true(error < 4 * 2.2e-16);
     assert_true(y[2] == x[2]);
 

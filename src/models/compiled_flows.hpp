@@ -46,8 +46,23 @@ struct Entry {  // A_row,col += coefficient * g_parameter
 
 // What SparseExponential's constructor works out for one index set (`mask`:
 // bit j for index j), at compile time.
+struct Scaling {  // a diagonal entry c g_p of index `index`
+    int index, parameter;
+    double coefficient;
+    int group;     // its Group, or -1: its own expm1
+    int multiple;  // k: c is k times the group's base
+};
+struct Group {  // diagonal entries k base g_p of one parameter
+    int parameter;
+    double base;
+    int largest;  // the largest |k|
+};
+constexpr int kMaxMultiple = 8;  // as SparseExponential's
+
 struct Plan {
-    bool usable = false;  // abelian, nilpotent, A not zero, one term a position
+    bool usable = false;  // abelian, A not zero, one term a position, and a
+                          // nilpotent pattern or a diagonal that commutes
+                          // with a nilpotent rest (in a block of three or more)
     int depth = 0;
     int level[kMaxDim] = {};  // 0: not moved
     int nodes = 0;
@@ -55,7 +70,13 @@ struct Plan {
     int first[kMaxDim + 1] = {};  // entries of node n: first[n] .. first[n + 1]
     int count = 0;
     Entry entry[kMaxEntries] = {};
+    int scalings = 0;
+    Scaling scaling[kMaxDim] = {};
+    int groups = 0;
+    Group group[kMaxDim] = {};
 };
+
+constexpr double absolute(double v) { return v < 0 ? -v : v; }
 
 template <class Algebra>
 constexpr Plan plan(unsigned mask) {
@@ -79,13 +100,59 @@ constexpr Plan plan(unsigned mask) {
     for (int e = 0; e < count; ++e)
         for (int f = e + 1; f < count; ++f)
             if (raw[e].row == raw[f].row && raw[e].col == raw[f].col) return P;
-    // Levels: the longest path ending at each index; still growing after
-    // dim rounds means a cycle (no nilpotent series).
+    // The diagonal: it must commute with the rest (an entry of the rest
+    // joins two indices with the same diagonal term, or none), and the
+    // pattern touch three indices or more (two: SparseExponential's closed
+    // form of a plane).
+    double diagonal[kMaxDim] = {};
+    int diagonal_parameter[kMaxDim] = {}, touched = 0;
+    bool has_diagonal[kMaxDim] = {}, touches[kMaxDim] = {};
+    for (int e = 0; e < count; ++e) {
+        touches[raw[e].row] = touches[raw[e].col] = true;
+        if (raw[e].row != raw[e].col) continue;
+        has_diagonal[raw[e].row] = true;
+        diagonal[raw[e].row] = raw[e].coefficient;
+        diagonal_parameter[raw[e].row] = raw[e].parameter;
+        P.scaling[P.scalings++] = {raw[e].row, raw[e].parameter, raw[e].coefficient, -1, 0};
+    }
+    for (int v = 0; v < dim; ++v) touched += touches[v] ? 1 : 0;
+    if (P.scalings > 0 && touched <= 2) return P;
+    for (int e = 0; e < count; ++e) {
+        const int r = raw[e].row, c = raw[e].col;
+        if (r != c && (has_diagonal[r] != has_diagonal[c] ||
+                       (has_diagonal[r] && (diagonal[r] != diagonal[c] ||
+                                            diagonal_parameter[r] != diagonal_parameter[c]))))
+            return P;
+    }
+    // Diagonal entries that are multiples k of their parameter's smallest
+    // |c| take their exponentials by powers, as SparseExponential's do.
+    for (int d = 0; d < P.scalings; ++d) {
+        int g = 0;
+        while (g < P.groups && P.group[g].parameter != P.scaling[d].parameter) ++g;
+        if (g == P.groups) P.group[P.groups++] = {P.scaling[d].parameter, absolute(P.scaling[d].coefficient), 0};
+        if (absolute(P.scaling[d].coefficient) < P.group[g].base) P.group[g].base = absolute(P.scaling[d].coefficient);
+        P.scaling[d].group = g;
+    }
+    for (int d = 0; d < P.scalings; ++d) {
+        Group &group = P.group[P.scaling[d].group];
+        const double c = P.scaling[d].coefficient, k = c / group.base;
+        const int whole = static_cast<int>(k);
+        if (k != static_cast<double>(whole) || absolute(k) > kMaxMultiple || k * group.base != c) {
+            P.scaling[d].group = -1;
+            continue;
+        }
+        P.scaling[d].multiple = whole;
+        if ((whole < 0 ? -whole : whole) > group.largest) group.largest = whole < 0 ? -whole : whole;
+    }
+    // Levels: the longest path ending at each index off the diagonal; still
+    // growing after dim rounds means a cycle (no nilpotent series).
     bool moved[kMaxDim] = {};
-    for (int e = 0; e < count; ++e) moved[raw[e].row] = true;
+    for (int e = 0; e < count; ++e)
+        if (raw[e].row != raw[e].col) moved[raw[e].row] = true;
     for (int round = 0; round <= dim; ++round) {
         bool grew = false;
         for (int e = 0; e < count; ++e) {
+            if (raw[e].row == raw[e].col) continue;
             const int candidate = P.level[raw[e].col] + 1;
             if (candidate > P.level[raw[e].row]) {
                 P.level[raw[e].row] = candidate;
@@ -107,7 +174,7 @@ constexpr Plan plan(unsigned mask) {
         for (int pass = 0; pass < 2; ++pass)
             for (int col = 0; col < dim; ++col)
                 for (int e = 0; e < count; ++e)
-                    if (raw[e].row == P.order[n] && raw[e].col == col &&
+                    if (raw[e].row == P.order[n] && raw[e].col == col && raw[e].row != raw[e].col &&
                         (P.level[col] == 0) == (pass == 0))
                         P.entry[P.count++] = raw[e];
     }
@@ -130,9 +197,16 @@ template <class Algebra, unsigned Mask>
 struct Piece {
     static constexpr Plan P = plan<Algebra>(Mask);
 
+    // The first node, in order, whose increment is not finite.
+    static long first_nonfinite(const double *increment) {
+        for (int n = 0; n < P.nodes; ++n)
+            if (!std::isfinite(increment[P.order[n]])) return P.order[n];
+        return -1;
+    }
+
     static long flow(const double *g, double t, double *x) {
         constexpr int depth = P.depth;
-        // c[v][k] = ((tA)^k x / k!)_v, written for k <= level(v) and read
+        // c[v][k] = ((tN)^k x / k!)_v, written for k <= level(v) and read
         // only there (the general sweep's lanes above are exact zeros).
         double c[Algebra::dim][depth + 1];
         unroll<0, Algebra::dim>([&](auto v) { c[v][0] = x[v]; });
@@ -154,12 +228,44 @@ struct Piece {
             });
             increment[v] = total;
         });
-        long failed = -1;
-        unroll<0, P.nodes>([&](auto n) {
-            if (failed < 0 && !std::isfinite(increment[P.order[n]])) failed = P.order[n];
+        // 0 z is 0 for a finite z and NaN otherwise: one test for all.
+        double probe = 0.0;
+        unroll<0, P.nodes>([&](auto n) { probe += 0.0 * increment[P.order[n]]; });
+        if (probe != probe) return first_nonfinite(increment);
+        double y[Algebra::dim];  // exp(tN) x
+        unroll<0, Algebra::dim>([&](auto v) { y[v] = x[v]; });
+        unroll<0, P.nodes>([&](auto n) { y[P.order[n]] = c[P.order[n]][0] + increment[P.order[n]]; });
+        // Then exp(tD): E_k = exp(k s) - 1 of each group by powers of
+        // u = expm1(s), as SparseExponential::apply_scalings forms them.
+        double E[P.groups > 0 ? P.groups : 1][2 * kMaxMultiple + 1];
+        unroll<0, P.groups>([&](auto q) {
+            constexpr Group G = P.group[q];
+            double *e = E[q] + kMaxMultiple;
+            const double u = std::expm1(t * (G.base * g[G.parameter]));
+            e[1] = u;
+            unroll<2, (G.largest > 1 ? G.largest + 1 : 2)>([&](auto k) { e[k] = e[k - 1] + u + e[k - 1] * u; });
+            const double w = std::isfinite(u) ? -u / (1.0 + u) : -1.0;
+            e[-1] = w;
+            unroll<2, (G.largest > 1 ? G.largest + 1 : 2)>([&](auto k) { e[-k] = e[1 - k] + w + e[1 - k] * w; });
         });
-        if (failed >= 0) return failed;
-        unroll<0, P.nodes>([&](auto n) { x[P.order[n]] = c[P.order[n]][0] + increment[P.order[n]]; });
+        double scaled[P.scalings > 0 ? P.scalings : 1];
+        unroll<0, P.scalings>([&](auto d) {
+            constexpr Scaling S = P.scaling[d];
+            double growth;
+            if constexpr (S.group < 0)
+                growth = std::expm1(t * (S.coefficient * g[S.parameter]));
+            else
+                growth = E[S.group][kMaxMultiple + S.multiple];
+            scaled[d] = y[S.index] + growth * y[S.index];
+            probe += 0.0 * scaled[d];
+        });
+        if (probe != probe) {
+            for (int d = 0; d < P.scalings; ++d)
+                if (!std::isfinite(scaled[d])) return P.scaling[d].index;
+        }
+        unroll<0, P.scalings>([&](auto d) { y[P.scaling[d].index] = scaled[d]; });
+        unroll<0, P.nodes>([&](auto n) { x[P.order[n]] = y[P.order[n]]; });
+        unroll<0, P.scalings>([&](auto d) { x[P.scaling[d].index] = y[P.scaling[d].index]; });
         return -1;
     }
 };

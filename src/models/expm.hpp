@@ -109,8 +109,15 @@ private:
     struct Scaling {  // a diagonal position of the DiagonalSeries path
         std::uint32_t global;
         std::uint32_t position;
-        bool repeat;  // the same terms as the one before: the same expm1
+        int group;     // its PowerGroup, or -1: its own expm1
+        int multiple;  // k: the entry is k times the group's base
     };
+    struct PowerGroup {  // diagonal entries k c g_p of one parameter p
+        std::uint32_t parameter;
+        double base;  // c
+        int largest;  // the largest |k|
+    };
+    static constexpr int kMaxMultiple = 8;
     struct Term {  // a further term of a position with several
         std::uint32_t position;
         std::uint32_t parameter;
@@ -121,7 +128,7 @@ private:
     template <std::size_t Lanes>
     bool sweep(double *x);
     bool sweep(double *x);                // in lanes_ lanes
-    void apply_scalings(double *x);       // DiagonalSeries: exp(tD) after the series
+    void apply_scalings(const double *g, double t, double *x);  // DiagonalSeries: exp(tD) after N
     bool shear(const double *g, double t, double *x);  // depth 1, x untouched on failure
     void apply_plane(double t, double *x);  // a block of order 1 or 2
     void apply_pade(double t, double *x);
@@ -148,6 +155,8 @@ private:
     std::vector<double> inverse_;  // 1 / (k + 1), k < lanes_
     std::vector<double> coefficients_, accumulator_;
     std::vector<Scaling> scalings_;
+    std::vector<PowerGroup> power_groups_;
+    std::vector<double> powers_;  // per group: exp(k s) - 1, k = -kMaxMultiple .. kMaxMultiple
     std::vector<double> scaled_values_;
     std::vector<BlockEntry> block_;  // per position, block paths
     std::vector<double> scaled_, increment_, dense_, exp_, pade_scratch_;

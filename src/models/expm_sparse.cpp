@@ -174,16 +174,39 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
             ++(fixed(e) ? node.fixed_columns : node.moved_columns);
             columns_.push_back(fixed(e) ? touched[e.col] : node_of[e.col]);
         }
-        // The diagonal, entries with the same terms (the same weight of a
-        // graded algebra) next to one another: they share one expm1.
-        std::stable_sort(scalings.begin(), scalings.end(), [&](const Position &a, const Position &b) {
-            return std::make_pair(terms[a.first].parameter, terms[a.first].coefficient) <
-                   std::make_pair(terms[b.first].parameter, terms[b.first].coefficient);
-        });
+        // The diagonal. An entry of one term c g_p whose c is an integer
+        // multiple k of the smallest |c| of parameter p (|k| <=
+        // kMaxMultiple: the weights of a graded algebra) takes its
+        // exp(t c g_p) - 1 from one expm1 of that parameter, by powers; any
+        // other takes its own expm1.
+        std::vector<std::int64_t> group_of;  // by parameter
         for (std::size_t d = 0; d < scalings.size(); ++d) {
-            const bool repeat = d > 0 && same_terms(&scalings[d], &scalings[d - 1]);
-            scalings_.push_back({touched[scalings[d].row], static_cast<std::uint32_t>(series.size() + d), repeat});
+            const Position &e = scalings[d];
+            const SparseTerm &term = terms[e.first];
+            scalings_.push_back({touched[e.row], static_cast<std::uint32_t>(series.size() + d), -1, 0});
+            if (e.end - e.first != 1 || term.coefficient == 0.0) continue;
+            if (group_of.size() <= term.parameter) group_of.resize(term.parameter + 1, -1);
+            if (group_of[term.parameter] < 0) {
+                group_of[term.parameter] = static_cast<std::int64_t>(power_groups_.size());
+                power_groups_.push_back({term.parameter, std::fabs(term.coefficient), 0});
+            }
+            PowerGroup &group = power_groups_[static_cast<std::size_t>(group_of[term.parameter])];
+            group.base = std::min(group.base, std::fabs(term.coefficient));
+            scalings_.back().group = static_cast<int>(group_of[term.parameter]);
         }
+        for (std::size_t d = 0; d < scalings.size(); ++d) {
+            Scaling &scaling = scalings_[d];
+            if (scaling.group < 0) continue;
+            PowerGroup &group = power_groups_[static_cast<std::size_t>(scaling.group)];
+            const double c = terms[scalings[d].first].coefficient, k = c / group.base;
+            if (k != std::nearbyint(k) || std::fabs(k) > kMaxMultiple || k * group.base != c) {
+                scaling.group = -1;
+                continue;
+            }
+            scaling.multiple = static_cast<int>(k);
+            group.largest = std::max(group.largest, std::abs(scaling.multiple));
+        }
+        powers_.assign(power_groups_.size() * (2 * kMaxMultiple + 1), 0.0);
         scaled_values_.resize(scalings_.size());
         lanes_ = depth_ <= 1 ? 1 : depth_ <= 2 ? 2 : depth_ <= 4 ? 4 : depth_ <= 8 ? 8 : depth_;
         for (std::size_t k = 0; k < lanes_; ++k) inverse_.push_back(1.0 / static_cast<double>(k + 1));
@@ -321,7 +344,7 @@ void SparseExponential::apply(const double *g, double t, double *x) {
             return;
         case ExpmPath::DiagonalSeries:
             if (!sweep(x)) fail_nonfinite();
-            apply_scalings(x);
+            apply_scalings(g, t, x);
             return;
     }
 }
@@ -339,12 +362,29 @@ bool SparseExponential::sweep(double *x) {
 // x_i <- exp(d_i) x_i = x_i + expm1(d_i) x_i after the series of N, one
 // expm1 for each run of equal diagonal terms. When a result is not finite,
 // x goes back to what it was before the series too.
-void SparseExponential::apply_scalings(double *x) {
-    double growth = 0.0;
+void SparseExponential::apply_scalings(const double *g, double t, double *x) {
+    // Group by group: E_k = exp(k s) - 1 for s = t (base g_p), from u = E_1
+    // and w = E_-1 = -u / (1 + u) by E_{k+1} = E_k + u + E_k u and
+    // E_{-k-1} = E_{-k} + w + E_{-k} w, without cancellation (w = -1 where
+    // exp(s) overflows: exp(-s) is then below the smallest double).
+    for (std::size_t q = 0; q < power_groups_.size(); ++q) {
+        const PowerGroup &group = power_groups_[q];
+        double *E = powers_.data() + q * (2 * kMaxMultiple + 1) + kMaxMultiple;
+        const double u = std::expm1(t * (group.base * g[group.parameter]));
+        E[1] = u;
+        for (int k = 2; k <= group.largest; ++k) E[k] = E[k - 1] + u + E[k - 1] * u;
+        const double w = std::isfinite(u) ? -u / (1.0 + u) : -1.0;
+        E[-1] = w;
+        for (int k = 2; k <= group.largest; ++k) E[-k] = E[1 - k] + w + E[1 - k] * w;
+    }
     std::size_t failed = scalings_.size();
     for (std::size_t d = 0; d < scalings_.size(); ++d) {
         const Scaling &scaling = scalings_[d];
-        if (!scaling.repeat) growth = std::expm1(scaled_[scaling.position]);
+        const double growth =
+            scaling.group < 0
+                ? std::expm1(scaled_[scaling.position])
+                : powers_[static_cast<std::size_t>(scaling.group) * (2 * kMaxMultiple + 1) + kMaxMultiple +
+                          static_cast<std::size_t>(static_cast<std::ptrdiff_t>(scaling.multiple))];
         const double z = x[scaling.global];
         scaled_values_[d] = z + growth * z;
         if (failed == scalings_.size() && !std::isfinite(scaled_values_[d])) failed = d;

@@ -191,6 +191,8 @@ public:
         : Piece(std::move(label)), constants_(constants), sigma_(std::move(sigma)), grad_(grad),
           energy_(energy), user_(user), x_sigma_(sigma_.size()), g_(sigma_.size()),
           compiled_(compiled), sorted_g_(sigma_.size()) {
+        consecutive_ = true;
+        for (std::size_t p = 1; p < sigma_.size(); ++p) consecutive_ = consecutive_ && sigma_[p] == sigma_[p - 1] + 1;
         if (!compiled_) {
             exponential_.emplace(constants_.dim(), flow_terms(constants_, sigma_));
             return;
@@ -222,9 +224,8 @@ public:
     }
 
     double energy(const double *x) const override {
-        gather(x);
         double h = 0.0;
-        const int rc = energy_(sigma_.size(), x_sigma_.data(), &h, user_);
+        const int rc = energy_(sigma_.size(), gather(x), &h, user_);
         if (rc != 0)
             fail(LPI_ERR_CALLBACK, "the energy callback of " + label() + " returned " +
                                        std::to_string(rc));
@@ -250,13 +251,16 @@ private:
         return terms;
     }
 
-    void gather(const double *x) const {
+    // x_sigma: where the index set is a run of consecutive indices (a single
+    // one included), in place; else gathered into x_sigma_.
+    const double *gather(const double *x) const {
+        if (consecutive_) return x + sigma_[0];
         for (std::size_t p = 0; p < sigma_.size(); ++p) x_sigma_[p] = x[sigma_[p]];
+        return x_sigma_.data();
     }
 
     void gradient(const double *x) const {
-        gather(x);
-        const int rc = grad_(sigma_.size(), x_sigma_.data(), g_.data(), user_);
+        const int rc = grad_(sigma_.size(), gather(x), g_.data(), user_);
         bool finite = true;
         for (std::size_t p = 0; p < g_.size(); ++p) finite &= std::isfinite(g_[p]);
         if (rc != 0 || !finite) fail_gradient(rc);
@@ -278,6 +282,7 @@ private:
     lpi_gradient_fn grad_;
     lpi_energy_fn energy_;
     void *user_;
+    bool consecutive_ = false;  // sigma_ = {s, s + 1, ...}: x_sigma is read in place
     mutable std::vector<double> x_sigma_, g_;
     CompiledFlow compiled_;
     std::vector<std::uint32_t> rank_;  // compiled, sigma_ not sorted: sigma_[p]'s place in order
