@@ -435,7 +435,8 @@ void test_diagonal_series(void **) {
                      static_cast<int>(lpi::ExpmPath::DiagonalSeries));
     const double g[2] = {0.45, -1.3}, t = 0.8;
     std::vector<double> A(n * n, 0.0);
-    for (const lpi::SparseTerm &term : terms) A[term.row * n + term.col] += t * term.coefficient * g[term.parameter];
+    for (const lpi::SparseTerm &term : terms)
+        A[term.row * n + term.col] += t * term.coefficient * g[term.parameter];
     const std::vector<double> x = {0.9, -1.7, 0.25, 1.1, -0.4, 2.3, -0.6, 1.3};
     std::vector<double> y = x;
     exponential.apply(g, t, y.data());

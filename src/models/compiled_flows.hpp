@@ -127,22 +127,26 @@ constexpr Plan plan(unsigned mask) {
     // Diagonal entries that are multiples k of their parameter's smallest
     // |c| take their exponentials by powers, as SparseExponential's do.
     for (int d = 0; d < P.scalings; ++d) {
+        Scaling &scaling = P.scaling[d];
+        const double size = absolute(scaling.coefficient);
         int g = 0;
-        while (g < P.groups && P.group[g].parameter != P.scaling[d].parameter) ++g;
-        if (g == P.groups) P.group[P.groups++] = {P.scaling[d].parameter, absolute(P.scaling[d].coefficient), 0};
-        if (absolute(P.scaling[d].coefficient) < P.group[g].base) P.group[g].base = absolute(P.scaling[d].coefficient);
-        P.scaling[d].group = g;
+        while (g < P.groups && P.group[g].parameter != scaling.parameter) ++g;
+        if (g == P.groups) P.group[P.groups++] = {scaling.parameter, size, 0};
+        if (size < P.group[g].base) P.group[g].base = size;
+        scaling.group = g;
     }
     for (int d = 0; d < P.scalings; ++d) {
-        Group &group = P.group[P.scaling[d].group];
-        const double c = P.scaling[d].coefficient, k = c / group.base;
-        const int whole = static_cast<int>(k);
-        if (k != static_cast<double>(whole) || absolute(k) > kMaxMultiple || k * group.base != c) {
-            P.scaling[d].group = -1;
+        Scaling &scaling = P.scaling[d];
+        Group &group = P.group[scaling.group];
+        const double c = scaling.coefficient, k = c / group.base;
+        const int whole = absolute(k) <= kMaxMultiple ? static_cast<int>(k) : 0;
+        if (whole == 0 || k != static_cast<double>(whole) || k * group.base != c) {
+            scaling.group = -1;
             continue;
         }
-        P.scaling[d].multiple = whole;
-        if ((whole < 0 ? -whole : whole) > group.largest) group.largest = whole < 0 ? -whole : whole;
+        scaling.multiple = whole;
+        const int size = whole < 0 ? -whole : whole;
+        if (size > group.largest) group.largest = size;
     }
     // Levels: the longest path ending at each index off the diagonal; still
     // growing after dim rounds means a cycle (no nilpotent series).
@@ -243,10 +247,11 @@ struct Piece {
             double *e = E[q] + kMaxMultiple;
             const double u = std::expm1(t * (G.base * g[G.parameter]));
             e[1] = u;
-            unroll<2, (G.largest > 1 ? G.largest + 1 : 2)>([&](auto k) { e[k] = e[k - 1] + u + e[k - 1] * u; });
+            constexpr int powers = G.largest > 1 ? G.largest + 1 : 2;  // k = 2 .. largest
+            unroll<2, powers>([&](auto k) { e[k] = e[k - 1] + u + e[k - 1] * u; });
             const double w = std::isfinite(u) ? -u / (1.0 + u) : -1.0;
             e[-1] = w;
-            unroll<2, (G.largest > 1 ? G.largest + 1 : 2)>([&](auto k) { e[-k] = e[1 - k] + w + e[1 - k] * w; });
+            unroll<2, powers>([&](auto k) { e[-k] = e[1 - k] + w + e[1 - k] * w; });
         });
         double scaled[P.scalings > 0 ? P.scalings : 1];
         unroll<0, P.scalings>([&](auto d) {
@@ -289,7 +294,9 @@ template <class Algebra>
 struct Table {
     static_assert(Algebra::dim <= kMaxDim, "a compiled algebra has at most kMaxDim indices");
     CompiledFlow flows[1u << Algebra::dim] = {};
-    constexpr Table() { fill_table<Algebra>(flows, std::make_integer_sequence<unsigned, 1u << Algebra::dim>{}); }
+    constexpr Table() {
+        fill_table<Algebra>(flows, std::make_integer_sequence<unsigned, 1u << Algebra::dim>{});
+    }
 };
 
 }  // namespace compiled

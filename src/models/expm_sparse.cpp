@@ -149,8 +149,7 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
     } else {
         // The series of N: the moved indices (level >= 1) by level are in
         // topological order; each position goes with the node of its row.
-        // The diagonal positions, if any, follow, those with the same terms
-        // next to one another.
+        // The diagonal positions, if any, follow.
         path_ = any_diagonal ? ExpmPath::DiagonalSeries : ExpmPath::Nilpotent;
         std::vector<std::uint32_t> order;
         for (std::uint32_t v = 0; v < m; ++v)
@@ -380,11 +379,10 @@ void SparseExponential::apply_scalings(const double *g, double t, double *x) {
     std::size_t failed = scalings_.size();
     for (std::size_t d = 0; d < scalings_.size(); ++d) {
         const Scaling &scaling = scalings_[d];
-        const double growth =
-            scaling.group < 0
-                ? std::expm1(scaled_[scaling.position])
-                : powers_[static_cast<std::size_t>(scaling.group) * (2 * kMaxMultiple + 1) + kMaxMultiple +
-                          static_cast<std::size_t>(static_cast<std::ptrdiff_t>(scaling.multiple))];
+        const std::ptrdiff_t power =
+            scaling.group * (2 * kMaxMultiple + 1) + kMaxMultiple + scaling.multiple;
+        const double growth = scaling.group < 0 ? std::expm1(scaled_[scaling.position])
+                                                : powers_[static_cast<std::size_t>(power)];
         const double z = x[scaling.global];
         scaled_values_[d] = z + growth * z;
         if (failed == scalings_.size() && !std::isfinite(scaled_values_[d])) failed = d;

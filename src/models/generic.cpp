@@ -192,16 +192,17 @@ public:
           energy_(energy), user_(user), x_sigma_(sigma_.size()), g_(sigma_.size()),
           compiled_(compiled), sorted_g_(sigma_.size()) {
         consecutive_ = true;
-        for (std::size_t p = 1; p < sigma_.size(); ++p) consecutive_ = consecutive_ && sigma_[p] == sigma_[p - 1] + 1;
+        for (std::size_t p = 1; p < sigma_.size(); ++p)
+            consecutive_ = consecutive_ && sigma_[p] == sigma_[p - 1] + 1;
         if (!compiled_) {
             exponential_.emplace(constants_.dim(), flow_terms(constants_, sigma_));
             return;
         }
         // A compiled flow takes g in the order of the sorted index set.
         if (std::is_sorted(sigma_.begin(), sigma_.end())) return;
-        for (std::size_t p = 0; p < sigma_.size(); ++p)
-            rank_.push_back(static_cast<std::uint32_t>(
-                std::count_if(sigma_.begin(), sigma_.end(), [&](std::uint32_t j) { return j < sigma_[p]; })));
+        for (std::uint32_t index : sigma_)
+            rank_.push_back(static_cast<std::uint32_t>(std::count_if(
+                sigma_.begin(), sigma_.end(), [&](std::uint32_t j) { return j < index; })));
     }
 
     void flow(double t, double *x) override {
