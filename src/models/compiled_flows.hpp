@@ -210,6 +210,21 @@ struct Piece {
 
     static long flow(const double *g, double t, double *x) {
         constexpr int depth = P.depth;
+        // For exp(tD): E_k = exp(k s) - 1 of each group by powers of
+        // u = expm1(s), as SparseExponential::apply_scalings forms them;
+        // first, so that nothing of x is held across the calls.
+        double growths[P.groups > 0 ? P.groups : 1][2 * kMaxMultiple + 1];
+        unroll<0, P.groups>([&](auto q) {
+            constexpr Group G = P.group[q];
+            double *e = growths[q] + kMaxMultiple;
+            const double u = std::expm1(t * (G.base * g[G.parameter]));
+            e[1] = u;
+            constexpr int powers = G.largest > 1 ? G.largest + 1 : 2;  // k = 2 .. largest
+            unroll<2, powers>([&](auto k) { e[k] = e[k - 1] + u + e[k - 1] * u; });
+            const double w = std::isfinite(u) ? -u / (1.0 + u) : -1.0;
+            e[-1] = w;
+            unroll<2, powers>([&](auto k) { e[-k] = e[1 - k] + w + e[1 - k] * w; });
+        });
         // c[v][k] = ((tN)^k x / k!)_v, written for k <= level(v) and read
         // only there (the general sweep's lanes above are exact zeros).
         double c[Algebra::dim][depth + 1];
@@ -239,20 +254,6 @@ struct Piece {
         double y[Algebra::dim];  // exp(tN) x
         unroll<0, Algebra::dim>([&](auto v) { y[v] = x[v]; });
         unroll<0, P.nodes>([&](auto n) { y[P.order[n]] = c[P.order[n]][0] + increment[P.order[n]]; });
-        // Then exp(tD): E_k = exp(k s) - 1 of each group by powers of
-        // u = expm1(s), as SparseExponential::apply_scalings forms them.
-        double E[P.groups > 0 ? P.groups : 1][2 * kMaxMultiple + 1];
-        unroll<0, P.groups>([&](auto q) {
-            constexpr Group G = P.group[q];
-            double *e = E[q] + kMaxMultiple;
-            const double u = std::expm1(t * (G.base * g[G.parameter]));
-            e[1] = u;
-            constexpr int powers = G.largest > 1 ? G.largest + 1 : 2;  // k = 2 .. largest
-            unroll<2, powers>([&](auto k) { e[k] = e[k - 1] + u + e[k - 1] * u; });
-            const double w = std::isfinite(u) ? -u / (1.0 + u) : -1.0;
-            e[-1] = w;
-            unroll<2, powers>([&](auto k) { e[-k] = e[1 - k] + w + e[1 - k] * w; });
-        });
         double scaled[P.scalings > 0 ? P.scalings : 1];
         unroll<0, P.scalings>([&](auto d) {
             constexpr Scaling S = P.scaling[d];
@@ -260,7 +261,7 @@ struct Piece {
             if constexpr (S.group < 0)
                 growth = std::expm1(t * (S.coefficient * g[S.parameter]));
             else
-                growth = E[S.group][kMaxMultiple + S.multiple];
+                growth = growths[S.group][kMaxMultiple + S.multiple];
             scaled[d] = y[S.index] + growth * y[S.index];
             probe += 0.0 * scaled[d];
         });
