@@ -2,13 +2,14 @@
 // codelets for small sizes: when the structure constants are known when the
 // library is compiled, the plan SparseExponential makes when a piece is added
 // (the pattern of A, the levels of its nilpotent series, the order of the
-// sums) is made by the compiler instead, for every abelian index set whose
-// pattern is nilpotent, and each flow is straight-line code with no tables
-// to read. The arithmetic is SparseExponential's sweep, operation for
+// sums, the diagonal's exponentials) is made by the compiler instead, for
+// every abelian index set whose pattern is nilpotent or a diagonal that
+// commutes with a nilpotent rest, and each flow is straight-line code with
+// no tables to read. The arithmetic is SparseExponential's, operation for
 // operation (each row's fixed columns first, then its moved ones, each in
-// order of column; lanes k = 1..level; the increment summed in order of k),
-// so a compiled flow gives the same bits as the general one
-// (test_compiled_flows checks every index set).
+// order of column; lanes k = 1..level; the increment summed in order of k;
+// the diagonal's exponentials by powers), so a compiled flow gives the same
+// bits as the general one (test_compiled_flows checks every index set).
 //
 // An algebra is a type with `static constexpr int dim` (at most 16) and
 // `static constexpr Bracket brackets[]`: {x_i, x_j} = c x_k for i < j, one
@@ -20,6 +21,8 @@
 #include <cstdint>
 #include <type_traits>
 #include <utility>
+
+#include "expm.hpp"
 
 namespace lpi {
 
@@ -44,8 +47,6 @@ struct Entry {  // A_row,col += coefficient * g_parameter
     double coefficient;
 };
 
-// What SparseExponential's constructor works out for one index set (`mask`:
-// bit j for index j), at compile time.
 struct Scaling {  // a diagonal entry c g_p of index `index`
     int index, parameter;
     double coefficient;
@@ -57,8 +58,10 @@ struct Group {  // diagonal entries k base g_p of one parameter
     double base;
     int largest;  // the largest |k|
 };
-constexpr int kMaxMultiple = 8;  // as SparseExponential's
+constexpr int kMaxMultiple = kMaxScalingMultiple;
 
+// What SparseExponential's constructor works out for one index set (`mask`:
+// bit j for index j), at compile time.
 struct Plan {
     bool usable = false;  // abelian, A not zero, one term a position, and a
                           // nilpotent pattern or a diagonal that commutes
@@ -91,6 +94,7 @@ constexpr Plan plan(unsigned mask) {
     for (int j = 0; j < dim; ++j) {
         if (!(mask >> j & 1u)) continue;
         for (const Bracket &b : Algebra::brackets) {
+            if (count + 2 > kMaxEntries) return P;  // too many to compile: the general plan
             if (b.j == j) raw[count++] = {b.i, b.k, parameter, b.c};
             if (b.i == j) raw[count++] = {b.j, b.k, parameter, -b.c};
         }

@@ -45,6 +45,10 @@ struct SparseTerm {
 
 enum class ExpmPath { Nilpotent, DiagonalSeries, Plane, Pade };
 
+// The largest |k| for which a diagonal entry k c g_p of the DiagonalSeries
+// path takes exp(t k c g_p) - 1 by powers of expm1(t c g_p).
+constexpr int kMaxScalingMultiple = 8;
+
 // LPI_ERR_NONFINITE: the exact flow's increment of `component` is not finite.
 [[noreturn]] void fail_flow_overflow(std::size_t component);
 
@@ -117,7 +121,7 @@ private:
         double base;  // c
         int largest;  // the largest |k|
     };
-    static constexpr int kMaxMultiple = 8;
+    static constexpr int kMaxMultiple = kMaxScalingMultiple;
     struct Term {  // a further term of a position with several
         std::uint32_t position;
         std::uint32_t parameter;
