@@ -9,7 +9,8 @@
 //      models: built-in Hamiltonians, no callback, compensated sums): in a
 //      moments system (the algebra's compiled flows), and in a generic system
 //      given the same structure constants (the general plan, made when the
-//      piece is added);
+//      piece is added); and the squeeze S(x2) (the paper's H2 without x6:
+//      every moment scaled by its weight) vs one exponential and its powers;
 //  (d) the moments' product piece H(x1 x3) (closed form), and what one
 //      leapfrog stage of the scene costs against one RK4 step;
 // then (e) the `moments` scene of `lpi report`: CPU time of the best splitting
