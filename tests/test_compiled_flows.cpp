@@ -50,17 +50,9 @@ bool abelian(unsigned mask) {
 }
 
 lpi_system *moments_generic_twin() {
-    constexpr std::size_t count = sizeof lpi::MomentAlgebra::brackets / sizeof(lpi::Bracket);
-    int32_t i[count], j[count], k[count];
-    double c[count];
-    for (std::size_t e = 0; e < count; ++e) {
-        i[e] = lpi::MomentAlgebra::brackets[e].i;
-        j[e] = lpi::MomentAlgebra::brackets[e].j;
-        k[e] = lpi::MomentAlgebra::brackets[e].k;
-        c[e] = lpi::MomentAlgebra::brackets[e].c;
-    }
+    constexpr lpi::BracketColumns<lpi::MomentAlgebra> b;
     lpi_system *sys = nullptr;
-    EXPECT_OK(NULL, lpi_generic_create(&sys, 8, count, i, j, k, c));
+    EXPECT_OK(NULL, lpi_generic_create(&sys, 8, b.count, b.i, b.j, b.k, b.c));
     return sys;
 }
 

@@ -31,6 +31,22 @@ struct Bracket {
     double c;
 };
 
+// An algebra's brackets as the four arrays lpi_generic_create takes.
+template <class Algebra>
+struct BracketColumns {
+    static constexpr std::size_t count = sizeof Algebra::brackets / sizeof(Bracket);
+    std::int32_t i[count] = {}, j[count] = {}, k[count] = {};
+    double c[count] = {};
+    constexpr BracketColumns() {
+        for (std::size_t e = 0; e < count; ++e) {
+            i[e] = Algebra::brackets[e].i;
+            j[e] = Algebra::brackets[e].j;
+            k[e] = Algebra::brackets[e].k;
+            c[e] = Algebra::brackets[e].c;
+        }
+    }
+};
+
 // x <- exp(t A) x for the piece on the index set of its table entry, A_il =
 // sum_p c_{i sigma_p}^l g_p with g in the order of the sorted index set.
 // Returns -1, or, x untouched, the first component whose increment is not

@@ -204,17 +204,10 @@ CompiledFlow moment_piece_flow(unsigned mask) {
 }
 
 std::unique_ptr<GenericModel> make_moments() {
-    constexpr std::size_t count = sizeof MomentAlgebra::brackets / sizeof MomentAlgebra::brackets[0];
-    std::int32_t i[count], j[count], k[count];
-    double c[count];
-    for (std::size_t e = 0; e < count; ++e) {
-        i[e] = MomentAlgebra::brackets[e].i;
-        j[e] = MomentAlgebra::brackets[e].j;
-        k[e] = MomentAlgebra::brackets[e].k;
-        c[e] = MomentAlgebra::brackets[e].c;
-    }
-    auto model = std::make_unique<GenericModel>(
-        std::make_unique<StructureConstants>(8, count, i, j, k, c), "moments");
+    constexpr BracketColumns<MomentAlgebra> b;
+    auto constants =
+        std::make_unique<StructureConstants>(MomentAlgebra::dim, b.count, b.i, b.j, b.k, b.c);
+    auto model = std::make_unique<GenericModel>(std::move(constants), "moments");
     model->set_compiled_flows(moment_piece_flow);
     model->add_builtin_casimir(casimir_I, "I = x4 x8 - 4 x5 x7 + 3 x6^2");
     model->add_builtin_casimir(casimir_K, "K = det [[x4,x5,x6],[x5,x6,x7],[x6,x7,x8]]");

@@ -33,6 +33,7 @@
 #include "capi/handle.hpp"
 #include "core/model.hpp"
 #include "liepoisson.h"
+#include "models/moments_algebra.hpp"
 
 namespace {
 
@@ -125,13 +126,10 @@ lpi_system *generic_e2() {
 // The moment algebra declared by its structure constants, with the scene's
 // V and T: a generic system, so the general plan (no compiled flows).
 lpi_system *moments_as_generic() {
-    // {x_i, x_j} = c x_k for i < j (0-based), as in the moments system.
-    const int32_t i[] = {0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 2, 2, 2, 2};
-    const int32_t j[] = {1, 2, 4, 5, 6, 7, 2, 3, 4, 6, 7, 3, 4, 5, 6};
-    const int32_t k[] = {0, 1, 3, 4, 5, 6, 2, 3, 4, 6, 7, 4, 5, 6, 7};
-    const double c[] = {2, 4, 2, 4, 6, 8, 2, -4, -2, 2, 4, -8, -6, -4, -2};
+    constexpr lpi::BracketColumns<lpi::MomentAlgebra> b;
     lpi_system *sys = nullptr;
-    check(lpi_generic_create(&sys, 8, 15, i, j, k, c), nullptr, "moment algebra as generic");
+    check(lpi_generic_create(&sys, 8, b.count, b.i, b.j, b.k, b.c), nullptr,
+          "moment algebra as generic");
     const int32_t potential[2] = {0, 3}, kinetic[2] = {2, 7};
     check(lpi_add_piece(sys, 2, potential, quartic_gradient, quartic_energy, nullptr), sys, "V");
     check(lpi_add_piece(sys, 2, kinetic, quartic_gradient, quartic_energy, nullptr), sys, "T");
