@@ -31,22 +31,19 @@ typedef double Complex1 __attribute__((vector_size(16)));
 typedef double Complex2 __attribute__((vector_size(32)));
 #if defined(__clang__)
 #define LPI_SHUFFLE(v, ...) __builtin_shufflevector(v, v, __VA_ARGS__)
+#define LPI_SHUFFLE2(a, b, ...) __builtin_shufflevector(a, b, __VA_ARGS__)
 #else
-typedef std::int64_t Mask1 __attribute__((vector_size(16)));
 typedef std::int64_t Mask2 __attribute__((vector_size(32)));
-template <class V> struct MaskOf;
-template <> struct MaskOf<Complex1> { typedef Mask1 type; };
-template <> struct MaskOf<Complex2> { typedef Mask2 type; };
-#define LPI_SHUFFLE(v, ...) __builtin_shuffle(v, typename MaskOf<decltype(v)>::type{__VA_ARGS__})
+#define LPI_SHUFFLE(v, ...) __builtin_shuffle(v, Mask2{__VA_ARGS__})
+#define LPI_SHUFFLE2(a, b, ...) __builtin_shuffle(a, b, Mask2{__VA_ARGS__})
 #endif
 
 inline Complex2 reversed(Complex2 v) { return LPI_SHUFFLE(v, 2, 3, 0, 1); }
-inline Complex1 swap_parts(Complex1 v) { return LPI_SHUFFLE(v, 1, 0); }
-inline Complex2 swap_parts(Complex2 v) { return LPI_SHUFFLE(v, 1, 0, 3, 2); }
-inline Complex1 real_parts(Complex1 v) { return LPI_SHUFFLE(v, 0, 0); }
-inline Complex2 real_parts(Complex2 v) { return LPI_SHUFFLE(v, 0, 0, 2, 2); }
-inline Complex1 imaginary_parts(Complex1 v) { return LPI_SHUFFLE(v, 1, 1); }
-inline Complex2 imaginary_parts(Complex2 v) { return LPI_SHUFFLE(v, 1, 1, 3, 3); }
+// (a0, b0, a2, b2) and (a1, b1, a3, b3): with a = (z0, z2) and b = (z1, z3)
+// the real and the imaginary parts of z0 .. z3, and back.
+inline Complex2 even_parts(Complex2 a, Complex2 b) { return LPI_SHUFFLE2(a, b, 0, 4, 2, 6); }
+inline Complex2 odd_parts(Complex2 a, Complex2 b) { return LPI_SHUFFLE2(a, b, 1, 5, 3, 7); }
+#undef LPI_SHUFFLE2
 #undef LPI_SHUFFLE
 
 template <class V>
@@ -58,6 +55,14 @@ inline V load(const double *p) {
 template <class V>
 inline void store(double *p, V v) {
     std::memcpy(p, &v, sizeof v);
+}
+// Two complex numbers from (to) two places.
+inline Complex2 load_pair(const double *low, const double *high) {
+    return __builtin_shufflevector(load<Complex1>(low), load<Complex1>(high), 0, 1, 2, 3);
+}
+inline void store_pair(double *low, double *high, Complex2 v) {
+    std::memcpy(low, &v, sizeof(Complex1));
+    std::memcpy(high, reinterpret_cast<const char *>(&v) + sizeof(Complex1), sizeof(Complex1));
 }
 
 // ---- Row and Column directions: runs along lanes --------------------------
@@ -235,46 +240,63 @@ void scatter_block(const Direction &D, int N, int d0, int count, int first_lane,
 // and Q = q / N, each divided once per flow, so that (e - 1) / N =
 // (P + conj(Q)) + P conj(q) needs no division here (dividing, not
 // multiplying by a rounded 1/N, which would scale every increment by the same
-// N fl(1/N) != 1). Two complex numbers at a time, in their interleaved parts:
-// P conj(q) = P (Re q, Re q) + swap(P) (Im q, -Im q), read from the tables
-// as they are, and the product with z = x[l, i] is z (Re e, Re e) + swap(z)
-// (-Im e, Im e). Every sum and product is the one the complex arithmetic
+// N fl(1/N) != 1). Every sum and product is the one the complex arithmetic
 // written out would form, in the same order. P_{l+d} is entry d + l of its
 // arrays, (Q, q)_{l-d} entry N + d - l of theirs: both run forwards along a
-// row of x.
+// row of x, four lines at a time, with the parts of x split into vectors of
+// their own on the way in and joined on the way out.
 namespace {
 
-// x[0 .. n) times the increments, n = 1 or 2 complex numbers (V).
+// Parts of (e - 1) / N for the lines at table entries up and down onward,
+// and their product with z = (zr, zi): n = 1 line (double) or 4 (Complex2).
 template <class V>
-inline void phase_numbers(const double *const arrays[kPhaseArrays], std::size_t up, std::size_t down,
-                          V negate_real, double *x) {
-    const V P = load<V>(arrays[0] + up), P_swapped = load<V>(arrays[1] + up);
-    const V Q_conjugate = load<V>(arrays[2] + down), q_real = load<V>(arrays[3] + down),
-            q_imaginary = load<V>(arrays[4] + down);
-    const V e = (P + Q_conjugate) + (P * q_real + P_swapped * q_imaginary);
-    const V z = load<V>(x);
-    const V product = z * real_parts(e) + swap_parts(z) * (imaginary_parts(e) * negate_real);
-    store(x, product);
+inline void phase_product(const double *const arrays[kPhaseArrays], std::size_t up, std::size_t down,
+                          double sign, V &zr, V &zi) {
+    const V Pr = load<V>(arrays[0] + up), Pi = load<V>(arrays[1] + up);
+    const V Qr = load<V>(arrays[2] + down), Qi = load<V>(arrays[3] + down);
+    const V qr = load<V>(arrays[4] + down), qi = load<V>(arrays[5] + down);
+    const V er = (Pr + Qr) + (Pr * qr + Pi * qi);
+    const V ei = ((Pi - Qi) + (Pi * qr - Pr * qi)) * sign;
+    const V real = zr * er - zi * ei, imaginary = zi * er + zr * ei;
+    zr = real;
+    zi = imaginary;
+}
+
+// Count > 0: the block size, known at compile time (full blocks); 0: count.
+template <int Count>
+inline void phase_rows(int N, int d0, int count, const double *const arrays[kPhaseArrays], double sign,
+                       double *x) {
+    const std::size_t n = Count > 0 ? Count : count, fours = n / 4 * 4;
+    for (std::size_t l = 0; l < static_cast<std::size_t>(N); ++l) {
+        double *z = x + 2 * l * n;
+        const std::size_t up = d0 + l, down = N + d0 - l;
+        for (std::size_t i = 0; i < fours; i += 4) {
+            double *z4 = z + 2 * i;
+            const Complex2 z02 = load_pair(z4, z4 + 4), z13 = load_pair(z4 + 2, z4 + 6);
+            Complex2 zr = even_parts(z02, z13), zi = odd_parts(z02, z13);
+            phase_product(arrays, up + i, down + i, sign, zr, zi);
+            store_pair(z4, z4 + 4, even_parts(zr, zi));
+            store_pair(z4 + 2, z4 + 6, odd_parts(zr, zi));
+        }
+        if (Count > 0 && Count % 4 == 0) continue;
+        for (std::size_t i = fours; i < n; ++i) {
+            double zr = z[2 * i], zi = z[2 * i + 1];
+            phase_product(arrays, up + i, down + i, sign, zr, zi);
+            z[2 * i] = zr;
+            z[2 * i + 1] = zi;
+        }
+    }
 }
 
 }  // namespace
 
 LPI_SIMD_CLONES
 void apply_phase(int N, int d0, int count, const double *tables, double sign, double *x) {
-    const std::size_t array = 4 * static_cast<std::size_t>(N);
-    const double *const arrays[kPhaseArrays] = {tables, tables + array, tables + 2 * array,
-                                                tables + 3 * array, tables + 4 * array};
-    const Complex2 negate_real2 = {-sign, sign, -sign, sign};
-    const Complex1 negate_real1 = {-sign, sign};
-    const std::size_t pairs = static_cast<std::size_t>(count) / 2 * 2;
-    for (std::size_t l = 0; l < static_cast<std::size_t>(N); ++l) {
-        double *z = x + 2 * l * count;
-        const std::size_t up = 2 * (d0 + l), down = 2 * (N + d0 - l);
-        for (std::size_t i = 0; i < pairs; i += 2)
-            phase_numbers(arrays, up + 2 * i, down + 2 * i, negate_real2, z + 2 * i);
-        if (pairs < static_cast<std::size_t>(count))
-            phase_numbers(arrays, up + 2 * pairs, down + 2 * pairs, negate_real1, z + 2 * pairs);
-    }
+    const std::size_t array = 2 * static_cast<std::size_t>(N);
+    const double *const arrays[kPhaseArrays] = {tables,             tables + array,     tables + 2 * array,
+                                                tables + 3 * array, tables + 4 * array, tables + 5 * array};
+    if (count == kBlock) phase_rows<kBlock>(N, d0, count, arrays, sign, x);
+    else phase_rows<0>(N, d0, count, arrays, sign, x);
 }
 
 }  // namespace sine_euler
