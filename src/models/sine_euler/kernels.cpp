@@ -155,20 +155,28 @@ inline void scatter_runs(int N, int slope, int d0, int count, int first_lane,
 }
 
 // ---- General directions: one mode at a time -------------------------------
-// Calls f(x_entry, mode) for element s of line d0 + i, at (d0 + i) j + s k:
-// x_entry = s count + i, mode its index in the mode array.
+// Calls f(x_entry, mode, mirror) for element s of line d0 + i, at (d0 + i) j
+// + s k: x_entry = s count + i, mode and mirror the indices of that mode and
+// of its conjugate in the mode array. Along a row of the block the mode moves
+// by j: its index by j1 N + j2, less N^2 where a wraps and N where b does;
+// the mirror's, -(a, b), is N^2 + N - mode, less N^2 where a = 0 and N where
+// b = 0.
 template <class F>
 inline void for_each_block_mode(const Direction &D, int N, int d0, int count, F &&f) {
+    const std::size_t n = N, square = n * n, stride = D.j1 * n + D.j2;
     int a0 = modulo(static_cast<std::int64_t>(d0) * D.j1, N), b0 = modulo(static_cast<std::int64_t>(d0) * D.j2, N);
     for (int s = 0; s < N; ++s) {
         int a = a0, b = b0;
+        std::size_t mode = mode_index(a, b, N);
         const std::size_t row = static_cast<std::size_t>(s) * count;
         for (int i = 0; i < count; ++i) {
-            f(row + i, a, b);
+            const std::size_t mirror = square + n - mode - (a == 0 ? square : 0) - (b == 0 ? n : 0);
+            f(row + i, mode, mirror);
+            mode += stride;
             a += D.j1;
-            if (a >= N) a -= N;
+            if (a >= N) a -= N, mode -= square;
             b += D.j2;
-            if (b >= N) b -= N;
+            if (b >= N) b -= N, mode -= n;
         }
         a0 += D.k1;
         if (a0 >= N) a0 -= N;
@@ -178,21 +186,16 @@ inline void for_each_block_mode(const Direction &D, int N, int d0, int count, F 
 }
 
 inline void gather_general(const Direction &D, int N, int d0, int count, const double *w, double *x) {
-    for_each_block_mode(D, N, d0, count, [&](std::size_t e, int a, int b) {
-        const double *src = w + 2 * mode_index(a, b, N);
-        x[2 * e] = src[0];
-        x[2 * e + 1] = src[1];
+    for_each_block_mode(D, N, d0, count, [&](std::size_t e, std::size_t mode, std::size_t) {
+        store(x + 2 * e, load<Complex1>(w + 2 * mode));
     });
 }
 
 inline void scatter_general(const Direction &D, int N, int d0, int count, const double *x, double *w) {
-    for_each_block_mode(D, N, d0, count, [&](std::size_t e, int a, int b) {
-        double *dst = w + 2 * mode_index(a, b, N);
-        dst[0] += x[2 * e];
-        dst[1] += x[2 * e + 1];
-        double *mirror = w + 2 * mirror_index(a, b, N);
-        mirror[0] = dst[0];
-        mirror[1] = -dst[1];
+    for_each_block_mode(D, N, d0, count, [&](std::size_t e, std::size_t mode, std::size_t mirror) {
+        const Complex1 sum = load<Complex1>(w + 2 * mode) + load<Complex1>(x + 2 * e);
+        store(w + 2 * mode, sum);
+        store(w + 2 * mirror, sum * Complex1{1.0, -1.0});
     });
 }
 
