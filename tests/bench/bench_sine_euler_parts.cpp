@@ -1,13 +1,15 @@
 // Sine-Euler on one thread: where a flow's time goes. The parts of a flow
 // (SineEuler::flow in model.cpp) timed one by one, on the library's own
-// kernels and plans (FFTW "measure", as in bench_sine_euler): the phase
-// tables (the line spectrum's FFT and two sines per entry), and for each
+// kernels and plans (FFTW "measure", as in bench_sine_euler): the line
+// spectrum (the direction's own line and its FFT: what stays serial when
+// threads share a flow), the phase tables (two sines per entry), and for each
 // block of lines the gather, the forward and backward FFTs, the phase and the
 // scatter. Summed over every direction of the projective line, so that the
 // Row, Column and General layouts weigh as they do in a step; per part the
-// least of three passes. Prints ns per mode moved and the parts beside the
-// FFTs: "rest / FFTs" is about what the step's ratio to the FFT floor of
-// bench_sine_euler exceeds 1 by. Prints figures; asserts nothing.
+// least of three passes. Prints ns per mode moved, the parts beside the FFTs
+// ("rest / FFTs" is about what the step's ratio to the FFT floor of
+// bench_sine_euler exceeds 1 by) and the serial part's share of the flow.
+// Prints figures; asserts nothing.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -25,7 +27,7 @@ namespace {
 using namespace lpi::sine_euler;
 using Clock = std::chrono::steady_clock;
 
-enum Part { Tables, Gather, Transforms, Phase, Scatter, kParts };
+enum Part { Spectrum, Tables, Gather, Transforms, Phase, Scatter, kParts };
 
 double seconds_since(Clock::time_point &start) {
     const Clock::time_point now = Clock::now();
@@ -58,7 +60,7 @@ void measure(int N) {
     int layouts[3] = {0, 0, 0};
     for (const Direction &D : directions) ++layouts[D.layout];
     for (int pass = 0; pass < 3; ++pass) {
-        double sum[kParts] = {0.0, 0.0, 0.0, 0.0, 0.0};
+        double sum[kParts] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
         for (const Direction &D : directions) {
             Clock::time_point clock = Clock::now();
             double *b = T.spectrum();
@@ -69,6 +71,7 @@ void measure(int N) {
                 a = modulo(a + D.k1, N), c = modulo(c + D.k2, N);
             }
             T.transform_spectrum();
+            sum[Spectrum] += seconds_since(clock);
             for (int l = 0; l < N; ++l) write_phase(N, l, factor, T.spectrum(), T.phase());
             sum[Tables] += seconds_since(clock);
             for (int block = 0; block < blocks.count(); ++block) {
@@ -90,11 +93,12 @@ void measure(int N) {
         for (int p = 0; p < kParts; ++p) best[p] = std::min(best[p], sum[p]);
     }
     const double modes = static_cast<double>(directions.size()) * N * blocks.M, ns = 1e9 / modes;
-    const double rest = best[Tables] + best[Gather] + best[Phase] + best[Scatter];
-    std::printf("%5d %5d %5d %5d %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %7.2f %7.2f\n", N, layouts[0],
-                layouts[1], layouts[2], ns * best[Transforms], ns * best[Tables], ns * best[Gather],
-                ns * best[Phase], ns * best[Scatter], ns * rest, rest / best[Transforms],
-                (best[Gather] + best[Scatter]) / best[Transforms]);
+    const double rest = best[Spectrum] + best[Tables] + best[Gather] + best[Phase] + best[Scatter];
+    std::printf("%5d %5d %5d %5d %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %7.2f %7.2f %6.1f%%\n", N,
+                layouts[0], layouts[1], layouts[2], ns * best[Transforms], ns * best[Spectrum],
+                ns * best[Tables], ns * best[Gather], ns * best[Phase], ns * best[Scatter], ns * rest,
+                rest / best[Transforms], (best[Gather] + best[Scatter]) / best[Transforms],
+                100.0 * best[Spectrum] / (rest + best[Transforms]));
     std::fflush(stdout);
 }
 
@@ -102,10 +106,10 @@ void measure(int N) {
 
 int main() {
     std::printf("sine-Euler, one thread: a flow's parts in ns per mode moved, summed over every direction\n");
-    std::printf("%5s %5s %5s %5s %8s %8s %8s %8s %8s %8s %7s %7s\n", "N", "rows", "cols", "other", "FFTs",
-                "tables", "gather", "phase", "scatter", "rest", "rest/", "moves/");
-    std::printf("%5s %5s %5s %5s %8s %8s %8s %8s %8s %8s %7s %7s\n", "", "", "", "", "", "", "", "", "", "",
-                "FFTs", "FFTs");
+    std::printf("%5s %5s %5s %5s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s\n", "N", "rows", "cols", "other",
+                "FFTs", "spectrum", "sines", "gather", "phase", "scatter", "rest", "rest/", "moves/", "serial");
+    std::printf("%5s %5s %5s %5s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s\n", "", "", "", "", "", "", "", "", "",
+                "", "", "FFTs", "FFTs", "");
     const int Ns[] = {61, 125, 127, 243, 251, 375, 509, 625};
     for (int N : Ns) measure(N);
     return 0;
