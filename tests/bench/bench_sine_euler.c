@@ -8,9 +8,16 @@
  * rest of the step (gather, phase, scatter, the serial part: (step - floor)
  * 1T over 2T), and the peak memory at N = 1021. Two-thread figures mean
  * something only on an otherwise idle machine: the bench prints the load
- * average it started under. Prints figures; asserts nothing. */
+ * average it started under, and the machine's own ceiling: what two threads
+ * each doing one thread's work gain over one (2 on two free cores; near 1
+ * for arithmetic at full throughput where the two CPUs are one core's two
+ * hardware threads, as a virtual machine's may be, at some times and not
+ * others), once for three kinds of work and then, for full-throughput
+ * arithmetic, beside each N just before its two-thread figures. Prints
+ * figures; asserts nothing. */
 #include <liepoisson.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,6 +27,81 @@
 #include <unistd.h>
 #define BENCH_NAME "bench_sine_euler"
 #include "bench_common.h"
+
+/* ---- the machine's two-thread ceiling ---------------------------------- */
+
+/* One thread's work, three kinds: multiply-adds in twelve independent scalar
+ * chains (each waits on its last result: latency-bound), the same in 24
+ * chains of vectors of two (as many as the floating-point units take at
+ * once: throughput-bound, as FFTs and the phase are), and sums over a 256 KiB
+ * buffer (the modes at N = 125), read again and again. The compiler is not
+ * told the numbers, so that it cannot fold the loops. */
+typedef double Pair __attribute__((vector_size(16)));
+enum { kChains = 12, kPairChains = 24, kBufferDoubles = 32768 };
+enum WorkKind { Dependent, Throughput, Reading, kWorkKinds };
+typedef struct {
+    enum WorkKind kind;
+    const double *buffer;
+} Work;
+static volatile double work_sink; /* the results, kept so that the work is done */
+
+static void *run_work(void *argument) {
+    const Work *work = argument;
+    const double *b = work->buffer, factor = 1.0 - b[1], term = b[1];
+    double sum = 0.0;
+    if (work->kind == Dependent) {
+        double a[kChains];
+        for (int i = 0; i < kChains; ++i) a[i] = 1.0 + b[i];
+        for (long k = 0; k < 4000000; ++k)
+            for (int i = 0; i < kChains; ++i) a[i] = a[i] * factor + term;
+        for (int i = 0; i < kChains; ++i) sum += a[i];
+    } else if (work->kind == Throughput) {
+        Pair a[kPairChains];
+        const Pair f = {factor, factor}, t = {term, term};
+        for (int i = 0; i < kPairChains; ++i) a[i] = (Pair){1.0 + b[i], 1.0 + b[i + 1]};
+        for (long k = 0; k < 2000000; ++k)
+            for (int i = 0; i < kPairChains; ++i) a[i] = a[i] * f + t;
+        for (int i = 0; i < kPairChains; ++i) sum += a[i][0] + a[i][1];
+    } else {
+        double a[4] = {0.0, 0.0, 0.0, 0.0};
+        for (int pass = 0; pass < 400; ++pass)
+            for (int i = 0; i < kBufferDoubles; i += 4)
+                for (int j = 0; j < 4; ++j) a[j] += b[i + j];
+        sum = a[0] + a[1] + a[2] + a[3];
+    }
+    work_sink = sum;
+    return NULL;
+}
+
+/* Seconds for `threads` threads each doing one thread's work at once, each
+ * on its own buffer (best of five). */
+static double time_work(int threads, enum WorkKind kind, double *buffers[2]) {
+    double best = INFINITY;
+    for (int pass = 0; pass < 5; ++pass) {
+        Work work[2] = {{kind, buffers[0]}, {kind, buffers[1]}};
+        pthread_t other;
+        const double t0 = now();
+        if (threads == 2 && pthread_create(&other, NULL, run_work, &work[1]) != 0) return NAN;
+        run_work(&work[0]);
+        if (threads == 2) pthread_join(other, NULL);
+        const double t = now() - t0;
+        if (t < best) best = t;
+    }
+    return best;
+}
+
+/* The gain of two threads over one on each kind of work (gain[kind]). */
+static void measure_ceiling(double gain[kWorkKinds]) {
+    double *buffers[2] = {malloc(kBufferDoubles * sizeof(double)), malloc(kBufferDoubles * sizeof(double))};
+    if (!buffers[0] || !buffers[1]) exit(1);
+    for (int i = 0; i < kBufferDoubles; ++i) buffers[0][i] = buffers[1][i] = 1e-9 * i;
+    for (int kind = 0; kind < kWorkKinds; ++kind)
+        gain[kind] = 2 * time_work(1, kind, buffers) / time_work(2, kind, buffers);
+    free(buffers[0]);
+    free(buffers[1]);
+}
+
+/* ---- sine-Euler --------------------------------------------------------- */
 
 static lpi_system *make(int N) {
     lpi_system *sys = NULL;
@@ -79,8 +161,15 @@ int main(void) {
     getloadavg(load, 3);
     printf("sine-Euler, leapfrog (time per step; floor = FFTW alone, same plans and transforms;"
            " load average %.2f at start)\n", load[0]);
-    printf("%5s %10s %12s %12s %7s %12s %12s %9s %8s %6s %6s\n", "N", "FFTs/step", "step 1T",
-           "floor 1T", "ratio", "step 2T", "floor 2T", "speed-up", "serial", "FFTs", "rest");
+    double gain[kWorkKinds];
+    measure_ceiling(gain);
+    printf("this machine now: two threads each doing one thread's work gain %.2fx (dependent arithmetic),"
+           " %.2fx (arithmetic at full throughput), %.2fx (reading 256 KiB) over one; 2 on two free"
+           " cores, near 1 for full-throughput arithmetic where the two CPUs share one core. The"
+           " \"ceiling\" column measures the full-throughput gain again beside each N.\n",
+           gain[Dependent], gain[Throughput], gain[Reading]);
+    printf("%5s %10s %12s %12s %7s %12s %12s %9s %8s %6s %6s %8s\n", "N", "FFTs/step", "step 1T",
+           "floor 1T", "ratio", "step 2T", "floor 2T", "speed-up", "serial", "FFTs", "rest", "ceiling");
     /* Prime and composite N: FFTW is 2-3x faster at 125, 243, 375, 625. */
     const int Ns[] = {31, 61, 125, 127, 243, 251, 375, 509, 625};
     for (size_t i = 0; i < sizeof Ns / sizeof Ns[0]; ++i) {
@@ -91,13 +180,15 @@ int main(void) {
         const double floor1 = time_floor(sys, step1, budget, &transforms);
         double step2 = NAN, floor2 = NAN;
         if (lpi_set_threads(sys, 2) == LPI_OK) {
+            measure_ceiling(gain);
             step2 = time_steps(sys, budget);
             floor2 = time_floor(sys, step2, budget, &transforms);
         }
         const double speed_up = step1 / step2;
-        printf("%5d %10.0f %10.3f ms %9.3f ms %7.2f %9.3f ms %9.3f ms %9.2f %7.1f%% %6.2f %6.2f\n",
+        printf("%5d %10.0f %10.3f ms %9.3f ms %7.2f %9.3f ms %9.3f ms %9.2f %7.1f%% %6.2f %6.2f %8.2f\n",
                N, transforms, 1e3 * step1, 1e3 * floor1, step1 / floor1, 1e3 * step2, 1e3 * floor2,
-               speed_up, 100 * (2 / speed_up - 1), floor1 / floor2, (step1 - floor1) / (step2 - floor2));
+               speed_up, 100 * (2 / speed_up - 1), floor1 / floor2, (step1 - floor1) / (step2 - floor2),
+               gain[Throughput]);
         fflush(stdout);
         lpi_destroy(sys);
     }
