@@ -36,8 +36,8 @@ double seconds_since(Clock::time_point &start) {
     return seconds;
 }
 
-// A smooth Hermitian field of unit size in the low modes (the benchmark
-// field of bench_sine_euler, by mode).
+// A smooth field in a few low modes, Hermitian to the bit (each mode and its
+// mirror real and equal), of unit size.
 std::vector<double> field(int N) {
     std::vector<double> w(2 * static_cast<std::size_t>(N) * N, 0.0);
     const int modes[][2] = {{1, 2}, {1, -2}, {3, -1}, {5, 4}};
