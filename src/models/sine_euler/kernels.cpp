@@ -57,9 +57,15 @@ template <class V>
 inline void store(double *p, const V &v) {
     std::memcpy(p, &v, sizeof v);
 }
-// Two complex numbers from (to) two places.
+// Two complex numbers from (to) two places. GCC before 12 has no
+// __builtin_shufflevector; built element by element the pair is the same.
 inline Complex2 load_pair(const double *low, const double *high) {
-    return __builtin_shufflevector(load<Complex1>(low), load<Complex1>(high), 0, 1, 2, 3);
+    const Complex1 a = load<Complex1>(low), b = load<Complex1>(high);
+#if defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 12)
+    return __builtin_shufflevector(a, b, 0, 1, 2, 3);
+#else
+    return Complex2{a[0], a[1], b[0], b[1]};
+#endif
 }
 inline void store_pair(double *low, double *high, const Complex2 &v) {
     std::memcpy(low, &v, sizeof(Complex1));
