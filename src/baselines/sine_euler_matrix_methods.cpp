@@ -133,7 +133,7 @@ protected:
     // One step of size dt on W_ (s: its index within the run).
     virtual void step(double dt, std::int64_t s) = 0;
 
-    bool run(const Model &model, double *state, double dt, std::int64_t n) {
+    bool run_in_matrix_form(const Model &model, double *state, double dt, std::int64_t n) {
         hamiltonian_.emplace(static_cast<const SineEulerModel &>(model).hamiltonian());
         const double w0[2] = {state[0], state[1]};
         form_.to_matrix(state, W_.data());
@@ -169,7 +169,7 @@ public:
     explicit RungeKutta4Matrix(int N) : MatrixIntegrator(N), stages_(size_) {}
 
     bool advance(Model &model, double *state, double dt, std::int64_t n) override {
-        return run(model, state, dt, n);
+        return run_in_matrix_form(model, state, dt, n);
     }
     std::size_t evaluations_per_step() const override { return 4; }
 
@@ -205,7 +205,7 @@ public:
 
     bool advance(Model &model, double *state, double dt, std::int64_t n) override {
         iterations_ = 0;
-        const bool ok = run(model, state, dt, n);
+        const bool ok = run_in_matrix_form(model, state, dt, n);
         average_iterations_ = static_cast<double>(iterations_) / static_cast<double>(n);
         return ok;
     }
