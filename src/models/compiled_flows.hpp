@@ -231,19 +231,12 @@ struct Piece {
     static long flow(const double *g, double t, double *x) {
         constexpr int depth = P.depth;
         // For exp(tD): E_k = exp(k s) - 1 of each group by powers of
-        // u = expm1(s), as SparseExponential::apply_scalings forms them;
-        // first, so that nothing of x is held across the calls.
+        // u = expm1(s) (expm1_powers, shared with SparseExponential); first,
+        // so that nothing of x is held across the calls.
         double growths[P.groups > 0 ? P.groups : 1][2 * kMaxMultiple + 1];
         unroll<0, P.groups>([&](auto q) {
             constexpr Group G = P.group[q];
-            double *e = growths[q] + kMaxMultiple;
-            const double u = std::expm1(t * (G.base * g[G.parameter]));
-            e[1] = u;
-            constexpr int powers = G.largest > 1 ? G.largest + 1 : 2;  // k = 2 .. largest
-            unroll<2, powers>([&](auto k) { e[k] = e[k - 1] + u + e[k - 1] * u; });
-            const double w = std::isfinite(u) ? -u / (1.0 + u) : -1.0;
-            e[-1] = w;
-            unroll<2, powers>([&](auto k) { e[-k] = e[1 - k] + w + e[1 - k] * w; });
+            expm1_powers(std::expm1(t * (G.base * g[G.parameter])), G.largest, growths[q] + kMaxMultiple);
         });
         // c[v][k] = ((tN)^k x / k!)_v, written for k <= level(v) and read
         // only there (the general sweep's lanes above are exact zeros).

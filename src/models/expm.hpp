@@ -11,6 +11,7 @@
 //    block of indices the nonzeros touch.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -48,6 +49,19 @@ enum class ExpmPath { Nilpotent, DiagonalSeries, Plane, Pade };
 // The largest |k| for which a diagonal entry k c g_p of the DiagonalSeries
 // path takes exp(t k c g_p) - 1 by powers of expm1(t c g_p).
 constexpr int kMaxScalingMultiple = 8;
+
+// E[k] = exp(k s) - 1 for k = +-1 .. +-largest (E points at k = 0) from
+// u = expm1(s), by E_{k+1} = E_k + u + E_k u and, with w = E_-1 = -u / (1 + u),
+// E_{-k-1} = E_{-k} + w + E_{-k} w: no cancellation (w = -1 where exp(s)
+// overflows: exp(-s) is then below the smallest double). The DiagonalSeries
+// path and the compiled flows share it, so that they give the same bits.
+inline void expm1_powers(double u, int largest, double *E) {
+    E[1] = u;
+    for (int k = 2; k <= largest; ++k) E[k] = E[k - 1] + u + E[k - 1] * u;
+    const double w = std::isfinite(u) ? -u / (1.0 + u) : -1.0;
+    E[-1] = w;
+    for (int k = 2; k <= largest; ++k) E[-k] = E[1 - k] + w + E[1 - k] * w;
+}
 
 // LPI_ERR_NONFINITE: the exact flow's increment of `component` is not finite.
 [[noreturn]] void fail_flow_overflow(std::size_t component);

@@ -362,19 +362,11 @@ bool SparseExponential::sweep(double *x) {
 // expm1 for each run of equal diagonal terms. When a result is not finite,
 // x goes back to what it was before the series too.
 void SparseExponential::apply_scalings(const double *g, double t, double *x) {
-    // Group by group: E_k = exp(k s) - 1 for s = t (base g_p), from u = E_1
-    // and w = E_-1 = -u / (1 + u) by E_{k+1} = E_k + u + E_k u and
-    // E_{-k-1} = E_{-k} + w + E_{-k} w, without cancellation (w = -1 where
-    // exp(s) overflows: exp(-s) is then below the smallest double).
+    // Group by group: E_k = exp(k s) - 1 for s = t (base g_p).
     for (std::size_t q = 0; q < power_groups_.size(); ++q) {
         const PowerGroup &group = power_groups_[q];
         double *E = powers_.data() + q * (2 * kMaxMultiple + 1) + kMaxMultiple;
-        const double u = std::expm1(t * (group.base * g[group.parameter]));
-        E[1] = u;
-        for (int k = 2; k <= group.largest; ++k) E[k] = E[k - 1] + u + E[k - 1] * u;
-        const double w = std::isfinite(u) ? -u / (1.0 + u) : -1.0;
-        E[-1] = w;
-        for (int k = 2; k <= group.largest; ++k) E[-k] = E[1 - k] + w + E[1 - k] * w;
+        expm1_powers(std::expm1(t * (group.base * g[group.parameter])), group.largest, E);
     }
     std::size_t failed = scalings_.size();
     for (std::size_t d = 0; d < scalings_.size(); ++d) {
