@@ -53,6 +53,7 @@ void measure(int N) {
     const std::vector<Direction> directions = projective_line(N);
     const LineBlocks blocks(N);
     LineTransforms T(N, blocks.M, lpi::FftPlanning::Measure);
+    const Hamiltonian H(N);  // Euler's
     std::vector<double> w = field(N);
     const double factor = 1e-3 / (2.0 * (2.0 * std::acos(-1.0) / N));  // t = 1e-3
     double best[kParts];
@@ -63,13 +64,7 @@ void measure(int N) {
         double sum[kParts] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
         for (const Direction &D : directions) {
             Clock::time_point clock = Clock::now();
-            double *b = T.spectrum();
-            for (int s = 0, a = 0, c = 0; s < N; ++s) {
-                const double lambda = Hamiltonian::euler_weight(a, c, N);
-                b[2 * s] = lambda * w[2 * mode_index(a, c, N)];
-                b[2 * s + 1] = lambda * w[2 * mode_index(a, c, N) + 1];
-                a = modulo(a + D.k1, N), c = modulo(c + D.k2, N);
-            }
+            line_stream(D, H, w.data(), T.spectrum());
             T.transform_spectrum();
             sum[Spectrum] += seconds_since(clock);
             for (int l = 0; l < N; ++l) write_phase(N, l, factor, T.spectrum(), T.phase());

@@ -175,33 +175,10 @@ LineTransforms &SineEuler::transforms() {
     return *transforms_;
 }
 
-// b_s = lambda_sk w_sk + f_sk on the owned modes, B = FFT(b) (real).
-// Returns false when every b_s is zero.
+// B = FFT(b) of D's line stream b (line_stream; real). Returns false when
+// every b_s is zero.
 bool SineEuler::line_spectrum(const Direction &D, const double *w) {
-    const int N = N_;
-    double *b = transforms_->spectrum();
-    const double *lambda = hamiltonian_.weights(), *f = hamiltonian_.forcing();
-    int a = 0, c = 0;
-    bool active = false;
-    for (int s = 0; s < N; ++s) {
-        if (D.owned[s]) {
-            const std::size_t m = mode_index(a, c, N);
-            b[2 * s] = w[2 * m] * lambda[m];
-            b[2 * s + 1] = w[2 * m + 1] * lambda[m];
-            if (f) {
-                b[2 * s] += f[2 * m];
-                b[2 * s + 1] += f[2 * m + 1];
-            }
-            active = active || b[2 * s] != 0.0 || b[2 * s + 1] != 0.0;
-        } else {
-            b[2 * s] = b[2 * s + 1] = 0.0;
-        }
-        a += D.k1;
-        if (a >= N) a -= N;
-        c += D.k2;
-        if (c >= N) c -= N;
-    }
-    if (!active) return false;
+    if (!line_stream(D, hamiltonian_, w, transforms_->spectrum())) return false;
     transforms_->transform_spectrum();
     return true;
 }

@@ -147,5 +147,31 @@ double piece_energy(const Direction &D, const Hamiltonian &H, const double *mode
     return sum;
 }
 
+bool line_stream(const Direction &D, const Hamiltonian &H, const double *modes, double *b) {
+    const int N = H.truncation();
+    const double *lambda = H.weights(), *f = H.forcing();
+    int a = 0, c = 0;
+    bool active = false;
+    for (int s = 0; s < N; ++s) {
+        if (D.owned[s]) {
+            const std::size_t m = mode_index(a, c, N);
+            b[2 * s] = modes[2 * m] * lambda[m];
+            b[2 * s + 1] = modes[2 * m + 1] * lambda[m];
+            if (f) {
+                b[2 * s] += f[2 * m];
+                b[2 * s + 1] += f[2 * m + 1];
+            }
+            active = active || b[2 * s] != 0.0 || b[2 * s + 1] != 0.0;
+        } else {
+            b[2 * s] = b[2 * s + 1] = 0.0;
+        }
+        a += D.k1;
+        if (a >= N) a -= N;
+        c += D.k2;
+        if (c >= N) c -= N;
+    }
+    return active;
+}
+
 }  // namespace sine_euler
 }  // namespace lpi

@@ -54,6 +54,11 @@ std::vector<int> prime_factors(int N);
 // The energy of piece D: the terms of H of the modes it owns.
 double piece_energy(const Direction &D, const Hamiltonian &H, const double *modes);
 
+// The stream function on piece D's own line, b_s = lambda_sk w_sk + f_sk for
+// the modes D owns and 0 elsewhere (N complex, interleaved), the input of
+// the line spectrum. Returns false when every b_s is zero.
+bool line_stream(const Direction &D, const Hamiltonian &H, const double *modes, double *b);
+
 // Lines d = 1 .. M of a direction, in blocks of kBlock. The block size is
 // fixed (not derived from the thread count), so each block meets the same
 // transform whichever thread runs it: results are identical to the bit for
