@@ -356,8 +356,8 @@ void piece_flows() {
     check(lpi_rigid_body_create(&body, 1.0, 2.0, 3.0), nullptr, "rigid body");
     check(lpi_set_split(body, "axes"), body, "split");
     const std::vector<double> m0 = {1.0, 0.5, -0.3};
-    report_pair("(a) so(3) axis rotations", kBefore.so3, in_turn(model_of(so3), {0, 1, 2}), model_of(so3),
-                in_turn(model_of(body), {0, 1, 2}), model_of(body), m0, 0.1, 3);
+    report_pair("(a) so(3) axis rotations", kBefore.so3, in_turn(model_of(so3), {0, 1, 2}),
+                model_of(so3), in_turn(model_of(body), {0, 1, 2}), model_of(body), m0, 0.1, 3);
 
     lpi_system *e2 = generic_e2(), *pendulum = nullptr;
     check(lpi_pendulum_create(&pendulum), nullptr, "pendulum");
