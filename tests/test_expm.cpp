@@ -496,6 +496,72 @@ void test_shear(void **) {
     assert_true(z[1] == y[1] && z[4] == y[4]);
 }
 
+// A component the flow contracts keeps its relative accuracy, however far:
+// the eigencomponents of a hyperbolic plane, a contracting trace, a decaying
+// 1x1 block and the scalings of the DiagonalSeries path, each against its
+// closed form in long double, component by component (a normwise error
+// would let the small components go). Exponents are exact in double, so
+// the reference is exact too.
+void expect_components(const std::vector<double> &y, const std::vector<long double> &exact,
+                       const char *what, double s) {
+    double worst = 0.0;
+    for (std::size_t i = 0; i < y.size(); ++i)
+        worst = std::max(worst, static_cast<double>(std::fabs(y[i] - exact[i]) / std::fabs(exact[i])));
+    std::printf("%s, s = %g: worst component rel. error %.2e\n", what, s, worst);
+    assert_true(worst < 8 * 2.2e-16);
+}
+
+void test_contracted_components_keep_relative_accuracy(void **) {
+    for (const double s : {0.5, 1.0, 4.0, 10.0, 30.0}) {
+        const long double grow = std::exp(static_cast<long double>(s)), shrink = 1.0L / grow;
+        // diag(-s, s) and [[0, s], [s, 0]] on its two eigenvectors (1, -1), (1, 1).
+        const std::vector<lpi::SparseTerm> diagonal = {{0, 0, 0, -1.0}, {1, 1, 0, 1.0}};
+        const std::vector<lpi::SparseTerm> boost = {{0, 1, 0, 1.0}, {1, 0, 0, 1.0}};
+        lpi::SparseExponential scaling(2, diagonal), hyperbolic(2, boost);
+        assert_int_equal(static_cast<int>(scaling.path()), static_cast<int>(lpi::ExpmPath::Plane));
+        std::vector<double> y = {0.7, -1.3};
+        scaling.apply(&s, 1.0, y.data());
+        expect_components(y, {0.7L * shrink, -1.3L * grow}, "plane diag(-s, s)", s);
+        y = {1.5, -1.5};
+        hyperbolic.apply(&s, 1.0, y.data());
+        expect_components(y, {1.5L * shrink, -1.5L * shrink}, "plane [[0, s], [s, 0]], contracted", s);
+        y = {1.5, 1.5};
+        hyperbolic.apply(&s, 1.0, y.data());
+        expect_components(y, {1.5L * grow, 1.5L * grow}, "plane [[0, s], [s, 0]], grown", s);
+        // A rotation by 1 contracted by e^-s: [[-s, 1], [-1, -s]].
+        const std::vector<lpi::SparseTerm> spiral = {
+            {0, 0, 0, -1.0}, {1, 1, 0, -1.0}, {0, 1, 1, 1.0}, {1, 0, 1, -1.0}};
+        lpi::SparseExponential inward(2, spiral);
+        const double g[2] = {s, 1.0};
+        y = {0.8, 0.3};
+        inward.apply(g, 1.0, y.data());
+        const long double c = std::cos(1.0L), sn = std::sin(1.0L);
+        expect_components(y, {shrink * (c * 0.8L + sn * 0.3L), shrink * (c * 0.3L - sn * 0.8L)},
+                          "plane e^-s rotation", s);
+        // A decaying 1x1 block.
+        const std::vector<lpi::SparseTerm> loop = {{0, 0, 0, -2.0}};
+        lpi::SparseExponential decay(1, loop);
+        y = {3.0};
+        decay.apply(&s, 1.0, y.data());
+        expect_components(y, {3.0L * shrink * shrink}, "1x1 e^-2s", s);
+        // DiagonalSeries: weights -4, -1, 2, 3 of s (one group, by powers).
+        const std::vector<lpi::SparseTerm> weights = {
+            {0, 0, 0, -4.0}, {1, 1, 0, -1.0}, {2, 2, 0, 2.0}, {3, 3, 0, 3.0}};
+        lpi::SparseExponential series(4, weights);
+        assert_int_equal(static_cast<int>(series.path()),
+                         static_cast<int>(lpi::ExpmPath::DiagonalSeries));
+        const double t = 0.25, h = 4.0 * s;  // t h = s exactly
+        y = {1.1, -0.6, 0.9, 2.5};
+        if (s <= 10.0) {  // e^{3 s} overflows nothing; e^{-4 s} is far below 1
+            series.apply(&h, t, y.data());
+            expect_components(y,
+                              {1.1L * std::pow(shrink, 4), -0.6L * shrink, 0.9L * grow * grow,
+                               2.5L * grow * grow * grow},
+                              "diagonal series weights -4 .. 3", s);
+        }
+    }
+}
+
 // The size of an n x n matrix is counted without wrapping: a dimension whose
 // bytes overflow a size_t is refused (LPI_ERR_NO_MEMORY), not allocated small.
 void test_square_entries_refuse_overflow(void **) {
@@ -528,6 +594,7 @@ int main() {
         cmocka_unit_test(test_refusals_leave_x_unchanged),
         cmocka_unit_test(test_shear),
         cmocka_unit_test(test_diagonal_series),
+        cmocka_unit_test(test_contracted_components_keep_relative_accuracy),
         cmocka_unit_test(test_deep_series_and_summed_terms),
         cmocka_unit_test(test_square_entries_refuse_overflow),
     };

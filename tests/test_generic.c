@@ -356,6 +356,41 @@ static void test_callback_failures_roll_back(void **state) {
     lpi_destroy(sys);
 }
 
+/* sl(2) (x_e, x_f, x_h; {h,e} = 2e, {h,f} = -2f, {e,f} = h) with the piece
+ * H = x_h^2 / 2: x_e -> x_e e^-s, x_f -> x_f e^s with s = 2 x_h t, whose
+ * closed form is the plane path's hyperbolic case. However far one flow
+ * contracts x_e, it keeps its relative accuracy and the Casimir
+ * x_h^2 + 4 x_e x_f stays at round-off (cosh - sinh lost e^2s of it). */
+static void test_hyperbolic_piece_keeps_contracted_components(void **state) {
+    (void)state;
+    const int32_t i[] = {2, 2, 0}, j[] = {0, 1, 1}, k[] = {0, 1, 2};
+    const double c[] = {2, -2, 1};
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_generic_create(&sys, 3, 3, i, j, k, c), LPI_OK);
+    const int32_t h = 2;
+    assert_int_equal(lpi_add_piece(sys, 1, &h, half_square_grad, half_square_energy, NULL), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
+    for (double s = 0.5; s <= 32.0; s *= 2) {
+        const double x0[3] = {0.3, -0.7, 1.25}, dt = s / (2 * 1.25); /* 2 x_h dt = s exactly */
+        double x[3];
+        assert_int_equal(lpi_set_state(sys, x0, 3), LPI_OK);
+        assert_int_equal(lpi_step(sys, dt, 1), LPI_OK);
+        assert_int_equal(lpi_get_state(sys, x, 3), LPI_OK);
+        const long double e = 0.3L * expl(-(long double)s), f = -0.7L * expl((long double)s);
+        const double casimir0 = 1.25 * 1.25 + 4 * 0.3 * -0.7;
+        const long double casimir = (long double)x[2] * x[2] + 4.0L * x[0] * x[1];
+        const double error_e = (double)(fabsl(x[0] - e) / fabsl(e));
+        const double error_f = (double)(fabsl(x[1] - f) / fabsl(f));
+        const double drift = (double)(fabsl(casimir - casimir0) / fabs(casimir0));
+        printf("sl(2), H = x_h^2/2, s = %g: rel. error x_e %.1e, x_f %.1e; Casimir %.1e\n", s, error_e,
+               error_f, drift);
+        assert_true(error_e < 4 * 2.2e-16 && error_f < 4 * 2.2e-16);
+        assert_true(x[2] == x0[2]);
+        assert_true(drift < 8 * 2.2e-16);
+    }
+    lpi_destroy(sys);
+}
+
 static void test_no_pieces(void **state) {
     (void)state;
     lpi_system *sys = NULL;
@@ -384,6 +419,7 @@ int main(void) {
         cmocka_unit_test(test_add_piece_errors),
         cmocka_unit_test(test_callback_failures_roll_back),
         cmocka_unit_test(test_no_pieces),
+        cmocka_unit_test(test_hyperbolic_piece_keeps_contracted_components),
     };
     return lpi_run_tests(tests);
 }

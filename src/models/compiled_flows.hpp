@@ -270,12 +270,16 @@ struct Piece {
         double scaled[P.scalings > 0 ? P.scalings : 1];
         unroll<0, P.scalings>([&](auto d) {
             constexpr Scaling S = P.scaling[d];
-            double growth;
-            if constexpr (S.group < 0)
-                growth = std::expm1(t * (S.coefficient * g[S.parameter]));
-            else
+            double growth, exponent;
+            if constexpr (S.group < 0) {
+                exponent = t * (S.coefficient * g[S.parameter]);
+                growth = std::expm1(exponent);
+            } else {
+                constexpr Group G = P.group[S.group];
+                exponent = S.multiple * (t * (G.base * g[G.parameter]));
                 growth = growths[S.group][kMaxMultiple + S.multiple];
-            scaled[d] = y[S.index] + growth * y[S.index];
+            }
+            scaled[d] = scaled_by_exponential(y[S.index], growth, exponent);
             probe += 0.0 * scaled[d];
         });
         if (probe != probe) {

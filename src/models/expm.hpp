@@ -63,6 +63,15 @@ inline void expm1_powers(double u, int largest, double *E) {
     for (int k = 2; k <= largest; ++k) E[-k] = E[1 - k] + w + E[1 - k] * w;
 }
 
+// z exp(a), given growth = exp(a) - 1: z + growth z, rounding z once (no
+// bias near the identity), except where exp(a) contracts z by more than half.
+// There growth is close to -1 and z + growth z would keep only the accuracy of
+// z itself, a relative error e^-a times the round-off, so z is scaled by
+// exp(a) instead. The DiagonalSeries path and the compiled flows share it.
+inline double scaled_by_exponential(double z, double growth, double a) {
+    return growth < -0.5 ? z * std::exp(a) : z + growth * z;
+}
+
 // LPI_ERR_NONFINITE: the exact flow's increment of `component` is not finite.
 [[noreturn]] void fail_flow_overflow(std::size_t component);
 

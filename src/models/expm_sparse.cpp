@@ -54,6 +54,37 @@ void plane_expm1(double a, double b, double c, double d, double W[4]) {
     W[3] = scale * (c_minus_1 - sp) + scale_minus_1;
 }
 
+// exp(A) x of a 2x2 A = [[a, b], [c, d]] with real eigenvalues lambda+- =
+// tau +- r (delta = r^2 > 0), as e^lambda+ P+ x + e^lambda- P- x with the
+// spectral projectors P+- = (I +- N / r) / 2 (N = A - tau I), written so that
+// nothing cancels: for p = (a - d) / 2 >= 0 the diagonal of P+ is ((r + p) /
+// 2r, bc / (2r (r + p))) (as (r - p) / 2r = (r^2 - p^2) / (2r (r + p))), that
+// of P- the same swapped, and for p < 0 the roles swap. Each eigencomponent
+// is scaled by its own exponential, so the component the flow contracts keeps
+// its relative accuracy; formed from cosh r - sinh r it would lose a factor
+// e^2r. For r well away from 0 only: the projectors grow like 1 / r.
+void plane_hyperbolic_apply(double a, double b, double c, double d, double &x0, double &x1) {
+    const double tau = 0.5 * (a + d), p = 0.5 * (a - d);
+    const double r = std::sqrt(p * p + b * c), q = std::fabs(p);
+    const double high = (r + q) / (2.0 * r), low = b * c / (2.0 * r * (r + q));
+    const double up_b = b / (2.0 * r), up_c = c / (2.0 * r);
+    const double plus00 = p >= 0.0 ? high : low, plus11 = p >= 0.0 ? low : high;
+    // P+ x and P- x = (I - P+) x, each formed from x directly.
+    const double u0 = plus00 * x0 + up_b * x1, u1 = up_c * x0 + plus11 * x1;
+    const double v0 = plus11 * x0 - up_b * x1, v1 = plus00 * x1 - up_c * x0;
+    const double grow = std::exp(tau + r), shrink = std::exp(tau - r);
+    x0 = grow * u0 + shrink * v0;
+    x1 = grow * u1 + shrink * v1;
+}
+
+// The increment form x + (exp(A) - I) x rounds x once, which keeps the
+// Casimirs free of bias near the identity; but where exp(A) contracts a
+// component by e^-s it leaves that component only the accuracy of x itself,
+// a relative error e^s times the round-off. Beyond ln 2 (a contraction by
+// more than half, or eigenvalues that far apart) the plane path applies
+// exp(A) itself.
+constexpr double kIncrementFormLimit = 0.6931471805599453;
+
 }  // namespace
 
 // ---- sparse exponentials of a fixed pattern -----------------------------------
@@ -359,7 +390,7 @@ bool SparseExponential::sweep(double *x) {
 }
 
 // x_i <- exp(d_i) x_i = x_i + expm1(d_i) x_i after the series of N, one
-// expm1 for each run of equal diagonal terms. When a result is not finite,
+// expm1 for each run of equal diagonal terms (scaled_by_exponential). When a result is not finite,
 // x goes back to what it was before the series too.
 void SparseExponential::apply_scalings(const double *g, double t, double *x) {
     // Group by group: E_k = exp(k s) - 1 for s = t (base g_p).
@@ -371,12 +402,17 @@ void SparseExponential::apply_scalings(const double *g, double t, double *x) {
     std::size_t failed = scalings_.size();
     for (std::size_t d = 0; d < scalings_.size(); ++d) {
         const Scaling &scaling = scalings_[d];
-        const std::ptrdiff_t power =
-            scaling.group * (2 * kMaxMultiple + 1) + kMaxMultiple + scaling.multiple;
-        const double growth = scaling.group < 0 ? std::expm1(scaled_[scaling.position])
-                                                : powers_[static_cast<std::size_t>(power)];
-        const double z = x[scaling.global];
-        scaled_values_[d] = z + growth * z;
+        double growth, exponent;
+        if (scaling.group < 0) {
+            exponent = scaled_[scaling.position];
+            growth = std::expm1(exponent);
+        } else {
+            const PowerGroup &group = power_groups_[static_cast<std::size_t>(scaling.group)];
+            exponent = scaling.multiple * (t * (group.base * g[group.parameter]));
+            growth = powers_[static_cast<std::size_t>(scaling.group * (2 * kMaxMultiple + 1) +
+                                                      kMaxMultiple + scaling.multiple)];
+        }
+        scaled_values_[d] = scaled_by_exponential(x[scaling.global], growth, exponent);
         if (failed == scalings_.size() && !std::isfinite(scaled_values_[d])) failed = d;
     }
     if (failed < scalings_.size()) {
@@ -392,6 +428,29 @@ void SparseExponential::apply_plane(double t, double *x) {
     check_norm(std::max(std::fabs(A[0]) + std::fabs(A[2]), std::fabs(A[1]) + std::fabs(A[3])), t);
     const bool pair = moved_.size() == 2;
     const double x0 = x[moved_[0]], x1 = pair ? x[moved_[1]] : 0.0;
+    const double tau = pair ? 0.5 * (A[0] + A[3]) : A[0], p = 0.5 * (A[0] - A[3]);
+    const double delta = p * p + A[1] * A[2];
+    const bool apart = pair && delta > 0.0 && std::sqrt(delta) > kIncrementFormLimit;
+    if (apart || tau < -kIncrementFormLimit) {
+        double y0 = x0, y1 = x1;
+        if (apart) {
+            plane_hyperbolic_apply(A[0], A[1], A[2], A[3], y0, y1);
+        } else if (pair) {  // e^tau (C x + S N x), C and S as plane_expm1 forms them
+            double W[4];
+            plane_expm1(A[0] - tau, A[1], A[2], A[3] - tau, W);  // traceless: C - 1 +- S p, S b, S c
+            const double scale = std::exp(tau);
+            y0 = scale * ((x0 + W[0] * x0) + W[1] * x1);
+            y1 = scale * (W[2] * x0 + (x1 + W[3] * x1));
+        } else {
+            y0 = std::exp(tau) * x0;
+        }
+        increment_[0] = y0 - x0;  // only to name a non-finite component
+        if (pair) increment_[1] = y1 - x1;
+        if (!std::isfinite(y0) || !std::isfinite(y1)) fail_nonfinite();
+        x[moved_[0]] = y0;
+        if (pair) x[moved_[1]] = y1;
+        return;
+    }
     double W[4] = {0.0, 0.0, 0.0, 0.0};
     if (pair)
         plane_expm1(A[0], A[1], A[2], A[3], W);
