@@ -255,6 +255,51 @@ static void test_product_piece_closed_form(void **state) {
     check_product_flow(degenerate, 1.0);          /* x2^2 = x1 x3 */
 }
 
+/* Far from the identity (lambda t from 0.7 to 15 in one flow, a physical
+ * state: x2^2 < x1 x3) the product piece's flow keeps x1 = b e^{lambda t} and
+ * x3 = a e^{-lambda t} to their relative accuracy (the exponent itself is
+ * rounded: |lambda t| ulps) and I, K at round-off (the increment form lost
+ * e^{2 lambda t} of <p^4>: 2e-13 of K at lambda t = 3.7), and agrees with RK4
+ * where RK4 is cheap. */
+static void test_product_piece_far_from_identity(void **state) {
+    (void)state;
+    const double x0[8] = {1.3, 0.4, 0.9, 2.1, 0.5, 1.1, 0.3, 1.7};
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_moments_create(&sys), LPI_OK);
+    assert_int_equal(lpi_moments_add_product_piece(sys, product_h, product_dh, NULL), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
+    const double u = x0[0] * x0[2];
+    const long double lambda = 4.0L * x0[1] * (0.02L + 0.02L * u);
+    const double times[] = {10, 30, 60, 120, 216};
+    for (int n = 0; n < 5; ++n) {
+        const double t = times[n];
+        double x[8], c0[2], c1[2];
+        assert_int_equal(lpi_set_state(sys, x0, 8), LPI_OK);
+        assert_int_equal(lpi_step(sys, t, 1), LPI_OK);
+        assert_int_equal(lpi_get_state(sys, x, 8), LPI_OK);
+        casimirs_of(x0, c0);
+        casimirs_of(x, c1);
+        const long double x1 = x0[0] * expl(lambda * t), x3 = x0[2] * expl(-lambda * t);
+        const double error = fmax((double)(fabsl(x[0] - x1) / x1), (double)(fabsl(x[2] - x3) / x3));
+        const double drift = fmax(fabs(c1[0] - c0[0]) / fabs(c0[0]), fabs(c1[1] - c0[1]) / fabs(c0[1]));
+        printf("product piece, lambda t = %.2f: x1, x3 rel. error %.1e; I, K %.1e\n", (double)(lambda * t),
+               error, drift);
+        assert_true(error < (8 + 4 * (double)(lambda * t)) * 2.2e-16);
+        assert_true(x[1] == x0[1]);
+        assert_true(drift < 32 * 2.2e-16);
+        if (t == 30) {
+            double reference[8], scale = 0;
+            memcpy(reference, x0, sizeof reference);
+            lpi_test_rk4(product_field, NULL, 8, reference, t, 20000);
+            for (int i = 0; i < 8; ++i) scale = fmax(scale, fabs(reference[i]));
+            const double err = lpi_test_distance(x, reference, 8) / scale;
+            printf("product piece, lambda t = %.2f: closed form vs RK4 %.1e\n", (double)(lambda * t), err);
+            assert_true(err < 1e-11);
+        }
+    }
+    lpi_destroy(sys);
+}
+
 /* The squeeze S = x2 (<qp>) scales every moment <q^a p^b> by e^{(a-b) t}
  * (the compiled flow's exponentials by powers): however far one flow
  * contracts a moment, it keeps its relative accuracy, and I, K stay at
@@ -408,6 +453,7 @@ int main(void) {
         cmocka_unit_test(test_orders_against_rk4),
         cmocka_unit_test(test_product_piece_closed_form),
         cmocka_unit_test(test_squeeze_keeps_contracted_moments),
+        cmocka_unit_test(test_product_piece_far_from_identity),
         cmocka_unit_test(test_separable_case),
         cmocka_unit_test(test_product_piece_errors),
     };
