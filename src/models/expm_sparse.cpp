@@ -80,9 +80,9 @@ void plane_hyperbolic_apply(double a, double b, double c, double d, double &x0, 
 // The increment form x + (exp(A) - I) x rounds x once, which keeps the
 // Casimirs free of bias near the identity; but where exp(A) contracts a
 // component by e^-s it leaves that component only the accuracy of x itself,
-// a relative error e^s times the round-off. Beyond ln 2 (a contraction by
-// more than half, or eigenvalues that far apart) the plane path applies
-// exp(A) itself.
+// a relative error e^s times the round-off. Beyond ln 2 (a trace that
+// contracts by more than half, or real eigenvalues tau +- r with r beyond
+// it) the plane path applies exp(A) itself.
 constexpr double kIncrementFormLimit = 0.6931471805599453;
 
 }  // namespace
@@ -390,8 +390,9 @@ bool SparseExponential::sweep(double *x) {
 }
 
 // x_i <- exp(d_i) x_i = x_i + expm1(d_i) x_i after the series of N, one
-// expm1 for each run of equal diagonal terms (scaled_by_exponential). When a result is not finite,
-// x goes back to what it was before the series too.
+// expm1 for each run of equal diagonal terms (scaled_by_exponential: the
+// exponential itself where it contracts by more than half). When a result is
+// not finite, x goes back to what it was before the series too.
 void SparseExponential::apply_scalings(const double *g, double t, double *x) {
     // Group by group: E_k = exp(k s) - 1 for s = t (base g_p).
     for (std::size_t q = 0; q < power_groups_.size(); ++q) {
