@@ -498,7 +498,8 @@ void test_shear(void **) {
 
 // A component the flow contracts keeps its relative accuracy, however far:
 // the eigencomponents of a hyperbolic plane, a contracting trace, a decaying
-// 1x1 block and the scalings of the DiagonalSeries path, each against its
+// 1x1 block, the scalings of the DiagonalSeries path and a contracted index
+// of the Pade path that nothing grown feeds, each against its
 // closed form in long double, component by component (a normwise error
 // would let the small components go). Exponents are exact in double, so
 // the reference is exact too.
@@ -550,6 +551,18 @@ void test_contracted_components_keep_relative_accuracy(void **) {
         lpi::SparseExponential series(4, weights);
         assert_int_equal(static_cast<int>(series.path()),
                          static_cast<int>(lpi::ExpmPath::DiagonalSeries));
+        // Pade: a contracted index that feeds a growing one,
+        // [[-s, 0, 0], [1, s, 0], [0, 1, 0]], keeps the relative accuracy of
+        // its exponential (|s| ulps: Pade's own backward error).
+        const std::vector<lpi::SparseTerm> triangular = {
+            {0, 0, 0, -1.0}, {1, 1, 0, 1.0}, {1, 0, 1, 1.0}, {2, 1, 1, 1.0}};
+        lpi::SparseExponential pade(3, triangular);
+        assert_int_equal(static_cast<int>(pade.path()), static_cast<int>(lpi::ExpmPath::Pade));
+        y = {0.7, 0.2, -0.4};
+        pade.apply(g, 1.0, y.data());
+        const double fed = static_cast<double>(std::fabs(y[0] - 0.7L * shrink) / (0.7L * shrink));
+        std::printf("Pade, contracted index feeding a growing one, s = %g: rel. error %.2e\n", s, fed);
+        assert_true(fed < (8 + 2 * s) * 2.2e-16);
         const double t = 0.25, h = 4.0 * s;  // t h = s exactly
         y = {1.1, -0.6, 0.9, 2.5};
         if (s <= 10.0) {  // e^{3 s} overflows nothing; e^{-4 s} is far below 1

@@ -180,9 +180,13 @@ bool pade_terms(std::size_t n, const double *A, PadeScratch &s, int &squarings) 
 }  // namespace
 
 void expm_dense(std::size_t n, const double *A, double *E) {
+    std::vector<double> buffer;
+    expm_dense(n, A, E, buffer);
+}
+
+void expm_dense(std::size_t n, const double *A, double *E, std::vector<double> &buffer) {
     if (n == 0) return;
     const std::size_t nn = n * n;
-    std::vector<double> buffer;
     PadeScratch s(n, buffer);
     int squarings = 0;
     if (!pade_terms(n, A, s, squarings)) {

@@ -26,6 +26,8 @@ std::size_t square_entries(std::size_t n, const char *what);
 // Dense exponential E = exp(A), both n x n row-major. Accurate to round-off
 // relative to the conditioning of exp at A (Higham 2005).
 void expm_dense(std::size_t n, const double *A, double *E);
+// The same with its scratch kept in `scratch`.
+void expm_dense(std::size_t n, const double *A, double *E, std::vector<double> &scratch);
 // W = exp(A) - I, computed without cancellation: accurate relative to ||A||
 // when exp(A) is close to I (what the increment form of a flow needs).
 void expm1_dense(std::size_t n, const double *A, double *W);
@@ -186,7 +188,7 @@ private:
     std::vector<double> powers_;  // per group: exp(k s) - 1, k = -kMaxMultiple .. kMaxMultiple
     std::vector<double> scaled_values_;
     std::vector<BlockEntry> block_;  // per position, block paths
-    std::vector<double> scaled_, increment_, dense_, exp_, pade_scratch_;
+    std::vector<double> scaled_, increment_, dense_, exp_, direct_, pade_scratch_;
 };
 
 }  // namespace lpi

@@ -473,17 +473,31 @@ void SparseExponential::apply_pade(double t, double *x) {
     exp_.resize(dense_.size());
     expm1_dense(m, dense_.data(), exp_.data(), pade_scratch_);
     // x += (exp(tA) - I) x: the increment carries its own small rounding
-    // errors, and x is rounded once (as on the other paths). x is left
-    // untouched when the exact flow is not representable.
+    // errors, and x is rounded once (as on the other paths). A row whose
+    // diagonal contracts by more than half (exp - 1 below -1/2) takes exp(tA)
+    // itself instead, as the scalings do: x + increment would keep of a
+    // contracted component only the accuracy of x (scaling and squaring
+    // keeps a triangular block's diagonal to its relative accuracy). x is
+    // left untouched when the exact flow is not representable.
+    bool contracted = false;
+    for (std::size_t r = 0; r < m; ++r) contracted |= exp_[r * m + r] < -0.5;
+    if (contracted) {
+        direct_.resize(dense_.size());
+        expm_dense(m, dense_.data(), direct_.data(), pade_scratch_);
+    }
+    scaled_values_.resize(m);
     bool finite = true;
     for (std::size_t r = 0; r < m; ++r) {
+        const bool direct = exp_[r * m + r] < -0.5;
+        const double *row = (direct ? direct_.data() : exp_.data()) + r * m;
         double s = 0.0;
-        for (std::size_t c = 0; c < m; ++c) s += exp_[r * m + c] * x[moved_[c]];
-        increment_[r] = s;
+        for (std::size_t c = 0; c < m; ++c) s += row[c] * x[moved_[c]];
+        increment_[r] = s;  // only to name a non-finite component
+        scaled_values_[r] = direct ? s : x[moved_[r]] + s;
         finite &= std::isfinite(s);
     }
     if (!finite) fail_nonfinite();
-    for (std::size_t r = 0; r < m; ++r) x[moved_[r]] += increment_[r];
+    for (std::size_t r = 0; r < m; ++r) x[moved_[r]] = scaled_values_[r];
 }
 
 }  // namespace lpi
