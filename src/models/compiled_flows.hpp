@@ -228,7 +228,26 @@ struct Piece {
         return -1;
     }
 
+    // Near the identity (every scaling exponent below 1/2 in size, where no
+    // growth can fall below -1/2) the flow takes z + growth z throughout;
+    // otherwise a second instantiation, out of the first one's way, asks
+    // scaled_by_exponential for each scaling. Both give the general plan's
+    // bits.
     static long flow(const double *g, double t, double *x) {
+        bool far = false;
+        unroll<0, P.groups>([&](auto q) {
+            constexpr Group G = P.group[q];
+            far |= may_contract_by_half(G.largest * (t * (G.base * g[G.parameter])));
+        });
+        unroll<0, P.scalings>([&](auto d) {
+            constexpr Scaling S = P.scaling[d];
+            if constexpr (S.group < 0) far |= may_contract_by_half(t * (S.coefficient * g[S.parameter]));
+        });
+        return far ? flow_in<true>(g, t, x) : flow_in<false>(g, t, x);
+    }
+
+    template <bool Far>
+    static long flow_in(const double *g, double t, double *x) {
         constexpr int depth = P.depth;
         // For exp(tD): E_k = exp(k s) - 1 of each group by powers of
         // u = expm1(s) (expm1_powers, shared with SparseExponential); first,
@@ -279,7 +298,10 @@ struct Piece {
                 exponent = S.multiple * (t * (G.base * g[G.parameter]));
                 growth = growths[S.group][kMaxMultiple + S.multiple];
             }
-            scaled[d] = scaled_by_exponential(y[S.index], growth, exponent);
+            if constexpr (Far)
+                scaled[d] = scaled_by_exponential(y[S.index], growth, exponent);
+            else
+                scaled[d] = y[S.index] + growth * y[S.index];
             probe += 0.0 * scaled[d];
         });
         if (probe != probe) {

@@ -73,6 +73,10 @@ inline void expm1_powers(double u, int largest, double *E) {
 inline double scaled_by_exponential(double z, double growth, double a) {
     return growth < -0.5 ? z * std::exp(a) : z + growth * z;
 }
+// Whether exp(a) - 1 may fall below -1/2: not for |a| <= 1/2, where it is at
+// least e^-1/2 - 1 > -0.4 however it is rounded, so a flow whose exponents
+// are all that small takes z + growth z without asking, with the same bits.
+inline bool may_contract_by_half(double a) { return std::fabs(a) > 0.5; }
 
 // LPI_ERR_NONFINITE: the exact flow's increment of `component` is not finite.
 [[noreturn]] void fail_flow_overflow(std::size_t component);
