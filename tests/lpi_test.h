@@ -144,6 +144,18 @@ static inline int lpi_test_axis_energy(size_t n, const double *x, double *h, voi
     return 0;
 }
 
+/* A piece H = x_sigma[0] on one index (grad 1): the pendulum's kick, the moments' squeeze. */
+static inline int lpi_test_linear_gradient(size_t n, const double *x, double *g, void *user) {
+    (void)n; (void)x; (void)user;
+    g[0] = 1.0;
+    return 0;
+}
+static inline int lpi_test_linear_energy(size_t n, const double *x, double *h, void *user) {
+    (void)n; (void)user;
+    *h = x[0];
+    return 0;
+}
+
 /* Sine-Euler mode indices: the representative of a mod N in -M..M, and a mod N. */
 static inline int lpi_test_centred(int a, int N) { return a > N / 2 ? a - N : a; }
 static inline int lpi_test_mod(int a, int N) { return ((a % N) + N) % N; }

@@ -13,16 +13,6 @@ static const double kE2C[] = {-1, 1};
 
 static const double kInertia[3] = {1.0, 2.0, 3.0};
 
-static int linear_grad(size_t n, const double *x, double *g, void *user) {
-    (void)n; (void)x; (void)user;
-    g[0] = 1.0;
-    return 0;
-}
-static int linear_energy(size_t n, const double *x, double *h, void *user) {
-    (void)n; (void)user;
-    *h = x[0];
-    return 0;
-}
 static int half_square_grad(size_t n, const double *x, double *g, void *user) {
     (void)n; (void)user;
     g[0] = x[0];
@@ -54,7 +44,8 @@ static lpi_system *generic_pendulum(void) {
     lpi_system *sys = NULL;
     const int32_t x2 = 1, x3 = 2;
     assert_int_equal(lpi_generic_create(&sys, 3, 2, kE2I, kE2J, kE2K, kE2C), LPI_OK);
-    assert_int_equal(lpi_add_piece(sys, 1, &x2, linear_grad, linear_energy, NULL), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 1, &x2, lpi_test_linear_gradient, lpi_test_linear_energy, NULL),
+                     LPI_OK);
     assert_int_equal(lpi_add_piece(sys, 1, &x3, half_square_grad, half_square_energy, NULL), LPI_OK);
     return sys;
 }

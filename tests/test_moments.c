@@ -304,23 +304,13 @@ static void test_product_piece_far_from_identity(void **state) {
  * (the compiled flow's exponentials by powers): however far one flow
  * contracts a moment, it keeps its relative accuracy, and I, K stay at
  * round-off (the increment form lost e^{4t} of <p^4>). */
-static int squeeze_grad(size_t n, const double *x, double *g, void *u) {
-    (void)n; (void)x; (void)u;
-    g[0] = 1.0;
-    return 0;
-}
-static int squeeze_energy(size_t n, const double *x, double *h, void *u) {
-    (void)n; (void)u;
-    *h = x[0];
-    return 0;
-}
-
 static void test_squeeze_keeps_contracted_moments(void **state) {
     (void)state;
     lpi_system *sys = NULL;
     assert_int_equal(lpi_moments_create(&sys), LPI_OK);
     const int32_t x2 = 1;
-    assert_int_equal(lpi_add_piece(sys, 1, &x2, squeeze_grad, squeeze_energy, NULL), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 1, &x2, lpi_test_linear_gradient, lpi_test_linear_energy, NULL),
+                     LPI_OK);
     assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
     /* <q^2>, <qp>, <p^2>, <q^4>, <q^3 p>, <q^2 p^2>, <q p^3>, <p^4>: a - b. */
     const int weight[8] = {2, 0, -2, 4, 2, 0, -2, -4};

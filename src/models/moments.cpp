@@ -60,21 +60,30 @@ int casimir_K(std::size_t, const double *x, double *out, void *) {
     return 0;
 }
 
-// Powers 0..4 of the entries of a plane map F = I + D = [[a, b], [c, d]],
-// and a^n - 1, d^n - 1 from a^n - 1 = (a - 1)(1 + a + ... + a^(n-1)).
+// Powers 0..4 of the entries of a plane map F = [[a, b], [c, d]], given as
+// F = I + D (with a^n - 1, d^n - 1 from a^n - 1 = (a - 1)(1 + a + ... +
+// a^(n-1))) or, far from the identity, as F itself (no differences).
 struct PlanePowers {
     double a[5], b[5], c[5], d[5], a_minus_1[5], d_minus_1[5];
     explicit PlanePowers(const double D[2][2]) {
-        const double fa = 1.0 + D[0][0], fb = D[0][1], fc = D[1][0], fd = 1.0 + D[1][1];
-        a[0] = b[0] = c[0] = d[0] = 1.0;
+        fill(1.0 + D[0][0], D[0][1], D[1][0], 1.0 + D[1][1]);
         a_minus_1[0] = d_minus_1[0] = 0.0;
+        for (int n = 1; n < 5; ++n) {
+            a_minus_1[n] = a_minus_1[n - 1] * a[1] + D[0][0];
+            d_minus_1[n] = d_minus_1[n - 1] * d[1] + D[1][1];
+        }
+    }
+    static PlanePowers of_map(const double F[2][2]) { return PlanePowers(F[0][0], F[0][1], F[1][0], F[1][1]); }
+
+private:
+    PlanePowers(double fa, double fb, double fc, double fd) { fill(fa, fb, fc, fd); }
+    void fill(double fa, double fb, double fc, double fd) {
+        a[0] = b[0] = c[0] = d[0] = 1.0;
         for (int n = 1; n < 5; ++n) {
             a[n] = a[n - 1] * fa;
             b[n] = b[n - 1] * fb;
             c[n] = c[n - 1] * fc;
             d[n] = d[n - 1] * fd;
-            a_minus_1[n] = a_minus_1[n - 1] * fa + D[0][0];
-            d_minus_1[n] = d_minus_1[n - 1] * fd + D[1][1];
         }
     }
 };
@@ -82,52 +91,55 @@ struct PlanePowers {
 constexpr double kBinomial[5][5] = {
     {1, 0, 0, 0, 0}, {1, 1, 0, 0, 0}, {1, 2, 1, 0, 0}, {1, 3, 3, 1, 0}, {1, 4, 6, 4, 1}};
 
-// Row R of Sym^4(F) - I applied to the fourth moments y = (<q^4>, <q^3 p>,
-// ..., <p^4>): the coefficients on q^(4-k) p^k of (a q + b p)^(4-R)
-// (c q + d p)^R, less the identity. Every coefficient is a sum of products
-// with a factor b or c, except the one term a^(4-R) d^R of the diagonal,
-// which enters as a^(4-R) d^R - 1: the increment is accurate relative to
-// itself. (A template: the loops have fixed bounds and unroll.)
-template <int R>
-double fourth_power_increment(const PlanePowers &p, const double *y) {
+// The coefficients of row R of Sym^4(F) on the fourth moments y = (<q^4>,
+// <q^3 p>, ..., <p^4>): those on q^(4-k) p^k of (a q + b p)^(4-R) (c q +
+// d p)^R, without the one term a^(4-R) d^R of the diagonal when Increment
+// (the caller adds it as a difference from 1). (Templates: the loops have
+// fixed bounds and unroll.)
+template <int R, bool Increment>
+void fourth_power_row(const PlanePowers &p, double row[5]) {
     constexpr int N = 4 - R;
-    double row[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
     // (a q + b p)^N: C(N, j) a^(N-j) b^j on q^(N-j) p^j; (c q + d p)^R:
     // C(R, i) c^(R-i) d^i on q^(R-i) p^i.
     for (int j = 0; j <= N; ++j) {
         const double first = kBinomial[N][j] * p.a[N - j] * p.b[j];
         for (int i = 0; i <= R; ++i)
-            if (j > 0 || i < R) row[j + i] += first * kBinomial[R][i] * p.c[R - i] * p.d[i];
+            if (!Increment || j > 0 || i < R) row[j + i] += first * kBinomial[R][i] * p.c[R - i] * p.d[i];
     }
+}
+
+// Row R of Sym^4(F) - I applied to y. Every coefficient is a sum of products
+// with a factor b or c, except the diagonal's a^(4-R) d^R, which enters as
+// a^(4-R) d^R - 1: the increment is accurate relative to itself.
+template <int R>
+double fourth_power_increment(const PlanePowers &p, const double *y) {
+    constexpr int N = 4 - R;
+    double row[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+    fourth_power_row<R, true>(p, row);
     row[R] += p.a_minus_1[N] + p.d_minus_1[R] + p.a_minus_1[N] * p.d_minus_1[R];
     double sum = 0.0;
     for (int k = 0; k < 5; ++k) sum += row[k] * y[k];
     return sum;
 }
 
-// y <- Sym^4(F) y for a plane map F given itself, each coefficient a product
-// of F's entries: for a flow far from the identity, where the increment form
-// (F - I, a^n - 1) would round a contracted moment away.
+// Row R of Sym^4(F) applied to y, F given itself: for a flow far from the
+// identity, where the increment form (F - I, a^n - 1) would round a
+// contracted moment away.
+template <int R>
+double fourth_power_of_map(const PlanePowers &p, const double *y) {
+    double row[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+    fourth_power_row<R, false>(p, row);
+    double sum = 0.0;
+    for (int k = 0; k < 5; ++k) sum += row[k] * y[k];
+    return sum;
+}
+
+// y <- Sym^4(F) y, F given itself.
 void apply_fourth_power_of_map(const double F[2][2], double *y) {
-    double a[5], b[5], c[5], d[5];
-    a[0] = b[0] = c[0] = d[0] = 1.0;
-    for (int n = 1; n < 5; ++n) {
-        a[n] = a[n - 1] * F[0][0];
-        b[n] = b[n - 1] * F[0][1];
-        c[n] = c[n - 1] * F[1][0];
-        d[n] = d[n - 1] * F[1][1];
-    }
-    double result[5];
-    for (int R = 0; R < 5; ++R) {
-        const int N = 4 - R;
-        double row[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
-        for (int j = 0; j <= N; ++j)
-            for (int i = 0; i <= R; ++i)
-                row[j + i] += kBinomial[N][j] * a[N - j] * b[j] * kBinomial[R][i] * c[R - i] * d[i];
-        double sum = 0.0;
-        for (int k = 0; k < 5; ++k) sum += row[k] * y[k];
-        result[R] = sum;
-    }
+    const PlanePowers powers = PlanePowers::of_map(F);
+    const double result[5] = {fourth_power_of_map<0>(powers, y), fourth_power_of_map<1>(powers, y),
+                              fourth_power_of_map<2>(powers, y), fourth_power_of_map<3>(powers, y),
+                              fourth_power_of_map<4>(powers, y)};
     std::copy(result, result + 5, y);
 }
 
