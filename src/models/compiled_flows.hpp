@@ -250,12 +250,12 @@ struct Piece {
     static long flow_in(const double *g, double t, double *x) {
         constexpr int depth = P.depth;
         // For exp(tD): E_k = exp(k s) - 1 of each group by powers of
-        // u = expm1(s) (expm1_powers, shared with SparseExponential); first,
+        // expm1(+-s) (expm1_powers, shared with SparseExponential); first,
         // so that nothing of x is held across the calls.
         double growths[P.groups > 0 ? P.groups : 1][2 * kMaxMultiple + 1];
         unroll<0, P.groups>([&](auto q) {
             constexpr Group G = P.group[q];
-            expm1_powers(std::expm1(t * (G.base * g[G.parameter])), G.largest, growths[q] + kMaxMultiple);
+            expm1_powers(t * (G.base * g[G.parameter]), G.largest, growths[q] + kMaxMultiple);
         });
         // c[v][k] = ((tN)^k x / k!)_v, written for k <= level(v) and read
         // only there (the general sweep's lanes above are exact zeros).

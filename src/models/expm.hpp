@@ -49,20 +49,37 @@ struct SparseTerm {
 enum class ExpmPath { Nilpotent, DiagonalSeries, Plane, Pade };
 
 // The largest |k| for which a diagonal entry k c g_p of the DiagonalSeries
-// path takes exp(t k c g_p) - 1 by powers of expm1(t c g_p).
+// path takes exp(t k c g_p) - 1 by powers of expm1(+-t c g_p).
 constexpr int kMaxScalingMultiple = 8;
 
-// E[k] = exp(k s) - 1 for k = +-1 .. +-largest (E points at k = 0) from
-// u = expm1(s), by E_{k+1} = E_k + u + E_k u and, with w = E_-1 = -u / (1 + u),
-// E_{-k-1} = E_{-k} + w + E_{-k} w: no cancellation (w = -1 where exp(s)
-// overflows: exp(-s) is then below the smallest double). The DiagonalSeries
-// path and the compiled flows share it, so that they give the same bits.
-inline void expm1_powers(double u, int largest, double *E) {
-    E[1] = u;
-    for (int k = 2; k <= largest; ++k) E[k] = E[k - 1] + u + E[k - 1] * u;
-    const double w = std::isfinite(u) ? -u / (1.0 + u) : -1.0;
-    E[-1] = w;
-    for (int k = 2; k <= largest; ++k) E[-k] = E[1 - k] + w + E[1 - k] * w;
+// E[k] = exp(k s) - 1 for k = +-1 .. +-largest (E points at k = 0), by
+// E_{k+1} = E_k + v + E_k v from v = E_1 = expm1(s) on one side and
+// E_{-k-1} = E_{-k} + w + E_{-k} w from w = E_-1 on the other. The growing
+// side must come from expm1 itself: for s < -ln 2, w = -v / (1 + v) would
+// take 1 + v = e^s by cancellation and leave every growing entry a relative
+// error e^|s| times the round-off, so there w = expm1(-s) and v follows from
+// it. For s >= -ln 2, w = -v / (1 + v) with 1 + v >= 1/2. Where one side
+// overflows, the other is -1 (its exponentials are below the smallest
+// double): those entries only contract, and scaled_by_exponential takes them
+// from exp itself. The DiagonalSeries path and the compiled flows share it,
+// so that they give the same bits.
+inline void expm1_powers(double s, int largest, double *E) {
+    // One side, E[side * k], from its base E[side] by the recurrence.
+    auto side_powers = [largest, E](int side, double base) {
+        E[side] = base;
+        for (int k = 2; k <= largest; ++k)
+            E[side * k] = E[side * (k - 1)] + base + E[side * (k - 1)] * base;
+    };
+    auto other_side = [](double v) { return std::isfinite(v) ? -v / (1.0 + v) : -1.0; };
+    if (s >= -0.6931471805599453) {
+        const double v = std::expm1(s);
+        side_powers(1, v);
+        side_powers(-1, other_side(v));
+    } else {
+        const double w = std::expm1(-s);
+        side_powers(-1, w);
+        side_powers(1, other_side(w));
+    }
 }
 
 // z exp(a), given growth = exp(a) - 1: z + growth z, rounding z once (no

@@ -398,7 +398,7 @@ void SparseExponential::apply_scalings(const double *g, double t, double *x) {
     for (std::size_t q = 0; q < power_groups_.size(); ++q) {
         const PowerGroup &group = power_groups_[q];
         double *E = powers_.data() + q * (2 * kMaxMultiple + 1) + kMaxMultiple;
-        expm1_powers(std::expm1(t * (group.base * g[group.parameter])), group.largest, E);
+        expm1_powers(t * (group.base * g[group.parameter]), group.largest, E);
     }
     std::size_t failed = scalings_.size();
     for (std::size_t d = 0; d < scalings_.size(); ++d) {
