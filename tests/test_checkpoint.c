@@ -639,6 +639,35 @@ static void test_sine_euler_payloads(void **state) {
     assert_crafted_refused(&c, LPI_ERR_FORMAT, "invalid sine-euler parameters");
     c.params = &fractional;
     assert_crafted_refused(&c, LPI_ERR_FORMAT, "not an integer");
+
+    /* N, lambda (N^2) and f (2 N^2): twice Euler's weights, f = 0, load and
+     * save back to the same bytes; parameters the library would store in
+     * another form are refused, so that every accepted checkpoint does. */
+    double params[1 + 9 + 18] = {3.0};
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+            const int ra = a > 1 ? a - 3 : a, rb = b > 1 ? b - 3 : b;
+            params[1 + 3 * a + b] = a == 0 && b == 0 ? 0.0 : 2.0 / (ra * ra + rb * rb);
+        }
+    c.params = params;
+    c.n_params = 28;
+    c.n_state = c.state_values = 18;
+    c.state = modes;
+    buf = craft(&c, &size);
+    sys = load(buf, size);
+    again = save(sys, &again_size);
+    assert_int_equal(again_size, size);
+    assert_memory_equal(again, buf, size);
+    free(again), free(buf);
+    lpi_destroy(sys);
+    params[1] = 5.0; /* lambda_0, which the library stores as 0 */
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "parameter 1 is not in the form");
+    params[1] = 0.0;
+    params[1 + 1] *= 1.0 + 1e-13; /* lambda_(0,1) != lambda_(0,2): stored as their mean */
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "parameter 2 is not in the form");
+    params[1 + 1] = 2.0;
+    for (int k = 1; k < 10; ++k) params[k] *= 0.5; /* Euler's own: stored as N alone */
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "not in the form this library writes");
 }
 
 /* A legitimate run is never refused: the carry frozen by a non-splitting

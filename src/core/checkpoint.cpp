@@ -14,6 +14,7 @@
 #include <system_error>
 
 #include "error.hpp"
+#include "text.hpp"
 
 namespace lpi {
 
@@ -147,6 +148,24 @@ const CheckpointKind *find_checkpoint_kind(const std::string &kind) {
     return nullptr;
 }
 
+// A model may bring its parameters to one form (the sine-Euler Hamiltonian
+// averages each lambda pair, zeroes the mean mode's terms, and stores Euler's
+// as N alone). A checkpoint whose parameters are not in that form did not
+// come from this library, and would save back to other bytes: refused.
+void require_canonical_parameters(const std::string &kind, const std::vector<double> &stored,
+                                  const std::vector<double> &rebuilt) {
+    if (stored.size() != rebuilt.size())
+        fail(LPI_ERR_FORMAT, "the " + std::to_string(stored.size()) + " parameters are not in the "
+                                 "form this library writes: the " + kind + " system they describe "
+                                 "saves " + std::to_string(rebuilt.size()));
+    for (std::size_t i = 0; i < stored.size(); ++i)
+        if (std::memcmp(&stored[i], &rebuilt[i], sizeof(double)) != 0)
+            fail(LPI_ERR_FORMAT, "parameter " + std::to_string(i) + " is not in the form this "
+                                 "library writes: the " + kind + " system it describes saves " +
+                                 number_text(rebuilt[i], 17) + " there, not " +
+                                 number_text(stored[i], 17));
+}
+
 // The model a checkpoint names, rebuilt from its parameters. The state
 // length is checked first: a crafted file must not make the library
 // allocate a model far larger than the file.
@@ -164,7 +183,9 @@ std::unique_ptr<Model> make_model_for_checkpoint(const std::string &kind,
             fail(LPI_ERR_FORMAT, "the state has " + std::to_string(state_length) + " values, a " +
                                      kind + " system of these parameters has " +
                                      std::to_string(expected));
-        return entry->build(p);
+        std::unique_ptr<Model> model = entry->build(p);
+        require_canonical_parameters(kind, p, model->checkpoint_parameters());
+        return model;
     } catch (const Error &e) {
         // Neither is a bad file: a build without FFTW cannot load sine-Euler, and
         // a system too large for this machine's memory may load on a larger one.
