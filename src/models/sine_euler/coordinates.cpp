@@ -79,8 +79,8 @@ void public_from_modes(int N, const double *w, double *x) {
                           w[2 * minus], w[2 * minus + 1], tolerance);
             fail(LPI_ERR_INVALID, text);
         }
-        x[1 + 2 * i] = 0.5 * (w[2 * m] + w[2 * minus]);
-        x[2 + 2 * i] = 0.5 * (w[2 * m + 1] - w[2 * minus + 1]);
+        x[1 + 2 * i] = mirror_mean(w[2 * m], w[2 * minus]);
+        x[2 + 2 * i] = mirror_mean(w[2 * m + 1], -w[2 * minus + 1]);
     });
 }
 

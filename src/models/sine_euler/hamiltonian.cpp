@@ -36,10 +36,6 @@ double largest_magnitude(const double *values, std::size_t n) {
     return largest;
 }
 
-// The mean of a pair equal within the tolerance (kept as is when equal, so
-// a symmetric input is stored to the bit).
-double mean(double x, double y) { return x == y ? x : 0.5 * x + 0.5 * y; }
-
 }  // namespace
 
 double Hamiltonian::euler_weight(int a, int b, int N) {
@@ -88,7 +84,7 @@ Hamiltonian::Hamiltonian(int N, const double *lambda, std::size_t n_lambda, cons
                               lambda_tolerance);
                 fail(LPI_ERR_INVALID, text);
             }
-            lambda_[m] = lambda_[minus] = mean(lambda_[m], lambda_[minus]);
+            lambda_[m] = lambda_[minus] = mirror_mean(lambda_[m], lambda_[minus]);
             if (!forced) continue;
             double *z = &forcing_[2 * m], *y = &forcing_[2 * minus];
             if (std::hypot(z[0] - y[0], z[1] + y[1]) > f_tolerance) {
@@ -100,8 +96,8 @@ Hamiltonian::Hamiltonian(int N, const double *lambda, std::size_t n_lambda, cons
                               f_tolerance);
                 fail(LPI_ERR_INVALID, text);
             }
-            z[0] = y[0] = mean(z[0], y[0]);
-            z[1] = mean(z[1], -y[1]);
+            z[0] = y[0] = mirror_mean(z[0], y[0]);
+            z[1] = mirror_mean(z[1], -y[1]);
             y[1] = -z[1];
         }
     if (!forced) forcing_.clear();

@@ -22,6 +22,11 @@ inline std::size_t mode_index(int a, int b, int N) { return static_cast<std::siz
 inline std::size_t mirror_index(int a, int b, int N) {
     return mode_index(a ? N - a : 0, b ? N - b : 0, N);
 }
+// The mean of a mode's value and the one its mirror implies, which a
+// symmetric field makes equal: kept as is when they are (such a field is
+// stored to the bit), and halved before the sum, which no finite pair
+// overflows (0.5 (x + y) did, for values beyond DBL_MAX / 2).
+inline double mirror_mean(double x, double y) { return x == y ? x : 0.5 * x + 0.5 * y; }
 // |m|^2 of the representative of mode (a, b), exact (in 64 bits: an int
 // overflows past N = 65535).
 inline double norm2(int a, int b, int N) {
