@@ -253,11 +253,14 @@ LPI_API int lpi_sine_euler_spectrum(const lpi_system *sys, double *energy, doubl
             require(enstrophy, "enstrophy");
         }
         const std::size_t count = lpi::sine_euler::shell_count(model.truncation());
-        *shells = count;
-        if (n < count)
+        // Set on success, and on LPI_ERR_SIZE to say what is needed; no
+        // other failure touches it.
+        if (n < count) {
+            *shells = count;
             lpi::fail(LPI_ERR_SIZE, "spectrum buffers of " + std::to_string(n) + " entries are too "
                                     "small: N = " + std::to_string(model.truncation()) + " has " +
                                     std::to_string(count) + " shells");
+        }
         std::vector<double> e(count), z(count);
         const std::vector<double> whole = model.whole_state(sys->system.working_state().data());
         lpi::sine_euler::shell_spectra(model.hamiltonian(), whole.data(), e.data(), z.data());
@@ -269,6 +272,7 @@ LPI_API int lpi_sine_euler_spectrum(const lpi_system *sys, double *energy, doubl
         });
         std::copy(e.begin(), e.end(), energy);
         std::copy(z.begin(), z.end(), enstrophy);
+        *shells = count;
     });
 }
 
