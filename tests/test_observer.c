@@ -238,6 +238,22 @@ static void test_failing_step_names_step_and_time(void **state) {
     assert_memory_equal(&now, &zero, sizeof now);
     lpi_destroy(sys);
 
+    /* Leapfrog merges one step's last flow with the next one's first: the
+     * first flow of a call stands alone, and is step 1's. */
+    assert_int_equal(lpi_generic_create(&sys, 3, 3, i, j, k, c), LPI_OK);
+    assert_int_equal(lpi_set_state(sys, kM0, 3), LPI_OK);
+    cd = (countdown){0, 3};
+    const int32_t second[] = {1};
+    assert_int_equal(lpi_add_piece(sys, 1, axis, failing_gradient, energy_0, &cd), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 1, second, lpi_test_axis_gradient, lpi_test_axis_energy,
+                                   (void *)&kInertia[1]),
+                     LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "leapfrog"), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.25, 1), LPI_OK); /* flows 1 and 2 of the failing piece */
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.25, 10), LPI_ERR_CALLBACK, "lpi_step");
+    assert_non_null(strstr(lpi_last_error(sys), "in step 1 of this call (t = 0.25 .. 0.5)"));
+    lpi_destroy(sys);
+
     /* A non-finite state is found at the latest at the next observation. */
     sys = rigid_body("rk4");
     assert_int_equal(lpi_set_observer(sys, 3, count_observer, &observed), LPI_OK);

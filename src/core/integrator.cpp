@@ -61,6 +61,7 @@ public:
         // The next observed step, counted rather than found by a division
         // per step (one division costs as much as a small model's flow).
         std::int64_t next_observed = observer.every > 0 ? observer.every : INT64_MAX;
+        progress = {1, 1};  // the leading flow is step 1's: a failure there names it
         if (merge_seam_) model.flow(program_[0].piece, program_[0].weight * dt, state);
         for (std::int64_t step = 1; step <= n; ++step) {
             progress = {step, step};
