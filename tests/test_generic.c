@@ -2,6 +2,8 @@
  * generic systems reproduce the built-in models to round-off; Poisson rank,
  * user Casimirs, energy; every bad input with its exact status, a message
  * naming the function and the fault, and the state unchanged. */
+#include <float.h>
+
 #include "lpi_test.h"
 
 /* so(3): {m1,m2} = -m3, {m1,m3} = m2, {m2,m3} = -m1 (the paper's J). */
@@ -217,6 +219,19 @@ static void test_create_errors(void **state) {
         expect_create_failure(4, 4, i, j, k, c, LPI_ERR_INVALID,
                               "Jacobi identity at (i, j, k) = (1, 2, 3)");
         assert_non_null(strstr(lpi_last_error(NULL), "coefficient 1 on x_3"));
+    }
+    /* The same at any scale: the Jacobiator is quadratic in the constants,
+     * and its products overflowed past 1.3e154 (inf against inf passed) and
+     * underflowed below 1e-162 (0 against 0). so(3) scaled stays accepted. */
+    const double scales[] = {1e155, 1e300, DBL_MAX, 1e-170, 1e-300, 5e-324};
+    for (size_t s = 0; s < sizeof scales / sizeof scales[0]; ++s) {
+        const int32_t i[] = {0, 1}, j[] = {1, 2}, k[] = {2, 1};
+        const double c[] = {scales[s], scales[s]};
+        expect_create_failure(3, 2, i, j, k, c, LPI_ERR_INVALID, "Jacobi identity at (i, j, k) = (0, 1, 2)");
+        const double so3[] = {-scales[s], scales[s], -scales[s]};
+        lpi_system *sys = NULL;
+        assert_int_equal(lpi_generic_create(&sys, 3, 3, kSoI, kSoJ, kSoK, so3), LPI_OK);
+        lpi_destroy(sys);
     }
     LPI_ASSERT_FAILS(NULL, lpi_generic_create(NULL, 3, 3, kSoI, kSoJ, kSoK, kSoC), LPI_ERR_NULL,
                      "lpi_generic_create");

@@ -28,6 +28,40 @@ std::string bracket_text(std::uint32_t i, std::uint32_t j,
 // Relative size below which a Jacobiator component counts as round-off.
 constexpr double kJacobiTolerance = 1e-10;
 
+// A sum of products c c' and the sum of their sizes, both held as a double
+// times 2^exponent, so that neither overflows nor underflows however large or
+// small the constants (products beyond 1e308 made the Jacobi test compare inf
+// with inf, and pass). Their ratio, which the test reads, does not depend on
+// the scale; each product is rounded once, as c c' would be.
+struct ScaledProductSum {
+    double value = 0.0, size = 0.0;
+    int exponent = 0;
+    bool empty = true;
+
+    void add(double a, double b) {
+        int ea = 0, eb = 0;
+        const double product = std::frexp(a, &ea) * std::frexp(b, &eb);
+        const int e = ea + eb;
+        if (empty || e > exponent) {
+            if (!empty) {
+                value = std::ldexp(value, exponent - e);
+                size = std::ldexp(size, exponent - e);
+            }
+            exponent = e;
+            empty = false;
+        }
+        const double term = std::ldexp(product, e - exponent);
+        value += term;
+        size += std::fabs(term);
+    }
+    bool exceeds(double tolerance) const { return std::fabs(value) > tolerance * size; }
+    std::string text() const {
+        const double sum = std::ldexp(value, exponent);
+        if (std::isfinite(sum) && (sum != 0.0 || value == 0.0)) return number_text(sum, 3);
+        return number_text(value, 3) + " * 2^" + std::to_string(exponent);
+    }
+};
+
 }  // namespace
 
 // ---- structure constants ------------------------------------------------------
@@ -104,17 +138,15 @@ void StructureConstants::check_jacobi() const {
     // It vanishes unless one of the three brackets does not, so each triple
     // is visited from its first nonzero pair only, with r among the indices
     // that some involved bracket can reach.
-    std::vector<double> value(dim_, 0.0), size(dim_, 0.0);
+    std::vector<ScaledProductSum> sums(dim_);
     std::vector<std::uint32_t> touched;
     std::vector<std::size_t> stamp(dim_, 0);
     std::size_t pass = 0;
     auto accumulate = [&](std::uint32_t a, std::uint32_t b, std::uint32_t d) {
         for (const Output &first : bracket(a, b))
             for (const Output &second : bracket(first.l, d)) {
-                const double product = first.c * second.c;
-                if (size[second.l] == 0.0) touched.push_back(second.l);
-                value[second.l] += product;
-                size[second.l] += std::fabs(product);
+                if (sums[second.l].empty) touched.push_back(second.l);
+                sums[second.l].add(first.c, second.c);
             }
     };
     auto nonzero = [&](std::uint32_t a, std::uint32_t b) { return !bracket(a, b).empty(); };
@@ -147,15 +179,15 @@ void StructureConstants::check_jacobi() const {
             accumulate(t[1], t[2], t[0]);
             accumulate(t[2], t[0], t[1]);
             for (std::uint32_t m : touched) {
-                if (std::fabs(value[m]) > kJacobiTolerance * size[m])
+                if (sums[m].exceeds(kJacobiTolerance))
                     fail(LPI_ERR_INVALID,
                          "the structure constants violate the Jacobi identity at (i, j, k) = (" +
                              std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " +
                              std::to_string(t[2]) + "): {{x_i, x_j}, x_k} + {{x_j, x_k}, x_i} + "
-                             "{{x_k, x_i}, x_j} has coefficient " + number_text(value[m], 3) +
+                             "{{x_k, x_i}, x_j} has coefficient " + sums[m].text() +
                              " on " + x_name(m) + " (must be 0)");
             }
-            for (std::uint32_t m : touched) value[m] = size[m] = 0.0;
+            for (std::uint32_t m : touched) sums[m] = ScaledProductSum{};
             touched.clear();
         }
     }
