@@ -809,6 +809,86 @@ static void test_files(void **state) {
     lpi_destroy(sys);
 }
 
+/* Runs lpi_save with writes beyond `limit` bytes failing (EFBIG, with
+ * SIGXFSZ ignored): a full disk, without one. */
+static int save_with_file_limit(const lpi_system *sys, const char *path, rlim_t limit) {
+    struct rlimit old, low;
+    assert_int_equal(getrlimit(RLIMIT_FSIZE, &old), 0);
+    low = old;
+    low.rlim_cur = limit;
+    void (*handler)(int) = signal(SIGXFSZ, SIG_IGN);
+    assert_int_equal(setrlimit(RLIMIT_FSIZE, &low), 0);
+    const int status = lpi_save(sys, path);
+    assert_int_equal(setrlimit(RLIMIT_FSIZE, &old), 0);
+    signal(SIGXFSZ, handler);
+    return status;
+}
+
+/* What a save may replace: a regular file, keeping its permission bits, or
+ * the file a symbolic link names, keeping the link; never a FIFO, a device
+ * or a link to nothing; and a failed write keeps the old file. */
+static void test_save_targets(void **state) {
+    (void)state;
+    char dir[] = "checkpoint_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char real[64], link_path[64], dangling[64], fifo[64], nowhere[64];
+    snprintf(real, sizeof real, "%s/real.lpi", dir);
+    snprintf(link_path, sizeof link_path, "%s/link.lpi", dir);
+    snprintf(dangling, sizeof dangling, "%s/dangling.lpi", dir);
+    snprintf(fifo, sizeof fifo, "%s/fifo.lpi", dir);
+    snprintf(nowhere, sizeof nowhere, "%s/nowhere.lpi", dir);
+    lpi_system *sys = rigid_body();
+    assert_int_equal(lpi_save(sys, real), LPI_OK);
+    assert_int_equal(chmod(real, 0600), 0);
+    struct stat st;
+
+    /* Through a link: the file it names is replaced, the link stays. */
+    assert_int_equal(symlink("real.lpi", link_path), 0);
+    assert_int_equal(lpi_step(sys, 0.01, 10), LPI_OK);
+    assert_int_equal(lpi_save(sys, link_path), LPI_OK);
+    assert_int_equal(lstat(link_path, &st), 0);
+    assert_true(S_ISLNK(st.st_mode));
+    assert_int_equal(stat(real, &st), 0);
+    assert_int_equal(st.st_mode & 07777, 0600);
+    lpi_system *back = NULL;
+    assert_int_equal(lpi_load(&back, real), LPI_OK);
+    assert_true(lpi_time(back) == lpi_time(sys));
+    lpi_destroy(back);
+    assert_int_equal(count_entries(dir), 2);
+
+    /* A link to nothing, a FIFO: refused, left as they are. */
+    assert_int_equal(symlink("nowhere.lpi", dangling), 0);
+    LPI_ASSERT_FAILS(sys, lpi_save(sys, dangling), LPI_ERR_IO, "lpi_save");
+    assert_non_null(strstr(lpi_last_error(sys), "symbolic link to a missing file"));
+    assert_int_equal(access(nowhere, F_OK), -1);
+    assert_int_equal(mkfifo(fifo, 0644), 0);
+    LPI_ASSERT_FAILS(sys, lpi_save(sys, fifo), LPI_ERR_IO, "lpi_save");
+    assert_non_null(strstr(lpi_last_error(sys), "not a regular file"));
+    assert_int_equal(lstat(fifo, &st), 0);
+    assert_true(S_ISFIFO(st.st_mode));
+
+    /* A write that fails midway keeps the old file, bytes and mode. */
+    size_t size;
+    unsigned char *old = save(sys, &size);
+    assert_int_equal(lpi_step(sys, 0.01, 10), LPI_OK);
+    assert_int_equal(save_with_file_limit(sys, real, 64), LPI_ERR_IO);
+    assert_non_null(strstr(lpi_last_error(sys), "cannot write"));
+    FILE *f = fopen(real, "rb");
+    assert_non_null(f);
+    unsigned char *kept = malloc(size + 1);
+    assert_int_equal(fread(kept, 1, size + 1, f), size);
+    fclose(f);
+    assert_memory_equal(kept, old, size);
+    assert_int_equal(stat(real, &st), 0);
+    assert_int_equal(st.st_mode & 07777, 0600);
+    assert_int_equal(count_entries(dir), 4); /* no temporary file left */
+
+    free(kept), free(old);
+    unlink(real), unlink(link_path), unlink(dangling), unlink(fifo);
+    assert_int_equal(rmdir(dir), 0);
+    lpi_destroy(sys);
+}
+
 /* Peak resident memory, in KiB. */
 static long peak_rss_kib(void) {
     struct rusage usage;
@@ -977,6 +1057,7 @@ int main(void) {
         cmocka_unit_test(test_sine_euler_after_rk4),
         cmocka_unit_test(test_callbacks_refused),
         cmocka_unit_test(test_files),
+        cmocka_unit_test(test_save_targets),
         cmocka_unit_test(test_files_read_bounded),
         cmocka_unit_test(test_save_names_and_failures),
         cmocka_unit_test(test_null_and_sizes),

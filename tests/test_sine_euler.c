@@ -5,6 +5,9 @@
 #include <complex.h>
 #include <float.h>
 #include <pthread.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -662,7 +665,32 @@ static void test_wisdom(void **state) {
     close(fd);
     LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_file(path), LPI_ERR_INVALID,
                      "lpi_fftw_wisdom_import_file");
-    unlink(path);
+    /* A FIFO is refused, not waited on. */
+    assert_int_equal(unlink(path), 0);
+    assert_int_equal(mkfifo(path, 0600), 0);
+    LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_file(path), LPI_ERR_IO, "lpi_fftw_wisdom_import_file");
+    assert_non_null(strstr(lpi_last_error(NULL), "not a regular file"));
+    assert_int_equal(unlink(path), 0);
+    /* Export is atomic: a write that fails (EFBIG past a file-size limit)
+     * keeps the wisdom file that was there. */
+    assert_int_equal(lpi_fftw_wisdom_export_file(path), LPI_OK);
+    struct stat before;
+    assert_int_equal(stat(path, &before), 0);
+    struct rlimit old, low;
+    assert_int_equal(getrlimit(RLIMIT_FSIZE, &old), 0);
+    low = old;
+    low.rlim_cur = 8;
+    void (*handler)(int) = signal(SIGXFSZ, SIG_IGN);
+    assert_int_equal(setrlimit(RLIMIT_FSIZE, &low), 0);
+    status = lpi_fftw_wisdom_export_file(path);
+    assert_int_equal(setrlimit(RLIMIT_FSIZE, &old), 0);
+    signal(SIGXFSZ, handler);
+    assert_int_equal(status, LPI_ERR_IO);
+    struct stat after;
+    assert_int_equal(stat(path, &after), 0);
+    assert_int_equal(after.st_size, before.st_size);
+    assert_int_equal(lpi_fftw_wisdom_import_file(path), LPI_OK);
+    assert_int_equal(unlink(path), 0);
     LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_file(NULL), LPI_ERR_NULL,
                      "lpi_fftw_wisdom_import_file");
 }

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "../core/checkpoint.hpp"
+#include "../core/files.hpp"
 #include "handle.hpp"
 
 using lpi::capi::Arguments;
@@ -53,7 +54,7 @@ LPI_API int lpi_save(const lpi_system *sys, const char *path) {
         if (!*path) lpi::fail(LPI_ERR_INVALID, "path is empty");
         const std::vector<unsigned char> bytes = lpi::encode_checkpoint(sys->system);
         // Written once when the system is spread over processes.
-        sys->system.model().on_one_process([&] { lpi::write_file_atomically(path, bytes); });
+        sys->system.model().on_one_process([&] { lpi::write_file_atomically(path, bytes.data(), bytes.size()); });
     });
 }
 

@@ -1,19 +1,13 @@
 #include "checkpoint.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <array>
-#include <atomic>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <limits>
-#include <system_error>
 
 #include "error.hpp"
+#include "files.hpp"
 #include "text.hpp"
 
 namespace lpi {
@@ -107,8 +101,6 @@ std::uint64_t load_u64(const unsigned char *p) {
     std::memcpy(&v, p, sizeof v);
     return v;
 }
-
-std::string io_reason(int error) { return std::generic_category().message(error); }
 
 // Checks the header (the first head_size <= 24 bytes of a checkpoint of
 // `size` bytes): magic, byte order, version, and the announced total size
@@ -325,110 +317,17 @@ void restore_checkpoint(System &system, const Checkpoint &cp) {
                              "in the checkpoint; resuming would not continue the same trajectory");
 }
 
-namespace {
-
-// The directory part of path, for the temporary file and the final fsync.
-std::string directory_of(const std::string &path) {
-    const std::size_t slash = path.find_last_of('/');
-    return slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
-}
-
-// A new, empty file in `dir` under a short name of its own (".lpi-" and 12
-// characters): legal wherever the target's name is, even a name of NAME_MAX
-// bytes to which no suffix could be added. O_EXCL with mode 0666 (not
-// mkstemp's 0600), so the umask gives the file the usual permissions.
-int create_temporary(const std::string &dir, std::string &temp) {
-    static std::atomic<unsigned> counter{0};
-    for (int attempt = 0;; ++attempt) {
-        char name[32];
-        std::snprintf(name, sizeof name, ".lpi-%06x%06x",
-                      static_cast<unsigned>(::getpid()) & 0xFFFFFFu,
-                      counter.fetch_add(1) & 0xFFFFFFu);
-        temp = dir + "/" + name;
-        const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd >= 0 || errno != EEXIST || attempt == 100) return fd;
-    }
-}
-
-}  // namespace
-
-void write_file_atomically(const std::string &path, const std::vector<unsigned char> &bytes) {
-    const std::string dir = directory_of(path);
-    std::string temp;
-    const int fd = create_temporary(dir, temp);
-    if (fd < 0)
-        fail(LPI_ERR_IO, "cannot save '" + path + "': cannot create a file in '" + dir +
-                             "': " + io_reason(errno));
-    // Until the rename, `path` is untouched: a failure leaves the old file.
-    auto abandon = [&](const std::string &what, int error, bool open) {
-        if (open) ::close(fd);
-        ::unlink(temp.c_str());
-        fail(LPI_ERR_IO, "cannot save '" + path + "': " + what + ": " + io_reason(error));
-    };
-    std::size_t done = 0;
-    while (done < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-        if (n < 0) {
-            if (errno == EINTR) continue;
-            abandon("cannot write '" + temp + "'", errno, true);
-        }
-        done += static_cast<std::size_t>(n);
-    }
-    if (::fsync(fd) != 0) abandon("cannot flush '" + temp + "'", errno, true);
-    if (::close(fd) != 0) abandon("cannot close '" + temp + "'", errno, false);
-    if (::rename(temp.c_str(), path.c_str()) != 0)
-        abandon("cannot rename '" + temp + "' to it", errno, false);
-    // Make the rename itself durable. Best effort: the file is complete and in
-    // place either way, and some file systems cannot sync a directory.
-    const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (dfd >= 0) {
-        ::fsync(dfd);
-        ::close(dfd);
-    }
-}
-
-namespace {
-
-// Reads up to n bytes; fewer only at the end of the file.
-std::size_t read_fully(int fd, unsigned char *data, std::size_t n, const std::string &path) {
-    std::size_t done = 0;
-    while (done < n) {
-        const ssize_t got = ::read(fd, data + done, n - done);
-        if (got < 0) {
-            if (errno == EINTR) continue;
-            fail(LPI_ERR_IO, "cannot read '" + path + "': " + io_reason(errno));
-        }
-        if (got == 0) break;
-        done += static_cast<std::size_t>(got);
-    }
-    return done;
-}
-
-}  // namespace
-
 std::vector<unsigned char> read_checkpoint_file(const std::string &path) {
-    // O_NONBLOCK: a FIFO given by mistake must not hang the call.
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-    if (fd < 0) fail(LPI_ERR_IO, "cannot open '" + path + "': " + io_reason(errno));
-    struct Closer {
-        int fd;
-        ~Closer() { ::close(fd); }
-    } closer{fd};
-    struct stat st;
-    if (::fstat(fd, &st) != 0) fail(LPI_ERR_IO, "cannot stat '" + path + "': " + io_reason(errno));
-    if (S_ISDIR(st.st_mode)) fail(LPI_ERR_IO, "'" + path + "' is a directory");
-    if (!S_ISREG(st.st_mode)) fail(LPI_ERR_IO, "'" + path + "' is not a regular file");
+    RegularFileReader file(path);
     // The header first, checked against the file's size: a foreign or lying
     // file costs 24 bytes of reading, never an allocation of its size.
-    const auto file_size = static_cast<std::uint64_t>(st.st_size);
     unsigned char head[kHeaderSize];
-    const std::size_t head_size = read_fully(fd, head, sizeof head, path);
-    check_header(head, head_size, file_size);
-    if (file_size > std::numeric_limits<std::size_t>::max()) throw std::bad_alloc();
-    std::vector<unsigned char> bytes(static_cast<std::size_t>(file_size));
+    const std::size_t head_size = file.read(head, sizeof head);
+    check_header(head, head_size, file.size());
+    std::vector<unsigned char> bytes(file.size());
     std::memcpy(bytes.data(), head, kHeaderSize);
     const std::size_t rest = bytes.size() - kHeaderSize;
-    if (read_fully(fd, bytes.data() + kHeaderSize, rest, path) != rest)
+    if (file.read(bytes.data() + kHeaderSize, rest) != rest)
         fail(LPI_ERR_FORMAT, "truncated while it was read (the file shrank)");
     return bytes;
 }

@@ -91,14 +91,10 @@ Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size);
 // or the name is an alias (a checkpoint stores the name itself).
 void restore_checkpoint(System &system, const Checkpoint &checkpoint);
 
-// Atomic write: a temporary file under a short name of its own in the same
-// directory, fsync, rename over path, fsync of the directory. LPI_ERR_IO
-// (naming path, with the reason) on failure; path then keeps its old
-// contents and no temporary file is left behind.
-void write_file_atomically(const std::string &path, const std::vector<unsigned char> &bytes);
 // The bytes of the checkpoint file at path, read bounded: the header is
 // checked against the file's size (LPI_ERR_FORMAT) before anything of that
-// size is allocated. LPI_ERR_IO when it cannot be read or is no regular file.
+// size is allocated. LPI_ERR_IO when it cannot be read or is no regular file
+// (files.hpp: the saves are write_file_atomically's).
 std::vector<unsigned char> read_checkpoint_file(const std::string &path);
 
 }  // namespace lpi

@@ -1,7 +1,6 @@
 // FFTW behind the LineTransforms interface, the grid transforms and wisdom.
 #include "transforms.hpp"
 
-#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -9,6 +8,7 @@
 #include <new>
 
 #include "../../core/error.hpp"
+#include "../../core/files.hpp"
 #include "../sine_euler.hpp"
 #include "lpi_config.h"
 #include "kernels.hpp"
@@ -180,32 +180,29 @@ void modes_from_grid(int N, const double *grid, double *modes) {
 
 namespace {
 
-[[noreturn]] void io_failure(const char *action, const char *path, int error) {
-    fail(LPI_ERR_IO, std::string("could not ") + action + " FFTW wisdom file '" + path +
-                         "': " + std::strerror(error));
-}
+// Far beyond any wisdom FFTW writes (some hundred bytes a plan): a larger file
+// is refused before it is read into memory.
+constexpr std::size_t kMaxWisdomBytes = std::size_t{64} << 20;
 
 }  // namespace
 
+// Read as a regular file only (a FIFO is refused, not waited on), then
+// imported as a string.
 void fftw_wisdom_import_file(const char *path) {
+    RegularFileReader file(path);
+    if (file.size() > kMaxWisdomBytes)
+        fail(LPI_ERR_INVALID, std::string("'") + path + "' is not FFTW wisdom: " +
+                                  std::to_string(file.size()) + " bytes, more than wisdom takes");
+    const std::string text = file.read_rest();
     std::lock_guard<std::mutex> lock(fftw_planner_mutex());
-    std::FILE *file = std::fopen(path, "r");
-    if (!file) io_failure("open", path, errno);
-    const int imported = fftw_import_wisdom_from_file(file);
-    const int read_error = std::ferror(file) ? errno : 0;
-    std::fclose(file);
-    if (read_error) io_failure("read", path, read_error);
-    if (!imported) fail(LPI_ERR_INVALID, std::string("'") + path + "' is not FFTW wisdom");
+    if (text.find('\0') != std::string::npos || !fftw_import_wisdom_from_string(text.c_str()))
+        fail(LPI_ERR_INVALID, std::string("'") + path + "' is not FFTW wisdom");
 }
 
+// Written atomically, as checkpoints are: a failed export keeps the old file.
 void fftw_wisdom_export_file(const char *path) {
-    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
-    std::FILE *file = std::fopen(path, "w");
-    if (!file) io_failure("create", path, errno);
-    fftw_export_wisdom_to_file(file);
-    const int write_error = std::ferror(file) ? (errno ? errno : EIO) : 0;
-    if (std::fclose(file) != 0 && !write_error) io_failure("write", path, errno);
-    if (write_error) io_failure("write", path, write_error);
+    const std::string wisdom = fftw_wisdom_export_string();
+    write_file_atomically(path, reinterpret_cast<const unsigned char *>(wisdom.data()), wisdom.size());
 }
 
 void fftw_wisdom_import_string(const char *wisdom) {

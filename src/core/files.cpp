@@ -1,0 +1,170 @@
+// Atomic writes and checked reads (see the header).
+#include "files.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <climits>
+#include <cstdio>
+#include <cstdint>
+#include <cstdlib>
+#include <limits>
+#include <new>
+#include <system_error>
+
+#include "error.hpp"
+
+namespace lpi {
+
+std::string io_reason(int error) { return std::generic_category().message(error); }
+
+namespace {
+
+// The directory part of path, for the temporary file and the final fsync.
+std::string directory_of(const std::string &path) {
+    const std::size_t slash = path.find_last_of('/');
+    return slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+}
+
+// A new, empty file in `dir` under a short name of its own (".lpi-" and 12
+// characters): legal wherever the target's name is, even a name of NAME_MAX
+// bytes to which no suffix could be added. O_EXCL with mode 0666 (not
+// mkstemp's 0600), so the umask gives a new file the usual permissions.
+int create_temporary(const std::string &dir, std::string &temp) {
+    static std::atomic<unsigned> counter{0};
+    for (int attempt = 0;; ++attempt) {
+        char name[32];
+        std::snprintf(name, sizeof name, ".lpi-%06x%06x", static_cast<unsigned>(::getpid()) & 0xFFFFFFu,
+                      counter.fetch_add(1) & 0xFFFFFFu);
+        temp = dir + "/" + name;
+        const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd >= 0 || errno != EEXIST || attempt == 100) return fd;
+    }
+}
+
+// What a save replaces: path itself, or the file a symbolic link there
+// names, so that the link survives (a rename over path would replace the
+// link with a file and leave its target stale). Only a regular file is
+// replaced: a rename over a device or a FIFO would destroy it.
+struct SaveTarget {
+    std::string path;
+    bool exists = false;
+    mode_t permissions = 0;
+};
+
+SaveTarget save_target(const std::string &path) {
+    auto refuse = [&path](const std::string &why) { fail(LPI_ERR_IO, "cannot save '" + path + "': " + why); };
+    SaveTarget target{path};
+    struct stat st;
+    if (::stat(path.c_str(), &st) != 0) {
+        const int error = errno;
+        struct stat link;
+        if (error == ENOENT && ::lstat(path.c_str(), &link) == 0 && S_ISLNK(link.st_mode))
+            refuse("it is a symbolic link to a missing file");
+        if (error != ENOENT) refuse(io_reason(error));
+        return target;  // a new file
+    }
+    if (S_ISDIR(st.st_mode)) refuse("it is a directory");
+    if (!S_ISREG(st.st_mode)) refuse("it is not a regular file (a device, a FIFO or a socket)");
+    target.exists = true;
+    target.permissions = st.st_mode & 07777;
+    struct stat link;
+    if (::lstat(path.c_str(), &link) == 0 && S_ISLNK(link.st_mode)) {
+        char *resolved = ::realpath(path.c_str(), nullptr);
+        if (!resolved) refuse("cannot resolve the symbolic link: " + io_reason(errno));
+        target.path = resolved;
+        std::free(resolved);
+    }
+    return target;
+}
+
+}  // namespace
+
+void write_file_atomically(const std::string &path, const unsigned char *bytes, std::size_t size) {
+    const SaveTarget target = save_target(path);
+    const std::string dir = directory_of(target.path);
+    std::string temp;
+    const int fd = create_temporary(dir, temp);
+    if (fd < 0)
+        fail(LPI_ERR_IO, "cannot save '" + path + "': cannot create a file in '" + dir + "': " + io_reason(errno));
+    // Until the rename, the target is untouched: a failure leaves the old file.
+    auto abandon = [&](const std::string &what, int error, bool open) {
+        if (open) ::close(fd);
+        ::unlink(temp.c_str());
+        fail(LPI_ERR_IO, "cannot save '" + path + "': " + what + ": " + io_reason(error));
+    };
+    if (target.exists && ::fchmod(fd, target.permissions) != 0)
+        abandon("cannot give '" + temp + "' the permissions of the old file", errno, true);
+    std::size_t done = 0;
+    while (done < size) {
+        const ssize_t n = ::write(fd, bytes + done, size - done);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            abandon("cannot write '" + temp + "'", errno, true);
+        }
+        done += static_cast<std::size_t>(n);
+    }
+    if (::fsync(fd) != 0) abandon("cannot flush '" + temp + "'", errno, true);
+    if (::close(fd) != 0) abandon("cannot close '" + temp + "'", errno, false);
+    if (::rename(temp.c_str(), target.path.c_str()) != 0)
+        abandon("cannot rename '" + temp + "' to " + (target.path == path ? "it" : "'" + target.path + "'"),
+                errno, false);
+    // Make the rename itself durable. Best effort: the file is complete and in
+    // place either way, and some file systems cannot sync a directory.
+    const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dfd >= 0) {
+        ::fsync(dfd);
+        ::close(dfd);
+    }
+}
+
+RegularFileReader::RegularFileReader(const std::string &path) : path_(path) {
+    // O_NONBLOCK: a FIFO given by mistake must not hang the call.
+    fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    if (fd_ < 0) fail(LPI_ERR_IO, "cannot open '" + path + "': " + io_reason(errno));
+    struct stat st;
+    const bool known = ::fstat(fd_, &st) == 0;
+    const int error = errno;
+    if (!known || !S_ISREG(st.st_mode)) {
+        ::close(fd_);
+        if (!known) fail(LPI_ERR_IO, "cannot stat '" + path + "': " + io_reason(error));
+        if (S_ISDIR(st.st_mode)) fail(LPI_ERR_IO, "'" + path + "' is a directory");
+        fail(LPI_ERR_IO, "'" + path + "' is not a regular file");
+    }
+    if (static_cast<std::uint64_t>(st.st_size) > std::numeric_limits<std::size_t>::max()) {
+        ::close(fd_);
+        throw std::bad_alloc();
+    }
+    size_ = static_cast<std::size_t>(st.st_size);
+}
+
+RegularFileReader::~RegularFileReader() { ::close(fd_); }
+
+std::size_t RegularFileReader::read(unsigned char *data, std::size_t n) {
+    std::size_t done = 0;
+    while (done < n) {
+        const ssize_t got = ::read(fd_, data + done, n - done);
+        if (got < 0) {
+            if (errno == EINTR) continue;
+            fail(LPI_ERR_IO, "cannot read '" + path_ + "': " + io_reason(errno));
+        }
+        if (got == 0) break;
+        done += static_cast<std::size_t>(got);
+    }
+    return done;
+}
+
+std::string RegularFileReader::read_rest() {
+    std::string text;
+    unsigned char chunk[65536];
+    for (;;) {
+        const std::size_t got = read(chunk, sizeof chunk);
+        text.append(reinterpret_cast<const char *>(chunk), got);
+        if (got < sizeof chunk) return text;
+    }
+}
+
+}  // namespace lpi

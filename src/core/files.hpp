@@ -1,0 +1,47 @@
+// Files the library writes and reads (checkpoints, FFTW wisdom): written
+// atomically, read only when they are regular files, so that no call can
+// hang on a FIFO, replace a device, or leave a partial file behind.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace lpi {
+
+// The reason an errno value names ("No such file or directory").
+std::string io_reason(int error);
+
+// Atomic write: a temporary file under a short name of its own in the
+// target's directory, fsync, rename over the target, fsync of the directory.
+// The target is path, or the file a symbolic link at path names (the link
+// is kept); an existing target keeps its permission bits. LPI_ERR_IO (naming
+// path, with the reason) when the target is a directory, a device, a FIFO or
+// a link to nothing, or on any failure; path then keeps its old contents and
+// no temporary file is left behind.
+void write_file_atomically(const std::string &path, const unsigned char *bytes, std::size_t size);
+
+// A file opened for reading that is known to be a regular file (opened
+// without blocking, so a FIFO given by mistake is refused, not waited on):
+// LPI_ERR_IO naming path when it cannot be opened, is a directory or is no
+// regular file. Closed on destruction.
+class RegularFileReader {
+public:
+    explicit RegularFileReader(const std::string &path);
+    ~RegularFileReader();
+    RegularFileReader(const RegularFileReader &) = delete;
+    RegularFileReader &operator=(const RegularFileReader &) = delete;
+
+    std::size_t size() const { return size_; }
+    // Reads up to n bytes; fewer only at the end of the file.
+    std::size_t read(unsigned char *data, std::size_t n);
+    // The whole rest of the file.
+    std::string read_rest();
+
+private:
+    std::string path_;
+    int fd_ = -1;
+    std::size_t size_ = 0;
+};
+
+}  // namespace lpi
