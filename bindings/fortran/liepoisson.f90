@@ -2,18 +2,24 @@
 !
 ! Two layers over the C library (include/liepoisson.h):
 !   c_lpi_<name>  bind(C) interfaces of every public function, exactly as in C;
-!   lpi_<name>    Fortran-friendly wrappers: character strings in and out,
-!                 assumed-shape arrays (their size is passed as the length),
-!                 and an optional integer status argument. When status is
-!                 absent, a failure stops the program with the library's
-!                 message (as Fortran I/O does without iostat=); when present,
-!                 it receives LPI_OK, the negative LPI_ERR_* code (then
-!                 lpi_last_error(sys) gives the message) or, from lpi_step,
-!                 the positive LPI_STOPPED (not a failure: never stops).
+!   lpi_<name>    Fortran-friendly wrappers: character strings in and out
+!                 (trailing blanks dropped), assumed-shape arrays (their size
+!                 is passed as the length), and an optional integer status
+!                 argument. When status is absent, a failure stops the program
+!                 with the library's message (as Fortran I/O does without
+!                 iostat=); when present, it receives LPI_OK, the negative
+!                 LPI_ERR_* code (then lpi_last_error(sys) gives the message)
+!                 or, from lpi_step, the positive LPI_STOPPED (not a failure:
+!                 never stops).
+! What C cannot see is refused here, before any C call and changing nothing:
+! a string holding a NUL (LPI_ERR_INVALID: C would stop reading there), a
+! negative dim (LPI_ERR_INVALID), sine-Euler arrays not N x N and the four
+! bracket arrays of lpi_generic_create differing in length (LPI_ERR_SIZE).
+! lpi_last_error does not describe these; the stop message does.
 ! Handles are type(c_ptr). Index sets and bracket indices are 0-based, as in C.
 ! Sine-Euler modes and grids are arrays w(0:N-1, 0:N-1) with w(a, b) = mode
-! (a, b) (resp. the vorticity at (2 pi a/N, 2 pi b/N)); the wrappers transpose
-! to and from the C row-major layout.
+! (a, b) (resp. the vorticity at (2 pi a/N, 2 pi b/N)), of exactly that shape;
+! the wrappers transpose to and from the C row-major layout.
 ! Callbacks are bind(C) functions matching the abstract interfaces
 ! lpi_gradient_fn, lpi_energy_fn, lpi_casimir_fn, lpi_scalar_fn and
 ! lpi_observer_fn.
@@ -474,10 +480,65 @@ contains
         end do
     end function
 
+    ! s less trailing blanks, NUL-terminated for C. Callers refuse a NUL
+    ! inside s first (nul_refused): C would end the string there.
     function c_string(s) result(c)
         character(len=*), intent(in) :: s
         character(kind=c_char, len=len_trim(s) + 1) :: c
         c = trim(s)//c_null_char
+    end function
+
+    ! A refusal made here, before any C call, of what the C function cannot
+    ! see: status receives code, or the program stops with message (C has no
+    ! way to take it, so lpi_last_error keeps what it had).
+    subroutine refuse(code, message, status)
+        integer(c_int), intent(in) :: code
+        character(len=*), intent(in) :: message
+        integer, intent(out), optional :: status
+        if (.not. present(status)) error stop "liepoisson: "//f_string(c_lpi_status_name(code))//": "//message
+        status = code
+    end subroutine
+
+    ! .true. after refusing s (LPI_ERR_INVALID) when it holds a NUL: C would
+    ! take the string before it ("leapfrog"//c_null_char//"x" as "leapfrog").
+    logical function nul_refused(s, what, status)
+        character(len=*), intent(in) :: s, what
+        integer, intent(out), optional :: status
+        nul_refused = index(s, c_null_char) > 0
+        if (nul_refused) call refuse(LPI_ERR_INVALID, what//" contains a NUL character", status)
+    end function
+
+    ! .true. after refusing n < 0 (LPI_ERR_INVALID): int(n, c_size_t) would
+    ! wrap it to nearly 2^64, and C would report that number.
+    logical function negative_refused(n, what, status)
+        integer, intent(in) :: n
+        character(len=*), intent(in) :: what
+        integer, intent(out), optional :: status
+        character(len=24) :: text
+        negative_refused = n < 0
+        if (negative_refused) then
+            write (text, '(i0)') n
+            call refuse(LPI_ERR_INVALID, what//" = "//trim(text)//" is negative", status)
+        end if
+    end function
+
+    ! .true. after refusing an array of shape dims (LPI_ERR_SIZE) that is not
+    ! N x N on a sine-Euler system: C sees only the element count, which a
+    ! 49 x 1 array shares with 7 x 7. Any other handle is left to C to report.
+    logical function shape_refused(sys, dims, what, status)
+        type(c_ptr), intent(in) :: sys
+        integer, intent(in) :: dims(2)
+        character(len=*), intent(in) :: what
+        integer, intent(out), optional :: status
+        integer(c_int32_t) :: n
+        character(len=64) :: text
+        shape_refused = .false.
+        if (c_lpi_sine_euler_size(sys, n) /= LPI_OK) return
+        shape_refused = any(dims /= n)
+        if (shape_refused) then
+            write (text, '(i0, " x ", i0, ", not N x N = ", i0, " x ", i0)') dims, n, n
+            call refuse(LPI_ERR_SIZE, what//" is "//trim(text), status)
+        end if
     end function
 
     ! Hands st to status when present; otherwise a failure stops the program.
@@ -586,6 +647,7 @@ contains
         type(c_ptr), intent(in) :: sys
         character(len=*), intent(in) :: name
         integer, intent(out), optional :: status
+        if (nul_refused(name, "lpi_set_method: name", status)) return
         call finish(c_lpi_set_method(sys, c_string(name)), sys, status)
     end subroutine
 
@@ -593,6 +655,7 @@ contains
         type(c_ptr), intent(in) :: sys
         character(len=*), intent(in) :: name
         integer, intent(out), optional :: status
+        if (nul_refused(name, "lpi_set_split: name", status)) return
         call finish(c_lpi_set_split(sys, c_string(name)), sys, status)
     end subroutine
 
@@ -740,13 +803,13 @@ contains
         integer(c_int32_t), intent(in) :: i(:), j(:), k(:)
         real(c_double), intent(in) :: c(:)
         integer, intent(out), optional :: status
+        sys = c_null_ptr
         if (size(j) /= size(i) .or. size(k) /= size(i) .or. size(c) /= size(i)) then
             ! Checked here: the C function cannot see the four lengths.
-            sys = c_null_ptr
-            if (.not. present(status)) error stop "liepoisson: lpi_generic_create: i, j, k and c differ in length"
-            status = LPI_ERR_SIZE
+            call refuse(LPI_ERR_SIZE, "lpi_generic_create: i, j, k and c differ in length", status)
             return
         end if
+        if (negative_refused(dim, "lpi_generic_create: dim", status)) return
         call finish(c_lpi_generic_create(sys, int(dim, c_size_t), size(i, kind=c_size_t), i, j, k, c), &
                     c_null_ptr, status)
     end subroutine
@@ -835,6 +898,7 @@ contains
         integer, intent(out), optional :: status
         real(c_double), allocatable :: buf(:)
         integer :: a, b, n1, n2, q
+        if (shape_refused(sys, shape(w), "lpi_sine_euler_set_modes: w", status)) return
         n1 = size(w, 1)
         n2 = size(w, 2)
         allocate (buf(2 * n1 * n2))
@@ -855,6 +919,7 @@ contains
         real(c_double), allocatable :: buf(:)
         integer(c_int) :: st
         integer :: a, b, n1, n2, q
+        if (shape_refused(sys, shape(w), "lpi_sine_euler_get_modes: w", status)) return
         n1 = size(w, 1)
         n2 = size(w, 2)
         allocate (buf(2 * n1 * n2))
@@ -876,6 +941,7 @@ contains
         real(c_double), intent(in) :: w(:, :)
         integer, intent(out), optional :: status
         real(c_double), allocatable :: t(:, :)
+        if (shape_refused(sys, shape(w), "lpi_sine_euler_set_grid: w", status)) return
         allocate (t(size(w, 2), size(w, 1)))
         t = transpose(w)
         call finish(c_lpi_sine_euler_set_grid(sys, t, size(t, kind=c_size_t)), sys, status)
@@ -887,6 +953,7 @@ contains
         integer, intent(out), optional :: status
         real(c_double), allocatable :: t(:, :)
         integer(c_int) :: st
+        if (shape_refused(sys, shape(w), "lpi_sine_euler_get_grid: w", status)) return
         allocate (t(size(w, 2), size(w, 1)))
         st = c_lpi_sine_euler_get_grid(sys, t, size(t, kind=c_size_t))
         if (st == LPI_OK) w = transpose(t)
@@ -923,6 +990,7 @@ contains
         type(c_ptr), intent(in) :: sys
         character(len=*), intent(in) :: rigor
         integer, intent(out), optional :: status
+        if (nul_refused(rigor, "lpi_sine_euler_set_planning: rigor", status)) return
         call finish(c_lpi_sine_euler_set_planning(sys, c_string(rigor)), sys, status)
     end subroutine
 
@@ -949,6 +1017,10 @@ contains
         real(c_double), allocatable :: t(:, :)
         real(c_double), allocatable, target :: buf(:)
         integer :: a, b, n2, q
+        if (shape_refused(sys, shape(lambda), "lpi_sine_euler_set_hamiltonian: lambda", status)) return
+        if (present(f)) then
+            if (shape_refused(sys, shape(f), "lpi_sine_euler_set_hamiltonian: f", status)) return
+        end if
         allocate (t(size(lambda, 2), size(lambda, 1)))
         t = transpose(lambda)
         if (.not. present(f)) then
@@ -976,6 +1048,7 @@ contains
         integer, intent(out), optional :: status
         real(c_double), allocatable :: t(:, :)
         integer(c_int) :: st
+        if (shape_refused(sys, shape(psi), "lpi_sine_euler_get_stream: psi", status)) return
         allocate (t(size(psi, 2), size(psi, 1)))
         st = c_lpi_sine_euler_get_stream(sys, t, size(t, kind=c_size_t))
         if (st == LPI_OK) psi = transpose(t)
@@ -1007,18 +1080,21 @@ contains
     subroutine lpi_fftw_wisdom_import_file(path, status)
         character(len=*), intent(in) :: path
         integer, intent(out), optional :: status
+        if (nul_refused(path, "lpi_fftw_wisdom_import_file: path", status)) return
         call finish(c_lpi_fftw_wisdom_import_file(c_string(path)), c_null_ptr, status)
     end subroutine
 
     subroutine lpi_fftw_wisdom_export_file(path, status)
         character(len=*), intent(in) :: path
         integer, intent(out), optional :: status
+        if (nul_refused(path, "lpi_fftw_wisdom_export_file: path", status)) return
         call finish(c_lpi_fftw_wisdom_export_file(c_string(path)), c_null_ptr, status)
     end subroutine
 
     subroutine lpi_fftw_wisdom_import_string(wisdom, status)
         character(len=*), intent(in) :: wisdom
         integer, intent(out), optional :: status
+        if (nul_refused(wisdom, "lpi_fftw_wisdom_import_string: wisdom", status)) return
         call finish(c_lpi_fftw_wisdom_import_string(c_string(wisdom)), c_null_ptr, status)
     end subroutine
 
@@ -1053,6 +1129,7 @@ contains
         type(c_ptr), intent(in) :: sys
         character(len=*), intent(in) :: path
         integer, intent(out), optional :: status
+        if (nul_refused(path, "lpi_save: path", status)) return
         call finish(c_lpi_save(sys, c_string(path)), sys, status)
     end subroutine
 
@@ -1060,6 +1137,8 @@ contains
         type(c_ptr), intent(out) :: sys
         character(len=*), intent(in) :: path
         integer, intent(out), optional :: status
+        sys = c_null_ptr
+        if (nul_refused(path, "lpi_load: path", status)) return
         call finish(c_lpi_load(sys, c_string(path)), c_null_ptr, status)
     end subroutine
 

@@ -1,6 +1,7 @@
 ! Test of the Fortran binding: statuses, the rigid body's Casimir, errors with
-! state unchanged, Fortran callbacks against the built-in model, and sine-Euler
-! (modes, grid orientation, Casimirs) when the library has FFTW.
+! state unchanged, refusals made in Fortran of what C cannot see, Fortran
+! callbacks against the built-in model, and sine-Euler (modes, grid
+! orientation, Casimirs, array shapes) when the library has FFTW.
 module test_callbacks
     use, intrinsic :: iso_c_binding
     implicit none
@@ -64,6 +65,7 @@ program test_liepoisson
     call test_statuses()
     call test_rigid_body()
     call test_errors()
+    call test_refusals()
     call test_generic()
     call test_sine_euler()
     call test_observer()
@@ -219,6 +221,52 @@ contains
         call lpi_destroy(sys)
     end subroutine
 
+    ! A NUL inside a string (C would read only the part before it) and a
+    ! negative dim (int(dim, c_size_t) would wrap it) are refused before C is
+    ! called: nothing changes, no file is written, no handle made.
+    subroutine test_refusals()
+        character(len=*), parameter :: path = "test_fortran_nul.ck"
+        type(c_ptr) :: sys, copy
+        integer :: status
+        logical :: exists
+        character(len=:), allocatable :: msg
+        call lpi_rigid_body_create(sys, 1.0_c_double, 2.0_c_double, 3.0_c_double)
+        call lpi_set_method(sys, "triple-jump-4")
+        call lpi_set_method(sys, "leapfrog"//c_null_char//"garbage", status)
+        call check(status == LPI_ERR_INVALID, "method name holding a NUL refused")
+        call check(lpi_get_method(sys) == "triple-jump-4", "method unchanged")
+        call lpi_set_split(sys, "axes"//c_null_char, status)
+        call check(status == LPI_ERR_INVALID, "split name holding a NUL refused")
+        call check(lpi_get_split(sys) == "casimir-shift", "split unchanged")
+        call remove_file(path)
+        call lpi_save(sys, path//c_null_char//".x", status)
+        call check(status == LPI_ERR_INVALID, "lpi_save: path holding a NUL refused")
+        inquire (file=path, exist=exists)
+        call check(.not. exists, "lpi_save: nothing written at the path before the NUL")
+        call lpi_save(sys, path)
+        call lpi_load(copy, path//c_null_char//".x", status)
+        call check(status == LPI_ERR_INVALID, "lpi_load: path holding a NUL refused")
+        call check(.not. c_associated(copy), "lpi_load: no handle after the refusal")
+        call remove_file(path)
+        call lpi_destroy(sys)
+        ! Refused before C: the thread's message is still the failed create's.
+        call lpi_rigid_body_create(copy, -1.0_c_double, 1.0_c_double, 1.0_c_double, status)
+        msg = lpi_last_error(c_null_ptr)
+        call lpi_generic_create(copy, -1, [integer(c_int32_t) ::], [integer(c_int32_t) ::], &
+                                [integer(c_int32_t) ::], [real(c_double) ::], status)
+        call check(status == LPI_ERR_INVALID, "negative dim refused")
+        call check(.not. c_associated(copy), "no handle after a negative dim")
+        call check(lpi_last_error(c_null_ptr) == msg, "negative dim refused before C (not as 2^64 - 1): " &
+                   //lpi_last_error(c_null_ptr))
+    end subroutine
+
+    subroutine remove_file(path)
+        character(len=*), intent(in) :: path
+        integer :: unit, ios
+        open (newunit=unit, file=path, status="old", iostat=ios)
+        if (ios == 0) close (unit, status="delete")
+    end subroutine
+
     function ieee_nan() result(x)
         use, intrinsic :: ieee_arithmetic
         real(c_double) :: x
@@ -278,7 +326,9 @@ contains
         complex(c_double_complex) :: w(0:n - 1, 0:n - 1), back(0:n - 1, 0:n - 1), s
         real(c_double) :: grid(0:n - 1, 0:n - 1), grid2(0:n - 1, 0:n - 1), t0(4), t1(4), e
         real(c_double) :: lambda(0:n - 1, 0:n - 1), energy(8), enstrophy(8), h
+        character(len=*), parameter :: wisdom_path = "test_fortran_nul.wisdom"
         integer :: status, a, b, m1, m2, size_n, shells
+        logical :: exists
         character(len=:), allocatable :: wisdom
         call lpi_sine_euler_create(sys, n, status)
         if (status == LPI_ERR_UNSUPPORTED) then
@@ -295,6 +345,10 @@ contains
         call check(wisdom == "measure", "planning read back")
         call lpi_sine_euler_set_planning(sys, "exhaustive", status)
         call check(status == LPI_ERR_INVALID, "unknown planning refused")
+        call lpi_sine_euler_set_planning(sys, "patient"//c_null_char//"x", status)
+        call check(status == LPI_ERR_INVALID, "planning holding a NUL refused")
+        call lpi_sine_euler_get_planning(sys, wisdom)
+        call check(wisdom == "measure", "planning unchanged")
         call random_seed()
         call random_number(grid)
         grid = grid - 0.5_c_double
@@ -357,7 +411,58 @@ contains
         call lpi_fftw_wisdom_import_string(wisdom)
         call lpi_fftw_wisdom_import_string("not wisdom", status)
         call check(status == LPI_ERR_INVALID, "bad wisdom refused")
+        call lpi_fftw_wisdom_import_string(wisdom//c_null_char//"x", status)
+        call check(status == LPI_ERR_INVALID, "wisdom holding a NUL refused")
+        call remove_file(wisdom_path)
+        call lpi_fftw_wisdom_export_file(wisdom_path//c_null_char//".x", status)
+        call check(status == LPI_ERR_INVALID, "wisdom export: path holding a NUL refused")
+        inquire (file=wisdom_path, exist=exists)
+        call check(.not. exists, "wisdom export: nothing written at the path before the NUL")
+        call lpi_fftw_wisdom_export_file(wisdom_path)
+        call lpi_fftw_wisdom_import_file(wisdom_path//c_null_char//".x", status)
+        call check(status == LPI_ERR_INVALID, "wisdom import: path holding a NUL refused")
+        call remove_file(wisdom_path)
+        call test_sine_euler_shapes(sys, n)
         call lpi_destroy(sys)
+    end subroutine
+
+    ! Arrays must be N x N: C sees only the element count, which 49 x 1 and
+    ! 1 x 49 share with 7 x 7. Refused with LPI_ERR_SIZE, the system and the
+    ! output untouched.
+    subroutine test_sine_euler_shapes(sys, n)
+        type(c_ptr), intent(in) :: sys
+        integer, intent(in) :: n
+        real(c_double), parameter :: mark = -7
+        real(c_double) :: grid(n, n), grid2(n, n), lambda(n, n), flat(n * n, 1), e, e2
+        complex(c_double_complex) :: w(n, n), w2(n, n), mflat(1, n * n)
+        integer :: status
+        call lpi_sine_euler_get_grid(sys, grid)
+        call lpi_sine_euler_get_modes(sys, w)
+        call lpi_energy(sys, e)
+        flat = reshape(2 * grid, [n * n, 1])
+        call lpi_sine_euler_set_grid(sys, flat, status)
+        call check(status == LPI_ERR_SIZE, "set_grid: 49 x 1 refused")
+        mflat = reshape(2 * w, [1, n * n])
+        call lpi_sine_euler_set_modes(sys, mflat, status)
+        call check(status == LPI_ERR_SIZE, "set_modes: 1 x 49 refused")
+        lambda = 1
+        call lpi_sine_euler_set_hamiltonian(sys, reshape(lambda, [n * n, 1]), status=status)
+        call check(status == LPI_ERR_SIZE, "set_hamiltonian: lambda 49 x 1 refused")
+        mflat = 0
+        call lpi_sine_euler_set_hamiltonian(sys, lambda, mflat, status)
+        call check(status == LPI_ERR_SIZE, "set_hamiltonian: f 1 x 49 refused")
+        call lpi_sine_euler_get_grid(sys, grid2)
+        call lpi_sine_euler_get_modes(sys, w2)
+        call lpi_energy(sys, e2)
+        call check(all(grid2 == grid) .and. all(w2 == w) .and. e2 == e, "refused shapes change nothing")
+        flat = mark
+        call lpi_sine_euler_get_grid(sys, flat, status)
+        call check(status == LPI_ERR_SIZE .and. all(flat == mark), "get_grid: 49 x 1 refused, untouched")
+        call lpi_sine_euler_get_stream(sys, flat, status)
+        call check(status == LPI_ERR_SIZE .and. all(flat == mark), "get_stream: 49 x 1 refused, untouched")
+        mflat = mark
+        call lpi_sine_euler_get_modes(sys, mflat, status)
+        call check(status == LPI_ERR_SIZE .and. all(mflat == mark), "get_modes: 1 x 49 refused, untouched")
     end subroutine
 
 end program
