@@ -26,6 +26,7 @@ STATUS : dict
 from __future__ import annotations
 
 import collections
+import collections.abc
 import ctypes
 import math
 import numbers
@@ -108,6 +109,61 @@ def _real(value, what):
     if isinstance(value, (bool, str, bytes)) or not isinstance(value, numbers.Real):
         raise TypeError("%s must be a real number, not %s" % (what, type(value).__name__))
     return float(value)
+
+
+def _complex(value, what):
+    """value as a complex: TypeError for anything but a number (no strings)."""
+    if isinstance(value, (bool, str, bytes)) or not isinstance(value, numbers.Number):
+        raise TypeError("%s must be a complex number, not %s" % (what, type(value).__name__))
+    return complex(value)
+
+
+def _is_array(value):
+    """Whether value is an array to read entry by entry: a sequence (list,
+    tuple, array.array, range) or an array object (numpy's, anything with
+    __array__) of at least one dimension. Not str, bytes or bytearray, nor a
+    set, dict or iterator: iterating those gives characters, byte values, keys
+    or an arbitrary order, never the numbers meant."""
+    if type(value) in (list, tuple):  # the usual answers first: callbacks' results come here
+        return True
+    if isinstance(value, (float, int, str, bytes, bytearray)) or getattr(value, "ndim", 1) == 0:
+        return False
+    return isinstance(value, collections.abc.Sequence) or hasattr(value, "__array__")
+
+
+def _array(value, what):
+    """value itself if _is_array(value), else TypeError."""
+    if not _is_array(value):
+        raise TypeError("%s must be a sequence or array of numbers, not %s" % (what, type(value).__name__))
+    return value
+
+
+def _nested(values, what, convert=_real):
+    """values, an array (of arrays ...) of numbers, as nested lists of
+    convert(entry, what): what list mode reads, and numpy mode where numpy
+    could only make an array of objects (2**70, None, a Fraction)."""
+    return [_nested(v, what, convert) if _is_array(v) else convert(v, what)
+            for v in _array(values, what)]
+
+
+def _shape(nested):
+    """The shape of a result of _nested, as numpy would give it ("ragged"
+    where the rows differ)."""
+    if not isinstance(nested, list):
+        return ()
+    inner = {_shape(v) for v in nested}
+    return (len(nested),) + (inner.pop() if len(inner) == 1 else ("ragged",) if inner else ())
+
+
+def _reals(values, what):
+    """values, a one-dimensional array of real numbers, as a list of floats.
+    The same checks in both modes (list-mode arguments, callback results)."""
+    if type(values) in (list, tuple) and all(isinstance(v, float) for v in values):
+        return list(values)  # nothing to check: the usual gradient's result, on the hot path
+    flat = _nested(values, what)
+    if any(isinstance(v, list) for v in flat):
+        raise ValueError("%s must be one-dimensional, not of shape %s" % (what, _shape(flat)))
+    return flat
 
 
 def _c_string(value, what):
@@ -348,8 +404,11 @@ def methods() -> List[Method]:
 def _real_array(values, what, kinds="iuf"):
     """values as a numpy array of real (or, with kinds "iufc", complex)
     numbers: TypeError for strings, objects, booleans and (unless allowed)
-    complex numbers, which numpy would otherwise convert or truncate."""
-    a = np.asarray(values)
+    complex numbers, which numpy would otherwise convert or truncate, and
+    for what list mode refuses (a set, a dict, bytes)."""
+    a = np.asarray(_array(values, what))
+    if a.dtype == object:  # each entry through the scalar check, as in list mode
+        a = np.asarray(_nested(values, what, _complex if "c" in kinds else _real))
     if a.dtype.kind not in kinds:
         raise TypeError("%s must be %s numbers, not an array of %s"
                         % (what, "complex" if "c" in kinds else "real", a.dtype))
@@ -362,12 +421,13 @@ def _doubles_in(values, what="values"):
     real array (float32, integers, a strided view) is copied."""
     if np is not None:
         a = values
-        if not (isinstance(a, np.ndarray) and a.dtype == np.float64 and a.flags.c_contiguous):
-            a = np.ascontiguousarray(_real_array(values, what), dtype=np.float64)
-        if a.ndim != 1:
-            raise ValueError("%s must be one-dimensional, not of shape %s" % (what, a.shape))
+        if not (isinstance(a, np.ndarray) and a.ndim == 1 and a.dtype == np.float64 and a.flags.c_contiguous):
+            a = _real_array(values, what)
+            if a.ndim != 1:
+                raise ValueError("%s must be one-dimensional, not of shape %s" % (what, a.shape))
+            a = np.ascontiguousarray(a, dtype=np.float64)
         return a.ctypes.data_as(_lib.c_double_p), a.size, a
-    vals = [_real(v, what) for v in values]
+    vals = _reals(values, what)
     buf = (c_double * len(vals))(*vals)
     return buf, len(vals), buf
 
@@ -389,7 +449,7 @@ def _doubles_out(n, out=None):
 
 
 def _int32s(values, what):
-    vals = [_integer(v, what, "int32") for v in values]
+    vals = [_integer(v, what, "int32") for v in _array(values, what)]
     return (c_int32 * max(len(vals), 1))(*vals), len(vals)
 
 
@@ -436,12 +496,14 @@ class Trajectory:
                                                  ", casimirs" if self.casimirs is not None else "")
 
 
-def _destroy(handle, keep):
-    # keep holds the ctypes callbacks until the handle that calls them is gone.
-    status = lib.lpi_destroy(handle)
-    if status == 0:
-        del keep[:]
-    return status
+def _destroy(handle):
+    # A system's finalizer: it holds the handle only. The ctypes callbacks stay
+    # on the system (_keep), so that a cycle through them and the user's
+    # callables (a bound method of the system's owner) is collectable; the
+    # finalizer's weakref callback runs before gc clears any object of the
+    # cycle, and the library calls callbacks only inside a call made through
+    # the live system, so none is freed while the handle could call it.
+    return lib.lpi_destroy(handle)
 
 
 class System:
@@ -463,12 +525,16 @@ class System:
     def __init__(self, create: str, *args: Any) -> None:
         handle = ctypes.c_void_p()
         _check_free(getattr(lib, create)(byref(handle), *args))
+        self._own(handle)
+
+    def _own(self, handle):
+        """Takes charge of a new handle (from a create function or lpi_load*)."""
         self._handle = handle
-        self._keep = []        # ctypes callbacks the library holds
+        self._keep = []        # ctypes callbacks the library holds, until it is destroyed
         self._pending = []     # exception raised inside a callback during the current call
         self._threads = 1
         self._seconds_per_step = None  # measured by step(), for the SIGINT observer
-        self._finalizer = weakref.finalize(self, _destroy, handle, self._keep)
+        self._finalizer = weakref.finalize(self, _destroy, handle)  # not _keep: see _destroy
 
     # lifetime
     def close(self) -> None:
@@ -483,10 +549,11 @@ class System:
         if not self._finalizer.alive:
             return
         self._finalizer.detach()
-        status = _destroy(self._handle, self._keep)
-        if status != 0:
-            self._finalizer = weakref.finalize(self, _destroy, self._handle, self._keep)
+        status = _destroy(self._handle)
+        if status != 0:  # BUSY: the handle and its callbacks stay as they were
+            self._finalizer = weakref.finalize(self, _destroy, self._handle)
             _raise(status, _text(lib.lpi_last_error(self._handle)))
+        del self._keep[:]  # nothing can call them now
 
     @property
     def closed(self) -> bool:
@@ -847,8 +914,7 @@ class System:
         dt = _real(dt, "dt")
         if not math.isfinite(dt) or dt == 0.0:
             raise ValueError("dt must be finite and nonzero, not %r" % dt)
-        times = [_real(t, "t_eval entry") for t in (t_eval.tolist() if np is not None
-                                                   and isinstance(t_eval, np.ndarray) else t_eval)]
+        times = _reals(t_eval, "t_eval")
         start = self.time
         counts, previous = [], 0
         for t in times:
@@ -1038,11 +1104,7 @@ class System:
         classes = {"sine-euler": SineEuler, "rigid-body": RigidBody, "pendulum": Pendulum}
         kind = classes[_text(lib.lpi_kind(handle))]
         self = kind.__new__(kind)
-        self._handle = handle
-        self._keep, self._pending = [], []
-        self._threads = 1
-        self._seconds_per_step = None
-        self._finalizer = weakref.finalize(self, _destroy, handle, self._keep)
+        self._own(handle)
         return self
 
     # copies and pickles go through a checkpoint
@@ -1156,7 +1218,7 @@ class Generic(System):
         if _create is not None:
             super().__init__(_create)
             return
-        rows = [tuple(b) for b in brackets]
+        rows = [tuple(_array(b, "bracket")) for b in _array(brackets, "brackets")]
         if any(len(r) != 4 for r in rows):
             raise ValueError("each bracket is (i, j, k, c)")
         i, nnz = _int32s([r[0] for r in rows], "bracket index i")
@@ -1201,14 +1263,14 @@ class Generic(System):
         idx, n = _int32s(indices, "piece index")
 
         def grad_body(m, x, out, user):
-            g = gradient(_callback_view(x, m))
+            g = _reals(gradient(_callback_view(x, m)), "gradient's result")
             if len(g) != m:
                 raise ValueError("gradient returned %d values for %d indices" % (len(g), m))
             for q in range(m):
-                out[q] = float(g[q])
+                out[q] = g[q]
 
         def energy_body(m, x, out, user):
-            out[0] = float(energy(_callback_view(x, m)))
+            out[0] = _real(energy(_callback_view(x, m)), "energy's result")
 
         g_fn = _lib.GRADIENT_FN(self._guard(grad_body))
         e_fn = _lib.ENERGY_FN(self._guard(energy_body))
@@ -1224,7 +1286,7 @@ class Generic(System):
             ``casimir(x)`` of the full state returns a float.
         """
         def body(dim, x, out, user):
-            out[0] = float(casimir(_callback_view(x, dim)))
+            out[0] = _real(casimir(_callback_view(x, dim)), "Casimir's result")
 
         fn = _lib.CASIMIR_FN(self._guard(body))
         self._call("lpi_add_casimir", fn, None)
@@ -1283,13 +1345,13 @@ class Moments(Generic):
         dh : callable
             ``dh(u)``, its derivative H'(u).
         """
-        def scalar_body(f):
+        def scalar_body(f, what):
             def body(u, out, user):
-                out[0] = float(f(u))
+                out[0] = _real(f(u), what)
             return body
 
-        h_fn = _lib.SCALAR_FN(self._guard(scalar_body(h)))
-        dh_fn = _lib.SCALAR_FN(self._guard(scalar_body(dh)))
+        h_fn = _lib.SCALAR_FN(self._guard(scalar_body(h, "h's result")))
+        dh_fn = _lib.SCALAR_FN(self._guard(scalar_body(dh, "dh's result")))
         self._call("lpi_moments_add_product_piece", h_fn, dh_fn, None)
         self._keep.extend((h_fn, dh_fn))
 
@@ -1353,11 +1415,25 @@ class SineEuler(System):
         if tuple(shape) != (N, N):
             _raise(STATUS["LPI_ERR_SIZE"], "%s must be %d x %d, not of shape %s" % (what, N, N, tuple(shape)))
 
-    @staticmethod
-    def _rows_shape(rows: Any) -> Tuple[Any, ...]:
-        rows = list(rows)
-        lengths = {len(r) for r in rows}
-        return (len(rows), lengths.pop()) if len(lengths) == 1 else (len(rows), "ragged")
+    def _square_in(self, values: Any, what: str, complex_: bool = False) -> Tuple[Any, int, Any]:
+        """(pointer, number of doubles, keep-alive) for an N x N array of real
+        numbers, or of complex numbers as (re, im) pairs with complex_. A
+        C-contiguous float64 (complex128) numpy array is passed as it is."""
+        if np is not None:
+            dtype = np.complex128 if complex_ else np.float64
+            a = values
+            if not (isinstance(a, np.ndarray) and a.ndim == 2 and a.dtype == dtype
+                    and a.flags.c_contiguous):
+                a = np.ascontiguousarray(_real_array(values, what, "iufc" if complex_ else "iuf"), dtype=dtype)
+            self._check_square(a.shape, what)
+            return a.ctypes.data_as(_lib.c_double_p), a.size * (2 if complex_ else 1), a
+        rows = _nested(values, what, _complex if complex_ else _real)
+        self._check_square(_shape(rows), what)
+        flat = [v for row in rows for v in row]
+        if complex_:
+            flat = [part for z in flat for part in (z.real, z.imag)]
+        buf = (c_double * max(len(flat), 1))(*flat)
+        return buf, len(flat), buf
 
     def set_modes(self, modes: Any) -> None:
         """Set the modes (checked Hermitian, then symmetrised); the time becomes 0.
@@ -1374,24 +1450,8 @@ class SineEuler(System):
         InvalidArgumentError
             Not Hermitian; the state is unchanged.
         """
-        if np is not None:
-            a = modes
-            if not (isinstance(a, np.ndarray) and a.dtype == np.complex128 and a.flags.c_contiguous):
-                a = np.ascontiguousarray(_real_array(modes, "modes", "iufc"), dtype=np.complex128)
-            self._check_square(a.shape, "modes")
-            self._call("lpi_sine_euler_set_modes", a.ctypes.data_as(_lib.c_double_p), 2 * a.size)
-            return
-        modes = [list(row) for row in modes]
-        self._check_square(self._rows_shape(modes), "modes")
-        flat = []
-        for row in modes:
-            for z in row:
-                if isinstance(z, (bool, str, bytes)) or not isinstance(z, numbers.Number):
-                    raise TypeError("modes must be complex numbers, not %s" % type(z).__name__)
-                z = complex(z)
-                flat.extend((z.real, z.imag))
-        buf = (c_double * max(len(flat), 1))(*flat)
-        self._call("lpi_sine_euler_set_modes", buf, len(flat))
+        ptr, n, _keep = self._square_in(modes, "modes", complex_=True)
+        self._call("lpi_sine_euler_set_modes", ptr, n)
 
     modes = property(get_modes, set_modes)
 
@@ -1426,14 +1486,7 @@ class SineEuler(System):
         SizeError
             Not N x N.
         """
-        if np is not None:
-            a = _real_array(w, "grid")
-            self._check_square(a.shape, "grid")
-            ptr, n, _keep = _doubles_in(a.astype(np.float64).reshape(-1), "grid")
-        else:
-            w = [list(row) for row in w]
-            self._check_square(self._rows_shape(w), "grid")
-            ptr, n, _keep = _doubles_in([v for row in w for v in row], "grid")
+        ptr, n, _keep = self._square_in(w, "grid")
         self._call("lpi_sine_euler_set_grid", ptr, n)
 
     grid = property(get_grid, set_grid)
@@ -1553,31 +1606,10 @@ class SineEuler(System):
         InvalidArgumentError
             lam not symmetric or f not Hermitian; nothing is changed.
         """
-        N = self.N
-        if np is not None:
-            a = _real_array(lam, "lam")
-            self._check_square(a.shape, "lam")
-            lam_ptr, n_lam, _keep_lam = _doubles_in(a.astype(np.float64).reshape(-1), "lam")
-        else:
-            rows = [list(row) for row in lam]
-            self._check_square(self._rows_shape(rows), "lam")
-            lam_ptr, n_lam, _keep_lam = _doubles_in([v for row in rows for v in row], "lam")
+        lam_ptr, n_lam, _keep_lam = self._square_in(lam, "lam")
         f_ptr, n_f, _keep_f = None, 0, None
         if f is not None:
-            if np is not None:
-                b = np.ascontiguousarray(_real_array(f, "f", "iufc"), dtype=np.complex128)
-                self._check_square(b.shape, "f")
-                f_ptr, n_f, _keep_f = b.ctypes.data_as(_lib.c_double_p), 2 * b.size, b
-            else:
-                rows = [list(row) for row in f]
-                self._check_square(self._rows_shape(rows), "f")
-                flat = []
-                for z in (z for row in rows for z in row):
-                    if isinstance(z, (bool, str, bytes)) or not isinstance(z, numbers.Number):
-                        raise TypeError("f must be complex numbers, not %s" % type(z).__name__)
-                    flat.extend((complex(z).real, complex(z).imag))
-                f_ptr, n_f = (c_double * (2 * N * N))(*flat), 2 * N * N
-                _keep_f = f_ptr
+            f_ptr, n_f, _keep_f = self._square_in(f, "f", complex_=True)
         self._call("lpi_sine_euler_set_hamiltonian", lam_ptr, n_lam, f_ptr, n_f)
 
     def stream_function(self) -> Any:

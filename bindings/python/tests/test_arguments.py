@@ -146,6 +146,66 @@ class TestArraysAndStrings(unittest.TestCase):
                     b.state = bad
                 self.assertEqual(as_list(b.state), state)
 
+    def test_arrays_are_sequences_in_both_modes(self):
+        # Iterating these gives byte values, keys, characters or an arbitrary
+        # order: refused alike with and without numpy, wherever an array is taken.
+        not_arrays = (b"abc", bytearray(b"abc"), {1.0: "a", 2.0: "b", 3.0: "c"}, {1.0, 2.0, 3.0},
+                      frozenset((1.0, 2.0, 3.0)), "123", iter([1.0, 2.0, 3.0]), 5.0, None)
+        with rigid_body() as b:
+            state, t = as_list(b.state), b.time
+            for bad in not_arrays:
+                for refused in (lambda: setattr(b, "state", bad), lambda: b.set_composition(bad),
+                                lambda: b.integrate(bad, 0.5)):
+                    with self.assertRaises(TypeError, msg=repr(bad)):
+                        refused()
+                self.assertEqual(as_list(b.state), state)
+                self.assertEqual(b.time, t)
+            for bad in ([b"\x01", 0.0, 0.0], [{1.0}, 0.0, 0.0], [{1.0: 0}, 0.0, 0.0]):
+                with self.assertRaises(TypeError, msg=repr(bad)):
+                    b.state = bad
+            for bad in ([[1.0, 0.5, -0.3]], [[1.0], 0.5, -0.3]):
+                with self.assertRaises(ValueError, msg=repr(bad)):
+                    b.state = bad
+            b.state = [2 ** 70, 0, 0]  # a real number, exact as a double
+            self.assertEqual(as_list(b.state), [2.0 ** 70, 0.0, 0.0])
+            with self.assertRaises(OverflowError):
+                b.state = [2 ** 1100, 0, 0]
+            self.assertEqual(as_list(b.state), [2.0 ** 70, 0.0, 0.0])
+            sol = b.integrate((b.time, b.time + 0.5), 0.5)
+            self.assertEqual(len(sol), 2)
+        g = lp.Generic(3, SO3)
+        for bad in (b"\x00", {0}, "0"):
+            with self.assertRaises(TypeError, msg=repr(bad)):
+                g.add_piece(bad, lambda x: [x[0]], lambda x: 0.0)
+            with self.assertRaises(TypeError, msg=repr(bad)):
+                g.poisson_rank(bad)
+        for bad in ([b"\x00\x01\x02\x01"], {(0, 1, 2, -1.0)}, [{0: 0, 1: 1, 2: 2, -1.0: 3}]):
+            with self.assertRaises(TypeError, msg=repr(bad)):
+                lp.Generic(3, bad)
+        self.assertEqual(g.casimir_count, 0)
+
+    def test_sine_euler_arrays_in_both_modes(self):
+        s = sine_euler_or_skip(self, 3)
+        with s:
+            before = [as_list(row) for row in s.grid]
+            lam = [[0.0, 1.0, 1.0], [1.0, 0.5, 0.5], [1.0, 0.5, 0.5]]
+            for bad in ([b"\x01\x02\x03"] * 3, [{1.0, 2.0, 3.0}] * 3, b"abc", {0: [1.0] * 3},
+                        [["1", "2", "3"]] * 3):
+                with self.assertRaises(TypeError, msg=repr(bad)):
+                    s.grid = bad
+                with self.assertRaises(TypeError, msg=repr(bad)):
+                    s.modes = bad
+                with self.assertRaises(TypeError, msg=repr(bad)):
+                    s.set_hamiltonian(bad)
+                with self.assertRaises(TypeError, msg=repr(bad)):
+                    s.set_hamiltonian(lam, bad)
+            for bad in ([[[1.0]] * 3] * 3, [1.0] * 9):
+                with self.assertRaises(lp.SizeError, msg=repr(bad)):
+                    s.grid = bad
+            self.assertEqual([as_list(row) for row in s.grid], before)
+            s.grid = [[2 ** 70, 0, 0], [0, 0, 0], [0, 0, 0]]
+            self.assertAlmostEqual(as_list(s.grid[0])[0] / 2.0 ** 70, 1.0, places=12)
+
     def test_numpy_arrays_of_other_kinds(self):
         if np is None:
             self.skipTest("numpy not available")

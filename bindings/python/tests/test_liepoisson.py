@@ -6,6 +6,8 @@ import os
 import random
 import tempfile
 import unittest
+import unittest.mock
+import weakref
 
 import liepoisson as lp
 
@@ -200,6 +202,54 @@ class TestRigidBody(unittest.TestCase):
         gc.collect()
         self.assertFalse(fin.alive)  # the finaliser released the handle
 
+    def test_system_in_a_cycle_through_its_callbacks_is_freed(self):
+        class Model:
+            """Owns the system and gives it its own methods: a reference
+            cycle through the ctypes callbacks, which gc must collect."""
+            def __init__(self):
+                self.sys = lp.Generic(3, SO3)
+                self.sys.add_piece([0], self.grad, self.energy)
+                self.sys.add_casimir(self.casimir)
+
+            def grad(self, x):
+                return [x[0]]
+
+            def energy(self, x):
+                return 0.5 * x[0] ** 2
+
+            def casimir(self, x):
+                return sum(v * v for v in x)
+
+        gc.collect()
+        destroyed = []
+        real_destroy = lp.lib.lpi_destroy
+
+        def spy(handle):
+            status = real_destroy(handle)
+            destroyed.append((handle.value, status))
+            return status
+
+        with unittest.mock.patch.object(lp.lib, "lpi_destroy", spy):
+            m = Model()
+            m.sys.state = [1.0, 0.5, -0.3]
+            m.sys.step(0.1, 3)
+            handle = m.sys._handle.value
+            model, system = weakref.ref(m), weakref.ref(m.sys)
+            del m
+            gc.collect()
+            self.assertIsNone(system())
+            self.assertIsNone(model())
+            self.assertEqual([st for h, st in destroyed if h == handle], [lp.LPI_OK])
+            # close() lets go of the callbacks: the owner goes without gc
+            m = Model()
+            model = weakref.ref(m)
+            with m.sys as g:
+                g.state = [1.0, 0.5, -0.3]
+                self.assertEqual(len(g.casimirs()), 1)
+            del m
+            self.assertIsNone(model())
+            self.assertTrue(g.closed)
+
 
 class TestGeneric(unittest.TestCase):
     def test_python_callbacks_match_the_built_in(self):
@@ -293,6 +343,46 @@ class TestGeneric(unittest.TestCase):
         with self.assertRaises(lp.LiePoissonError):
             g3.step(0.1)
         self.assertEqual(as_list(g3.state), [1.0, 0.5, -0.3])
+
+    def test_callback_results_must_be_numbers(self):
+        # float() would take "5", b"5" and True; the binding's own check refuses them
+        def fails(make, call):
+            g = make()
+            with self.assertRaises(lp.CallbackError) as cm:
+                call(g)
+            self.assertIsInstance(cm.exception.__cause__, TypeError)
+
+        def generic(grad=lambda x: [x[0]], energy=lambda x: 0.5 * x[0] ** 2, casimir=None):
+            def make():
+                g = lp.Generic(3, SO3)
+                g.add_piece([0], grad, energy)
+                if casimir is not None:
+                    g.add_casimir(casimir)
+                g.state = [1.0, 0.5, -0.3]
+                return g
+            return make
+
+        for bad in ("5", b"5", {0: 1.0}, {1.0}, True, [True], ["5"], None):
+            fails(generic(grad=lambda x, bad=bad: bad), lambda g: g.step(0.1))
+        for bad in ("2.5", b"2", True, 1j, [1.0], None):
+            fails(generic(energy=lambda x, bad=bad: bad), lambda g: g.energy())
+        for bad in ("7", False):
+            fails(generic(casimir=lambda x, bad=bad: bad), lambda g: g.casimirs())
+
+        def moments(h, dh):
+            def make():
+                m = lp.Moments()
+                m.add_product_piece(h, dh)
+                m.state = [1.0, 0.2, 1.0, 3.0, 0.1, 1.0, 0.1, 3.0]
+                return m
+            return make
+
+        fails(moments(lambda u: True, lambda u: 0.5), lambda m: m.energy())
+        fails(moments(lambda u: 0.5 * u, lambda u: "0.5"), lambda m: m.step(0.1))
+        # tuples and numpy numbers are fine
+        g = generic(grad=lambda x: (x[0],), energy=lambda x: x[0] ** 2 / 2)()
+        g.step(0.1)
+        self.assertEqual(g.energy(), as_list(g.state)[0] ** 2 / 2)
 
     def test_not_abelian_and_bad_brackets(self):
         g = lp.Generic(3, SO3)
