@@ -5,7 +5,7 @@
 # file that h5py (and xarray, when installed) reads. Checked against numpy
 # when a Python with numpy is found (the energy recomputed from the vorticity
 # snapshot by FFT), byte by byte otherwise. --init takes an N x N grid from
-# .npy (float64, float32, either order) or from a run's .h5, and refuses a
+# .npy (float64, float32, int64, int32, either order) or from a run's .h5, and refuses a
 # bad file with exit status 1 (unreadable) or 2 (no usable N x N grid).
 # Exits 77 without sine-Euler (FFTW).
 set -eu
@@ -65,12 +65,22 @@ refused 2 "exclude" sine-euler --init "$v" --resume "$out/x.lpi"
 if [ "$have_h5" = 1 ]; then
     # A run's .h5: the last snapshot; --N must agree with it.
     refused 2 "but --N is 11" sine-euler --N 11 --init "$out/h5/sine-euler.h5"
-    refused 2 "not a sine-Euler scene" rigid-body --init "$out/h5/sine-euler.h5"
+    refused 2 "--init: rigid-body does not take it" rigid-body --init "$out/h5/sine-euler.h5"
     head -c 3000 "$out/h5/sine-euler.h5" > "$out/truncated.h5"
     refused 1 "HDF5 cannot" sine-euler --init "$out/truncated.h5"
     "$lpi" run rigid-body --steps 2 --format h5 --out "$out/rb" >/dev/null
     refused 2 "no dataset /init or /vorticity" sine-euler --init "$out/rb/rigid-body.h5"
 fi
+# An integer grid (NumPy's int32, written here byte by byte: 3 x 3, the
+# header padded to 64 bytes) starts a run, and the help says that it does.
+dict="{'descr': '<i4', 'fortran_order': False, 'shape': (3, 3), }"
+pad=$((128 - 10 - ${#dict} - 1))
+{ printf '\223NUMPY\001\000\166\000%s%*s\n' "$dict" "$pad" ""
+  for k in 0 1 2 3 4 5 6 7 8; do printf "\\$(printf %o $k)\\000\\000\\000"; done; } > "$out/int3.npy"
+[ "$(wc -c < "$out/int3.npy")" -eq $((128 + 36)) ] || fail "int3.npy: the test wrote $(wc -c < "$out/int3.npy") bytes"
+"$lpi" run sine-euler --init "$out/int3.npy" --steps 1 --out "$out/int3" >/dev/null 2>"$out/err" ||
+    { cat "$out/err"; fail "lpi run --init with an int32 grid"; }
+"$lpi" run --help | grep -q "int64 or int32" || fail "lpi run --help does not name the integer dtypes --init reads"
 
 if [ -z "$python" ]; then
     echo "PASS (byte level; no Python with numpy): lpi run data and --init"
@@ -139,10 +149,12 @@ if "h5" in runs:
 
 # --init: a grid w(x, y) = cos(x) + 0.5 sin(2 y) + 0.3 cos(x + y): the run's
 # first snapshot is that grid and its energy the energy computed here, for
-# float64 and float32, C and Fortran order.
+# float64 and float32, C and Fortran order; integer grids (as documented) are
+# read as float64.
 a = np.arange(N) * 2 * np.pi / N
 grid = np.cos(a)[:, None] + 0.5 * np.sin(2 * a)[None, :] + 0.3 * np.cos(a[:, None] + a[None, :])
-cases = {"f8": grid, "f4": grid.astype(np.float32), "fortran": np.asfortranarray(grid)}
+cases = {"f8": grid, "f4": grid.astype(np.float32), "fortran": np.asfortranarray(grid),
+         "i4": np.round(10 * grid).astype(np.int32), "i8": np.round(10 * grid).astype(np.int64)}
 for name, g in cases.items():
     path = os.path.join(out, f"init_{name}.npy")
     np.save(path, g)
@@ -153,7 +165,9 @@ for name, g in cases.items():
     expected = np.asarray(g, dtype=np.float64)
     assert np.max(np.abs(d["vorticity"][0] - expected)) < 1e-13, name
     assert abs(d["energy"][0] - energy(expected)) < 1e-13 * energy(expected), name
-print("--init: .npy float64, float32 and Fortran order start from the given grid")
+usage = subprocess.run([lpi, "run", "--help"], check=True, capture_output=True).stdout.decode()
+assert "int64" in usage and "int32" in usage, "lpi run --help does not name the integer dtypes --init reads"
+print("--init: .npy float64, float32, int64, int32 and Fortran order start from the given grid")
 bad = os.path.join(out, "nan.npy")
 g = grid.copy(); g[2, 3] = np.nan
 np.save(bad, g)

@@ -1,7 +1,8 @@
 #!/bin/sh
 # The command's help is true: every scene lpi --help lists runs (tiny sizes;
-# a scene the build lacks says so), the commands it names exist, and each
-# subcommand's --help describes that subcommand.
+# a scene the build lacks says so), the commands it names exist, each
+# subcommand's --help describes that subcommand, the scenes and options
+# agree with man1, and help that cannot be written is a failure.
 set -eu
 lpi="$1"; out="$2"
 rm -rf "$out"; mkdir -p "$out"
@@ -9,10 +10,13 @@ rm -rf "$out"; mkdir -p "$out"
 scenes=$(sed -n '/^scenes:/,$p' "$out/help" | sed -n 's/^  \([a-z0-9-]*\) .*/\1/p')
 [ -n "$scenes" ] || { echo "lpi --help lists no scene"; exit 1; }
 for scene in $scenes; do
+    # The options in brackets are those the scene takes (others are refused).
+    line=$(grep "^  $scene " "$out/help")
+    size=; case "$line" in *"["*--N*"]"*) size="--N 5";; esac
     if grep -q "^  $scene .*(lpi report only)" "$out/help"; then
-        set -- report "$scene" --N 5 --T 5 --out "$out/$scene"
+        set -- report "$scene" $size --T 5 --out "$out/$scene"
     else
-        set -- run "$scene" --steps 3 --N 5 --out "$out/$scene"
+        set -- run "$scene" --steps 3 $size --out "$out/$scene"
     fi
     rc=0; "$lpi" "$@" >"$out/$scene.log" 2>&1 || rc=$?
     if [ "$rc" -eq 1 ] && grep -q "not available in this build" "$out/$scene.log"; then
@@ -38,4 +42,50 @@ for method in $(sed -n '2,$s/ .*//p' "$out/methods"); do
     "$lpi" run pendulum --method "$method" --steps 2 --out "$out/m" >/dev/null ||
         { echo "lpi methods lists $method, which lpi run refuses"; exit 1; }
 done
-echo "lpi --help: every scene runs, every command exists"
+# The scenes and options lpi --help and each command's --help list are the
+# ones man1 documents, both ways, so that neither can drift from the other.
+man1="$(cd "$(dirname "$0")/.." && pwd)/man/man1/lpi.1"
+# The words after the .TP tags of man1's section (.SH) or subsection (.SS) $1.
+man_tags() {
+    awk -v name="$1" '/^\.S[HS] / { on = (substr($0, 5) == name); next }
+        on && tag { print } { tag = on && $0 == ".TP" }' "$man1" | sed 's/\\-/-/g'
+}
+same_list() {  # same_list WHAT HELP-LIST MAN-LIST
+    if [ "$2" != "$3" ]; then
+        echo "$1 differ between the help and man1 (< help, > man1):"
+        printf '%s\n' "$2" >"$out/from-help"; printf '%s\n' "$3" >"$out/from-man"
+        diff "$out/from-help" "$out/from-man"; exit 1
+    fi
+}
+same_list "the scenes" "$(printf '%s\n' $scenes | sort)" \
+    "$(man_tags SCENES | sed -n 's/^\.B \([a-z0-9-]*\)$/\1/p' | sort)"
+for command in run report; do
+    same_list "the options of lpi $command" \
+        "$(sed -n 's/^  \(--[a-z][a-z-]*\).*/\1/p' "$out/$command.help" | sort -u)" \
+        "$(man_tags "lpi $command" | grep -o -- '--[a-z][a-z-]*' | sort -u)"
+done
+# Every option the help lists is one lpi run reads (a missing value, not an
+# unknown option).
+for option in $(sed -n 's/^  \(--[a-z][a-z-]*\).*/\1/p' "$out/run.help"); do
+    "$lpi" run rigid-body "$option" >/dev/null 2>"$out/option.err" && true
+    grep -q -e "$option needs a value" "$out/option.err" ||
+        { echo "lpi run --help lists $option, which lpi run does not read:"; cat "$out/option.err"; exit 1; }
+done
+
+# Standard output that cannot be written fails the command (exit status 1);
+# an argument after --version or --help is refused (2).
+if [ -w /dev/full ]; then
+    for command in --version --help "run --help" methods; do
+        rc=0; "$lpi" $command >/dev/full 2>"$out/full.err" || rc=$?
+        [ "$rc" -eq 1 ] && grep -q "standard output" "$out/full.err" ||
+            { echo "lpi $command >/dev/full: exit status $rc, expected 1 with a message"; cat "$out/full.err"; exit 1; }
+    done
+else
+    echo "not checked: output to /dev/full (none here)"
+fi
+for command in --version --help; do
+    rc=0; "$lpi" $command --bogus >/dev/null 2>"$out/extra.err" || rc=$?
+    [ "$rc" -eq 2 ] && grep -q -e "--bogus" "$out/extra.err" ||
+        { echo "lpi $command --bogus: exit status $rc, expected 2 naming --bogus"; exit 1; }
+done
+echo "lpi --help: every scene runs, every command exists, scenes and options as in man1"

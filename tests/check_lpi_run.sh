@@ -56,6 +56,22 @@ refused no-such-case stress no-such-case
 refused --bogus stress --bogus
 refused argument methods extra
 refused no-such-command no-such-command
+# Numbers are decimal: strtod's hexadecimal is refused.
+refused --steps $rb --steps 0x10
+refused --dt $rb --dt 0x1p-3 --steps 2
+# An option that would be ignored is refused, naming it: one that configures
+# other scenes, anything but --N, --steps, --dt and --out for rollup, and a
+# report option no reported scene takes.
+refused --kd $rb --kd 3
+refused --N $rb --N 5
+refused --inertia run sine-euler --N 5 --inertia 1,2,3 --out "$out/bad"
+refused --wisdom run pendulum --wisdom "$out/w" --out "$out/bad"
+refused --N run figure2 --N 5 --out "$out/bad"
+for option in "--every 3" "--threads 2" "--planning patient" "--snapshots 2" "--format npy" "--kd 2"; do
+    refused "${option% *}" run rollup --N 5 --steps 3 $option --out "$out/bad"
+done
+refused --N report rigid-body --N 5 --out "$out/bad"
+refused --T report pendulum --T 5 --out "$out/bad"
 
 # Every failure: non-zero. A checkpoint that cannot be written stops the run
 # before any step (it used to fail every save and still exit 0).
@@ -67,6 +83,35 @@ rc=0; "$lpi" run pendulum --resume "$out/no-such-file.lpi" --out "$out/f" >/dev/
 [ "$rc" -eq 1 ] || { echo "a missing checkpoint: exit status $rc"; exit 1; }
 rc=0; "$lpi" run rigid-body --dt 1e308 --steps 3 --out "$out/f" >/dev/null 2>&1 || rc=$?
 [ "$rc" -eq 1 ] || { echo "a step that overflows: exit status $rc"; exit 1; }
+# Output that cannot be written: exit status 1 and a message, never 0. An
+# --out that is a regular file fails at once, before the work.
+failed() {  # failed MESSAGE-PART lpi-arguments... (stdout to /dev/full when FULL=1)
+    what="$1"; shift
+    rc=0
+    stdout=/dev/null; [ "${FULL:-0}" = 1 ] && stdout=/dev/full
+    # A hang (lpi reading a FIFO) ends after a minute as a failure.
+    timeout 60 "$lpi" "$@" >$stdout 2>"$out.err" || rc=$?
+    [ "$rc" -eq 1 ] || { echo "lpi $*: exit status $rc, expected 1"; cat "$out.err"; exit 1; }
+    grep -q -e "$what" "$out.err" || { echo "lpi $*: no message with '$what':"; cat "$out.err"; exit 1; }
+}
+: > "$out/a-file"
+failed "not a directory" run pendulum --steps 3 --out "$out/a-file"
+failed "not a directory" report pendulum --out "$out/a-file"
+failed "not a directory" run rollup --N 5 --steps 3 --out "$out/a-file"
+if [ -w /dev/full ]; then
+    FULL=1 failed "standard output" run rigid-body --steps 100 --out "$out/f"
+    FULL=1 failed "standard output" stress --quick "pendulum near"
+    FULL=1 failed "standard output" methods
+fi
+# A size too large for memory: the library refuses it (exit status 1, its
+# message), never an abort from an allocation of lpi's own.
+for args in "run sine-euler --N 2147483647 --steps 1" "run sine-euler --N 99999 --steps 1" \
+    "run qg --N 2147483647 --steps 1" "run topography --N 99999 --steps 1" \
+    "run rollup --N 99999 --steps 1" "report sine-euler --N 99999"; do
+    rc=0; "$lpi" $args --out "$out/huge" >/dev/null 2>"$out.err" || rc=$?
+    [ "$rc" -eq 1 ] && ! grep -q "terminate called" "$out.err" ||
+        { echo "lpi $args: exit status $rc, expected 1"; cat "$out.err"; exit 1; }
+done
 
 # Sine-Euler runs where the build has it (FFTW); otherwise lpi says so. The
 # parts left out are named.
@@ -101,6 +146,15 @@ if [ "$have_sine_euler" = 1 ]; then
     refused --planning run sine-euler --planning exhaustive --out "$out/bad"
     refused --planning run sine-euler --planning "" --out "$out/bad"
     refused --planning $rb --planning measure
+    # Wisdom that cannot be written or read is a failed file (1), not a bad
+    # option; a FIFO is not read (FFTW would wait on it for ever).
+    failed "--wisdom" run sine-euler --N 5 --steps 3 --planning measure --wisdom "$out/no-such-dir/w" --out "$out/f"
+    echo "not wisdom" > "$out/bad.wisdom"
+    failed "--wisdom" run sine-euler --N 5 --steps 3 --wisdom "$out/bad.wisdom" --out "$out/f"
+    rm -f "$out/fifo.wisdom"
+    if mkfifo "$out/fifo.wisdom" 2>/dev/null; then
+        failed "not a regular file" run sine-euler --N 5 --steps 3 --wisdom "$out/fifo.wisdom" --out "$out/f"
+    fi
     # Measured plans differ from process to process; shared wisdom makes a
     # second run choose the first run's plans: the same bits.
     for run in 1 2; do

@@ -12,6 +12,8 @@
 #include <cstdlib>
 #include <ctime>
 #include <functional>
+#include <sys/stat.h>
+#include <cstring>
 #include <set>
 #include <string>
 #include <utility>
@@ -35,17 +37,43 @@ inline void check(int status, const lpi_system *sys, const char *what) {
     std::exit(1);
 }
 
+// Closes a file written with stdio: false when a write or the close failed
+// (a full disk may show only at the final flush, in fclose).
+inline bool close_written(FILE *f) {
+    const bool written = std::ferror(f) == 0;
+    return std::fclose(f) == 0 && written;
+}
+
+// Says on standard error that `path` was not written (errno: why); false.
+inline bool cannot_write(const std::string &path) {
+    std::fprintf(stderr, "lpi: cannot write %s: %s\n", path.c_str(), std::strerror(errno));
+    return false;
+}
+
+// Makes the output directory `dir` (one level), or finds it there: "" or why
+// not. Checked before anything is computed, so that a command whose output
+// cannot be written fails at once instead of after its work.
+inline std::string make_output_dir(const std::string &dir) {
+    if (mkdir(dir.c_str(), 0777) != 0 && errno != EEXIST) return dir + ": " + std::strerror(errno);
+    struct stat st;
+    if (stat(dir.c_str(), &st) != 0) return dir + ": " + std::strerror(errno);
+    if (!S_ISDIR(st.st_mode)) return dir + " exists and is not a directory";
+    return "";
+}
+
 // One strict reader of a command's arguments, used by every command for every
 // option: a value must be the whole text (no "10x", "", " 5"), numbers must be
-// finite and in range (no "nan", "1e400", 2^64), whole numbers whole ("2.9" is
-// refused, "1e6" accepted), and an option may be given once. Anything else
-// stops the command with a message and exit status 2.
+// decimal, finite and in range (no "0x10", "nan", "1e400", 2^64), whole
+// numbers whole ("2.9" is refused, "1e6" accepted), and an option may be
+// given once. Anything else stops the command with a message and exit status 2.
 class Arguments {
 public:
     Arguments(std::string command, int argc, char **argv)
         : command_(std::move(command)), argc_(argc), argv_(argv) {}
 
     bool done() const { return next_ >= argc_; }
+    // The options given with a value so far (for options a scene does not take).
+    const std::set<std::string> &given() const { return seen_; }
     // The next argument (an option name or an operand).
     std::string next() { return argv_[next_++]; }
 
@@ -122,14 +150,17 @@ public:
     }
 
 private:
-    // A finite number that is the whole text, neither overflowing nor underflowing.
+    // A finite decimal number that is the whole text, neither overflowing nor
+    // underflowing. strtod alone would also read hexadecimal ("0x10"), which
+    // the characters allowed here rule out.
     double real(const std::string &option, const std::string &text) const {
         const char *begin = text.c_str();
         char *end = nullptr;
         errno = 0;
         const double v = std::strtod(begin, &end);
-        if (text.empty() || std::isspace(static_cast<unsigned char>(text[0])) || end == begin || *end != '\0')
-            fail(option + ": '" + text + "' is not a number");
+        if (text.empty() || text.find_first_not_of("0123456789+-.eE") != std::string::npos || end == begin ||
+            *end != '\0')
+            fail(option + ": '" + text + "' is not a decimal number");
         if (!std::isfinite(v)) fail(option + ": " + text + " is not finite");
         if (errno == ERANGE) fail(option + ": " + text + " is out of the range of a double");
         return v;

@@ -46,6 +46,8 @@ std::vector<double> smooth_random_field(int N, double k0, std::uint64_t seed) {
     return w;
 }
 
+std::vector<double> smooth_field(int N) { return smooth_random_field(N, 3.0, 7); }
+
 std::vector<double> figure2_field() {
     const int N = 7;
     std::vector<double> w = smooth_random_field(N, 10.0, 1993);  // nearly flat spectrum

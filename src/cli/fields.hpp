@@ -12,6 +12,9 @@ namespace lpi_cli {
 // Hermitian (w_{-m} = conj w_m), w_0 = 0, scaled so that sum |w_m|^2 = 1.
 std::vector<double> smooth_random_field(int N, double k0, std::uint64_t seed);
 
+// The sine-Euler scenes' field: smooth_random_field(N, 3, 7).
+std::vector<double> smooth_field(int N);
+
 // The paper's Figure 2 field (N = 7): |w| = 1 over one mode of each pair +-m
 // (sum over all modes = 2) and H(0) = 0.75 exactly, by mixing the |m| = 1
 // modes of a random field with the others in the right proportion.

@@ -1,7 +1,5 @@
 // The paper's Figure 2 reproduced: sine-Euler at N = 7, leapfrog, dt = 0.05,
 // 10^5 steps (t = 5000), relative energy error and Casimir drift over time.
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,7 +12,7 @@
 
 namespace lpi_cli {
 
-void run_figure2(const std::string &out_dir) {
+bool run_figure2(const std::string &out_dir) {
     const int N = 7;
     const double dt = 0.05;
     const int64_t steps = 100000, every = 100;
@@ -29,10 +27,10 @@ void run_figure2(const std::string &out_dir) {
     std::printf("\n== figure2: McLachlan 1993, Figure 2. N = 7, leapfrog, dt = %g, %lld steps\n", dt,
                 static_cast<long long>(steps));
     std::printf("   field: |w| = 1 over one mode of each pair +-m (w_0 = 0), H(0) = %.15g\n", H0);
-    mkdir(out_dir.c_str(), 0777);
     const std::string csv = out_dir + "/figure2.csv";
     FILE *f = std::fopen(csv.c_str(), "w");
-    if (f) std::fprintf(f, "time,energy_error,c2_drift,spectrum_drift\n");
+    if (!f) return cannot_write(csv);
+    std::fprintf(f, "time,energy_error,c2_drift,spectrum_drift\n");
     double worst_first = 0.0, worst_second = 0.0, c2_drift = 0.0, spectrum_change = 0.0;
     const double t0 = cpu_seconds();
     for (int64_t done = 0; done < steps; done += every) {
@@ -46,10 +44,10 @@ void run_figure2(const std::string &out_dir) {
         }
         (done < steps / 2 ? worst_first : worst_second) =
             std::max(done < steps / 2 ? worst_first : worst_second, std::fabs(rel));
-        if (f) std::fprintf(f, "%.6g,%.6e,%.6e,%.6e\n", lpi_time(h.get()), rel, c2_drift, spectrum_change);
+        std::fprintf(f, "%.6g,%.6e,%.6e,%.6e\n", lpi_time(h.get()), rel, c2_drift, spectrum_change);
     }
     const double cpu = cpu_seconds() - t0;
-    if (f) std::fclose(f);
+    if (!close_written(f)) return cannot_write(csv);
     std::printf("   max |H - H0|/H0: %.3e over t in [0, 2500], %.3e over [2500, 5000]: %s\n",
                 worst_first, worst_second,
                 worst_second <= 1.5 * worst_first ? "bounded, no secular growth" : "GROWING");
@@ -59,13 +57,13 @@ void run_figure2(const std::string &out_dir) {
         std::printf("   spectrum of W (all N Casimirs): relative drift %.2e (%.2e per step)\n",
                     spectrum_change, spectrum_change / steps);
     std::printf("   %.2f CPU seconds (diagnostics included); wrote %s\n", cpu, csv.c_str());
+    if (!have_gnuplot()) {
+        std::printf("   gnuplot not found: no PNG\n");
+        return true;
+    }
     const std::string script = out_dir + "/figure2.gp";
     FILE *g = std::fopen(script.c_str(), "w");
-    if (!g || !have_gnuplot()) {
-        if (g) std::fclose(g);
-        std::printf("   gnuplot not found: no PNG\n");
-        return;
-    }
+    if (!g) return cannot_write(script);
     // The drift starts at round-off: its axis spans the decades from there.
     Range drift;
     drift.add(1e-16);
@@ -83,9 +81,12 @@ void run_figure2(const std::string &out_dir) {
                "lc rgb '#009e73' dt 2 lw 1.5 title 'spectrum of W'\nunset multiplot\n",
                csv.c_str(), csv.c_str());
     emit_figure(g, out_dir + "/figure2", 1000, 700, commands);
-    std::fclose(g);
-    if (run_gnuplot(script))
-        std::printf("   wrote %s/figure2.png and .svg\n", out_dir.c_str());
+    switch (finish_plot(g, script)) {
+    case Plot::drawn: std::printf("   wrote %s/figure2.png and .svg\n", out_dir.c_str()); return true;
+    case Plot::gnuplot_failed: std::printf("   gnuplot failed: see %s\n", script.c_str()); return true;
+    case Plot::not_written: return false;
+    }
+    return false;
 }
 
 }  // namespace lpi_cli

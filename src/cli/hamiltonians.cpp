@@ -1,6 +1,7 @@
 #include "hamiltonians.hpp"
 
 #include <cmath>
+#include <functional>
 #include <vector>
 
 #include "fields.hpp"
@@ -26,8 +27,21 @@ std::vector<double> lambda_of(int N, Weight weight) {
     return lambda;
 }
 
-Handle with_hamiltonian(int N, const std::vector<double> &lambda, const std::vector<double> &f) {
-    Handle h = sine_euler(N, smooth_random_field(N, 3.0, 7));
+// The scenes' field with lambda_n = weight(|n|^2) and, with `topography`,
+// over the smooth random topography h (f = -lambda h). lambda and f are made
+// once the system exists: the library refuses an N too large for memory
+// before lpi allocates N^2 of them.
+Handle with_hamiltonian(int N, const std::function<double(double)> &weight, bool topography) {
+    Handle h = sine_euler(N, smooth_field);
+    const std::vector<double> lambda = lambda_of(N, weight);
+    std::vector<double> f;
+    if (topography) {
+        f = smooth_random_field(N, 2.0, 11);  // the modes of h
+        for (std::size_t i = 0; i < lambda.size(); ++i) {
+            f[2 * i] *= -lambda[i];
+            f[2 * i + 1] *= -lambda[i];
+        }
+    }
     check(lpi_sine_euler_set_hamiltonian(h.get(), lambda.data(), lambda.size(), f.empty() ? nullptr : f.data(),
                                          f.size()),
           h.get(), "set Hamiltonian");
@@ -37,21 +51,15 @@ Handle with_hamiltonian(int N, const std::vector<double> &lambda, const std::vec
 }  // namespace
 
 Handle sqg_system(int N) {
-    return with_hamiltonian(N, lambda_of(N, [](double m2) { return 1.0 / std::sqrt(m2); }), {});
+    return with_hamiltonian(N, [](double m2) { return 1.0 / std::sqrt(m2); }, false);
 }
 
 Handle qg_system(int N, double kd) {
-    return with_hamiltonian(N, lambda_of(N, [kd](double m2) { return 1.0 / (m2 + kd * kd); }), {});
+    return with_hamiltonian(N, [kd](double m2) { return 1.0 / (m2 + kd * kd); }, false);
 }
 
 Handle topography_system(int N) {
-    const std::vector<double> lambda = lambda_of(N, [](double m2) { return 1.0 / m2; });
-    std::vector<double> f = smooth_random_field(N, 2.0, 11);  // the modes of h
-    for (std::size_t i = 0; i < lambda.size(); ++i) {
-        f[2 * i] *= -lambda[i];
-        f[2 * i + 1] *= -lambda[i];
-    }
-    return with_hamiltonian(N, lambda, f);
+    return with_hamiltonian(N, [](double m2) { return 1.0 / m2; }, true);
 }
 
 }  // namespace lpi_cli

@@ -2,8 +2,6 @@
 // over the whole run. Each method at its own step sizes, run to the final time
 // once per step, its maximum energy error and Casimir drift set against the CPU
 // time of the steps; tables, CSV files and plots.
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -76,14 +74,16 @@ std::string format_steps(const std::vector<double> &steps) {
     return text;
 }
 
-void write_long_csv(const std::string &base, const LongRunScene &scene, const std::vector<LongRow> &rows) {
-    FILE *f = std::fopen((base + ".csv").c_str(), "w");
-    FILE *g = std::fopen((base + "_history.csv").c_str(), "w");
-    if (!f || !g) {
-        std::fprintf(stderr, "lpi: cannot write %s.csv and %s_history.csv\n", base.c_str(), base.c_str());
-        if (f) std::fclose(f);
-        if (g) std::fclose(g);
-        return;
+// False, having said so, when a file was not written.
+bool write_long_csv(const std::string &base, const LongRunScene &scene, const std::vector<LongRow> &rows) {
+    const std::string csv = base + ".csv", history = base + "_history.csv";
+    FILE *f = std::fopen(csv.c_str(), "w");
+    if (!f) return cannot_write(csv);
+    FILE *g = std::fopen(history.c_str(), "w");
+    if (!g) {
+        cannot_write(history);
+        std::fclose(f);
+        return false;
     }
     std::fprintf(f, "scene,run,method,order,poisson,dt,steps,cpu_seconds,max_energy_error,"
                     "max_casimir_drift,final_casimir_drift,reached_time,status\n");
@@ -98,17 +98,17 @@ void write_long_csv(const std::string &base, const LongRunScene &scene, const st
             std::fprintf(g, "%d,%s,%.17g,%.10g,%.6e,%.6e\n", r.run, r.method.c_str(), r.dt, s.time,
                          s.energy_error, s.casimir_drift);
     }
-    std::fclose(f);
-    std::fclose(g);
+    const bool csv_written = close_written(f) || cannot_write(csv);
+    return (close_written(g) || cannot_write(history)) && csv_written;
 }
 
 // Max energy error and max Casimir drift against CPU time (one curve per
 // method through its step sizes), and both against time for the run of each
 // method whose CPU time is nearest `history_cpu`.
-bool plot_long(const std::string &base, const LongRunScene &scene, const std::vector<LongRow> &rows,
+Plot plot_long(const std::string &base, const LongRunScene &scene, const std::vector<LongRow> &rows,
                const std::vector<std::string> &methods, double history_cpu) {
     FILE *f = open_plot_script(base + ".gp");
-    if (!f) return false;
+    if (!f) return Plot::not_written;
     const char *energy_label = "|H(t) - H(0)| / |H(0)|";
     const char *casimir_label = "max_i |{/Symbol l}_i(t) - {/Symbol l}_i(0)| / max_i |{/Symbol l}_i(0)|";
     struct Panel {
@@ -189,13 +189,12 @@ bool plot_long(const std::string &base, const LongRunScene &scene, const std::ve
         commands += "\nunset key\n";
     }
     emit_figure(f, base + "_history", 1000, 900, commands + "unset multiplot\n");
-    std::fclose(f);
-    return run_gnuplot(base + ".gp");
+    return finish_plot(f, base + ".gp");
 }
 
 }  // namespace
 
-void run_long_scene(const LongRunScene &scene, const std::string &out_dir) {
+bool run_long_scene(const LongRunScene &scene, const std::string &out_dir) {
     measure_on_one_core();
     if (!(scene.final_time > 0.0) || !std::isfinite(scene.final_time)) {
         std::fprintf(stderr, "lpi report: %s needs --T > 0\n", scene.name.c_str());
@@ -269,9 +268,8 @@ void run_long_scene(const LongRunScene &scene, const std::string &out_dir) {
         std::printf("\n");
     }
 
-    mkdir(out_dir.c_str(), 0777);
     const std::string base = out_dir + "/" + scene.name;
-    write_long_csv(base, scene, rows);
+    if (!write_long_csv(base, scene, rows)) return false;
     std::printf("   wrote %s.csv and %s_history.csv (every sample of every run)\n", base.c_str(), base.c_str());
     // The history plot compares the methods at about equal cost: the
     // geometric mean of all successful runs' CPU times.
@@ -279,13 +277,23 @@ void run_long_scene(const LongRunScene &scene, const std::string &out_dir) {
     int count = 0;
     for (const LongRow &r : rows)
         if (r.status == LPI_OK && r.cpu > 0.0) log_sum += std::log(r.cpu), ++count;
-    if (!have_gnuplot())
+    if (!have_gnuplot()) {
         std::printf("   gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n");
-    else if (count > 0 && plot_long(base, scene, rows, methods, std::exp(log_sum / count)))
+        return true;
+    }
+    if (count == 0) {
+        std::printf("   no run succeeded: no plots\n");
+        return true;
+    }
+    switch (plot_long(base, scene, rows, methods, std::exp(log_sum / count))) {
+    case Plot::drawn:
         std::printf("   wrote %s_energy.png, %s_casimirs.png and %s_history.png\n", base.c_str(), base.c_str(),
                     base.c_str());
-    else
-        std::printf("   gnuplot failed: see %s.gp\n", base.c_str());
+        return true;
+    case Plot::gnuplot_failed: std::printf("   gnuplot failed: see %s.gp\n", base.c_str()); return true;
+    case Plot::not_written: return false;
+    }
+    return false;
 }
 
 }  // namespace lpi_cli

@@ -2,7 +2,10 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cerrno>
 #include <cstring>
+#include <exception>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -16,6 +19,7 @@ using namespace lpi_cli;
 
 namespace {
 
+// Each scene with, in brackets, the options that configure it.
 void print_scenes(FILE *to) {
     std::fprintf(to, "scenes:\n");
     for (const Scene &s : builtin_scenes()) {
@@ -23,7 +27,11 @@ void print_scenes(FILE *to) {
         if (s.run_own) notes += " (lpi run only)";
         else if (!s.create) notes += " (lpi report only)";
         if (!s.in_default_report && !s.run_own) notes += " (not in the default report)";
-        std::fprintf(to, "  %-16s %s%s\n", s.name.c_str(), s.description.c_str(), notes.c_str());
+        std::string options;
+        for (const std::string &option : s.options) options += (options.empty() ? " [" : " ") + option;
+        if (!options.empty()) options += "]";
+        std::fprintf(to, "  %-16s %s%s%s\n", s.name.c_str(), s.description.c_str(), options.c_str(),
+                     notes.c_str());
     }
 }
 
@@ -89,11 +97,26 @@ int report_command(int argc, char **argv) {
     if (chosen.empty())
         for (const Scene &s : all)
             if (s.in_default_report) chosen.push_back(&s);
+    // --N and --T configure scenes: one of those reported must take them.
+    for (const std::string &option : args.given())
+        if (configures_scenes(option) &&
+            std::none_of(chosen.begin(), chosen.end(), [&](const Scene *s) {
+                return std::find(s->options.begin(), s->options.end(), option) != s->options.end();
+            }))
+            args.fail(option + ": no scene reported takes it (lpi --help lists each scene's options)");
+    const std::string no_dir = make_output_dir(options.out_dir);
+    if (!no_dir.empty()) {
+        std::fprintf(stderr, "lpi report: --out %s\n", no_dir.c_str());
+        return 1;
+    }
     std::printf("liepoisson %s: error against CPU time, one core, measured in this run\n",
                 lpi_version_string());
-    for (const Scene *s : chosen) run_report(*s, options);
+    // A scene whose files were not written fails the command; the others still run.
+    int status = 0;
+    for (const Scene *s : chosen)
+        if (!run_report(*s, options)) status = 1;
     std::printf("\nCSV, PNG and SVG files are in %s/\n", options.out_dir.c_str());
-    return 0;
+    return status;
 }
 
 int methods_command(int argc, char **argv) {
@@ -115,20 +138,25 @@ int methods_command(int argc, char **argv) {
     return 0;
 }
 
-}  // namespace
+// Refuses any argument after a command that takes none (--version, --help).
+void takes_no_argument(const std::string &command, int argc, char **argv) {
+    Arguments args("lpi " + command, argc, argv);
+    if (!args.done()) args.fail("takes no argument ('" + args.next() + "')");
+}
 
-int main(int argc, char **argv) {
-    start_processes(&argc, &argv);
+int lpi_command(int argc, char **argv) {
     if (argc < 2) {
         print_usage(stderr);
         return 2;
     }
     const std::string command = argv[1];
     if (command == "--help" || command == "-h" || command == "help") {
+        takes_no_argument(command, argc - 2, argv + 2);
         print_usage(stdout);
         return 0;
     }
     if (command == "--version") {
+        takes_no_argument(command, argc - 2, argv + 2);
         std::printf("lpi (liepoisson) %s\n", lpi_version_string());
         return 0;
     }
@@ -144,4 +172,29 @@ int main(int argc, char **argv) {
     std::fprintf(stderr, "lpi: unknown command '%s'\n", command.c_str());
     print_usage(stderr);
     return 2;
+}
+
+}  // namespace
+
+// Every command ends here (a failure may exit earlier, never with status 0):
+// what escapes as a C++ exception (memory for a size the options ask for) is
+// a failure with a message, not an abort, and so is standard output that
+// could not be written (a full disk, a closed pipe).
+int main(int argc, char **argv) {
+    start_processes(&argc, &argv);
+    int status = 1;
+    try {
+        status = lpi_command(argc, argv);
+    } catch (const std::bad_alloc &) {
+        std::fprintf(stderr, "lpi: out of memory (the sizes asked for are too large)\n");
+        return 1;
+    } catch (const std::exception &e) {
+        std::fprintf(stderr, "lpi: %s\n", e.what());
+        return 1;
+    }
+    if (!close_written(stdout)) {
+        std::fprintf(stderr, "lpi: writing the standard output failed: %s\n", std::strerror(errno));
+        if (status == 0) status = 1;
+    }
+    return status;
 }

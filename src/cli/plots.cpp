@@ -2,7 +2,7 @@
 
 #include <cstdlib>
 
-#include <liepoisson.h>
+#include "common.hpp"
 
 namespace lpi_cli {
 
@@ -57,10 +57,19 @@ std::string method_label(const std::string &method) {
 // Starts a gnuplot script: CSV input, a grid, the key outside.
 FILE *open_plot_script(const std::string &path) {
     FILE *f = std::fopen(path.c_str(), "w");
-    if (f)
+    if (!f) cannot_write(path);
+    else
         std::fprintf(f, "set datafile separator ','\nset grid xtics ytics mxtics mytics lw 0.5, lw 0.2\n"
                         "set key below center horizontal maxcols 3 samplen 3\nset xlabel offset 0,0.5\nset bmargin 12\nset tics out nomirror\nset border 3\n");
     return f;
+}
+
+Plot finish_plot(FILE *f, const std::string &path) {
+    if (!close_written(f)) {
+        cannot_write(path);
+        return Plot::not_written;
+    }
+    return run_gnuplot(path) ? Plot::drawn : Plot::gnuplot_failed;
 }
 
 }  // namespace lpi_cli

@@ -85,7 +85,15 @@ std::string plot_style(std::size_t i, const std::string &method);
 // steps), which is what tells the curves apart.
 std::string method_label(const std::string &method);
 
-// Starts a gnuplot script: CSV input, a grid, the key outside.
+// What became of a figure: drawn; gnuplot failed (a note: its script and
+// data are there to rerun); or its script was not written (a failed file).
+enum class Plot { drawn, gnuplot_failed, not_written };
+
+// Starts a gnuplot script: CSV input, a grid, the key outside. Null, having
+// said so, when it cannot be created.
 FILE *open_plot_script(const std::string &path);
+
+// Closes the script `f` written to `path` and runs it.
+Plot finish_plot(FILE *f, const std::string &path);
 
 }  // namespace lpi_cli

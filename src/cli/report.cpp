@@ -3,8 +3,6 @@
 // time at equal error, the CSV files and the plots.
 #include "report.hpp"
 
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -154,38 +152,36 @@ double cpu_at_error(const std::vector<Row> &rows, const std::string &method, dou
     return kNaN;
 }
 
-void write_csv(const std::string &path, const std::vector<Row> &rows, const Scene &scene) {
+// Each writer returns false, having said so, when its file was not written.
+bool write_csv(const std::string &path, const std::vector<Row> &rows, const Scene &scene) {
     FILE *f = std::fopen(path.c_str(), "w");
-    if (!f) {
-        std::fprintf(stderr, "lpi: cannot write %s\n", path.c_str());
-        return;
-    }
+    if (!f) return cannot_write(path);
     std::fprintf(f, "scene,method,order,dt,steps,cpu_seconds,error,max_energy_error,max_casimir_drift,status\n");
     for (const Row &r : rows)
         std::fprintf(f, "%s,%s,%d,%.17g,%lld,%.6e,%.6e,%.6e,%.6e,%s\n", scene.name.c_str(),
                      r.method.c_str(), r.order, r.dt, static_cast<long long>(r.steps), r.cpu,
                      r.error, r.energy_error, r.casimir_drift, lpi_status_name(r.status));
-    std::fclose(f);
+    return close_written(f) || cannot_write(path);
 }
 
-void write_history(const std::string &path, const std::map<std::string, History> &histories) {
+bool write_history(const std::string &path, const std::map<std::string, History> &histories) {
     FILE *f = std::fopen(path.c_str(), "w");
-    if (!f) return;
+    if (!f) return cannot_write(path);
     std::fprintf(f, "method,dt,time,energy_error,casimir_drift\n");
     for (const auto &[method, history] : histories)
         for (const Sample &s : history.samples)
             std::fprintf(f, "%s,%.17g,%.10g,%.6e,%.6e\n", method.c_str(), history.dt, s.time,
                          s.energy_error, s.casimir_drift);
-    std::fclose(f);
+    return close_written(f) || cannot_write(path);
 }
 
 
 // Draws the work-precision and energy plots with gnuplot from the CSV files.
-bool plot(const std::string &dir, const Scene &scene, const std::vector<std::string> &methods,
+Plot plot(const std::string &dir, const Scene &scene, const std::vector<std::string> &methods,
           const std::vector<Row> &rows, const std::map<std::string, History> &histories) {
     const std::string script = dir + "/" + scene.name + ".gp";
     FILE *f = open_plot_script(script);
-    if (!f) return false;
+    if (!f) return Plot::not_written;
     const std::string base = dir + "/" + scene.name;
     Range cpu, error, energy;
     for (const Row &r : rows)
@@ -224,24 +220,19 @@ bool plot(const std::string &dir, const Scene &scene, const std::vector<std::str
                            method_label(methods[i]).c_str());
     }
     emit_figure(f, base + "_energy", 1000, 820, commands + "\n");
-    std::fclose(f);
-    return run_gnuplot(script);
+    return finish_plot(f, script);
 }
 
 }  // namespace
 
-void run_report(const Scene &scene, const ReportOptions &options) {
+bool run_report(const Scene &scene, const ReportOptions &options) {
     measure_on_one_core();
-    mkdir(options.out_dir.c_str(), 0777);
     const std::string why_not = scene.unavailable();
     if (!why_not.empty()) {
         std::printf("\n== %s: skipped in this build: %s\n", scene.name.c_str(), why_not.c_str());
-        return;
+        return true;
     }
-    if (scene.custom_run) {
-        scene.custom_run(options.out_dir);
-        return;
-    }
+    if (scene.custom_run) return scene.custom_run(options.out_dir);
     const std::vector<double> reference = reference_state(scene);
     std::printf("\n== %s: %s, T = %g\n", scene.name.c_str(), scene.description.c_str(),
                 scene.final_time);
@@ -337,16 +328,21 @@ void run_report(const Scene &scene, const ReportOptions &options) {
     }
 
     const std::string base = options.out_dir + "/" + scene.name;
-    write_csv(base + ".csv", rows, scene);
-    write_history(base + "_energy.csv", histories);
+    if (!write_csv(base + ".csv", rows, scene) || !write_history(base + "_energy.csv", histories)) return false;
     std::printf("   wrote %s.csv and %s_energy.csv (energy history of every method at dt = %g)\n", base.c_str(),
                 base.c_str(), scene.final_time / static_cast<double>(history_steps));
-    if (!have_gnuplot())
+    if (!have_gnuplot()) {
         std::printf("   gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n");
-    else if (plot(options.out_dir, scene, methods, rows, histories))
+        return true;
+    }
+    switch (plot(options.out_dir, scene, methods, rows, histories)) {
+    case Plot::drawn:
         std::printf("   wrote %s_work_precision.png and %s_energy.png, each with .svg\n", base.c_str(), base.c_str());
-    else
-        std::printf("   gnuplot failed: see %s.gp\n", base.c_str());
+        return true;
+    case Plot::gnuplot_failed: std::printf("   gnuplot failed: see %s.gp\n", base.c_str()); return true;
+    case Plot::not_written: return false;
+    }
+    return false;
 }
 
 }  // namespace lpi_cli

@@ -14,7 +14,8 @@ struct ReportOptions {
     int samples = 200;                 // energy/Casimir samples per diagnostic run
 };
 
-void run_report(const Scene &scene, const ReportOptions &options);
+// False when an output file was not written (it said why).
+bool run_report(const Scene &scene, const ReportOptions &options);
 
 // One diagnostic sample of a run: the relative energy error and Casimir drift
 // at a time.

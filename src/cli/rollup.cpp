@@ -2,8 +2,6 @@
 // up into the highest modes over long times? A smooth field is run long with
 // leapfrog; the enstrophy fraction in the highest third of the shells is
 // written against time, and the enstrophy spectrum at a few times.
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -43,6 +41,12 @@ double high_fraction(const std::vector<double> &enstrophy) {
     return all > 0.0 ? high / all : 0.0;
 }
 
+// Exit status 1, having said that `path` was not written.
+int not_written(const std::string &path) {
+    cannot_write(path);
+    return 1;
+}
+
 }  // namespace
 
 int run_rollup(const OwnRun &run) {
@@ -55,7 +59,7 @@ int run_rollup(const OwnRun &run) {
     // The spectrum is kept at the start and after 1/100, 1/10 and all of the run.
     const std::vector<int64_t> spectrum_rows = {0, std::max<int64_t>(1, rows / 100),
                                                 std::max<int64_t>(1, rows / 10), rows};
-    Handle h = sine_euler(N, smooth_random_field(N, 3.0, 7));
+    Handle h = sine_euler(N, smooth_field);
     lpi_system *sys = h.get();
     check(lpi_set_method(sys, "leapfrog"), sys, "set method");
     const double H0 = energy_of(sys);
@@ -68,13 +72,14 @@ int run_rollup(const OwnRun &run) {
                 N, dt, static_cast<long long>(steps), dt * static_cast<double>(steps));
     std::printf("   smooth random field (|w_m| ~ exp(-|m|^2/18)); %zu shells, the highest third: "
                 "k > %zu\n", K, (2 * K) / 3);
-    mkdir(run.out_dir.c_str(), 0777);
-    const std::string base = run.out_dir + "/rollup";
-    FILE *f = std::fopen((base + ".csv").c_str(), "w");
-    if (!f) {
-        std::fprintf(stderr, "lpi run rollup: cannot write %s.csv\n", base.c_str());
+    const std::string no_dir = make_output_dir(run.out_dir);
+    if (!no_dir.empty()) {
+        std::fprintf(stderr, "lpi run: --out %s\n", no_dir.c_str());
         return 1;
     }
+    const std::string base = run.out_dir + "/rollup", csv = base + ".csv", spectra = base + "_spectra.csv";
+    FILE *f = std::fopen(csv.c_str(), "w");
+    if (!f) return not_written(csv);
     std::fprintf(f, "time,energy_error,enstrophy_error,high_third_fraction\n");
     std::fprintf(f, "0,0,0,%.6e\n", high_fraction(s0.enstrophy));
     std::vector<Spectra> kept = {s0};
@@ -98,19 +103,18 @@ int run_rollup(const OwnRun &run) {
         }
     }
     const double cpu = cpu_seconds() - t0;
-    std::fclose(f);
-    FILE *g = std::fopen((base + "_spectra.csv").c_str(), "w");
-    if (g) {
-        std::fprintf(g, "k");
-        for (double t : kept_times) std::fprintf(g, ",enstrophy_t%g", t);
+    if (!close_written(f)) return not_written(csv);
+    FILE *g = std::fopen(spectra.c_str(), "w");
+    if (!g) return not_written(spectra);
+    std::fprintf(g, "k");
+    for (double t : kept_times) std::fprintf(g, ",enstrophy_t%g", t);
+    std::fprintf(g, "\n");
+    for (std::size_t k = 0; k < K; ++k) {
+        std::fprintf(g, "%zu", k + 1);
+        for (const Spectra &s : kept) std::fprintf(g, ",%.6e", s.enstrophy[k]);
         std::fprintf(g, "\n");
-        for (std::size_t k = 0; k < K; ++k) {
-            std::fprintf(g, "%zu", k + 1);
-            for (const Spectra &s : kept) std::fprintf(g, ",%.6e", s.enstrophy[k]);
-            std::fprintf(g, "\n");
-        }
-        std::fclose(g);
     }
+    if (!close_written(g)) return not_written(spectra);
     // Equipartition of the enstrophy over the modes puts in each shell its
     // share of the modes: the fraction the highest third would hold then.
     std::vector<double> modes_per_shell(K, 0.0);
@@ -124,12 +128,13 @@ int run_rollup(const OwnRun &run) {
                 first_fraction, peak, late_rows ? late_sum / late_rows : first_fraction,
                 high_fraction(modes_per_shell));
     std::printf("   %.1f CPU seconds; wrote %s.csv and %s_spectra.csv\n", cpu, base.c_str(), base.c_str());
-    FILE *p = std::fopen((base + ".gp").c_str(), "w");
-    if (!p || !have_gnuplot()) {
-        if (p) std::fclose(p);
+    if (!have_gnuplot()) {
         std::printf("   gnuplot not found: no PNG\n");
         return 0;
     }
+    const std::string script = base + ".gp";
+    FILE *p = std::fopen(script.c_str(), "w");
+    if (!p) return not_written(script);
     std::string commands = format(
         "set datafile separator ','\nset grid\nset tics out nomirror\nset border 3\n"
         "set multiplot layout 1,2\nset title 'enstrophy in the highest third of the shells' noenhanced\n"
@@ -152,9 +157,12 @@ int run_rollup(const OwnRun &run) {
                            i ? ", " : "", base.c_str(), i + 2, i + 2, plot_colour(i).c_str(), kept_times[i]);
     commands += "\nunset multiplot\n";
     emit_figure(p, base, 1100, 450, commands);
-    std::fclose(p);
-    if (run_gnuplot(base + ".gp")) std::printf("   wrote %s.png and .svg\n", base.c_str());
-    return 0;
+    switch (finish_plot(p, script)) {
+    case Plot::drawn: std::printf("   wrote %s.png and .svg\n", base.c_str()); return 0;
+    case Plot::gnuplot_failed: std::printf("   gnuplot failed: see %s\n", script.c_str()); return 0;
+    case Plot::not_written: return 1;
+    }
+    return 1;
 }
 
 }  // namespace lpi_cli

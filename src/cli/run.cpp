@@ -5,7 +5,6 @@
 #include "run.hpp"
 
 #include <sys/stat.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -27,11 +26,13 @@ namespace lpi_cli {
 
 namespace {
 
-// Usage error (exit status 2) when an option the library refuses was given.
-void check_option(int status, const lpi_system *sys, const char *option) {
+// Stops the command, naming the option, when the library refused it: a
+// usage error (exit status 2), or with `exit_status` 1 a file it names that
+// could not be read or written.
+void check_option(int status, const lpi_system *sys, const char *option, int exit_status = 2) {
     if (status == LPI_OK) return;
     std::fprintf(stderr, "lpi run: %s: %s (%s)\n", option, lpi_last_error(sys), lpi_status_name(status));
-    std::exit(2);
+    std::exit(exit_status);
 }
 
 // Whether `loaded` is a state of the system `fresh` (the scene with these
@@ -96,18 +97,26 @@ std::vector<std::string> csv_up_to(const std::string &path, int64_t step, double
 
 int run_command(int argc, char **argv) {
     RunOptions o;
-    parse_run_options(argc, argv, o);
-    std::vector<double> init_grid;
-    if (!o.init.empty()) {
-        int N = o.n_given ? o.scene_options.sine_euler_n : 0;
-        init_grid = initial_grid(o.init, &N);
-        o.scene_options.sine_euler_n = N;
-    }
-    const std::vector<Scene> all = builtin_scenes(o.scene_options);
-    auto it = std::find_if(all.begin(), all.end(), [&](const Scene &s) { return s.name == o.scene; });
+    if (!parse_run_options(argc, argv, o)) return 0;  // --help
+    const bool n_given = o.given.count("--N") > 0;
+    std::vector<Scene> all = builtin_scenes(o.scene_options);
+    auto find_scene = [&] {
+        return std::find_if(all.begin(), all.end(), [&](const Scene &s) { return s.name == o.scene; });
+    };
+    auto it = find_scene();
     if (it == all.end()) {
         std::fprintf(stderr, "lpi run: unknown scene '%s' (lpi --help lists them)\n", o.scene.c_str());
         return 2;
+    }
+    refuse_options_not_taken(o, *it);
+    std::vector<double> init_grid;
+    if (!o.init.empty()) {
+        // The grid's N is the scene's.
+        int N = n_given ? o.scene_options.sine_euler_n : 0;
+        init_grid = initial_grid(o.init, &N);
+        o.scene_options.sine_euler_n = N;
+        all = builtin_scenes(o.scene_options);
+        it = find_scene();
     }
     if (it->run_own) {
         const std::string why = it->unavailable();
@@ -115,15 +124,11 @@ int run_command(int argc, char **argv) {
             std::fprintf(stderr, "lpi run: %s is not available in this build: %s\n", o.scene.c_str(), why.c_str());
             return 1;
         }
-        if (!o.method.empty() || !o.init.empty() || !o.resume.empty() || !o.checkpoint.empty() || o.until > 0.0) {
-            std::fprintf(stderr, "lpi run: %s takes --N, --steps, --dt and --out only\n", o.scene.c_str());
-            return 2;
-        }
         if (process_count() > 1) {
             std::fprintf(stderr, "lpi run: %s runs on one process (not under mpirun)\n", o.scene.c_str());
             return 2;
         }
-        return it->run_own({o.n_given ? o.scene_options.sine_euler_n : 0, o.steps, o.dt, o.out_dir});
+        return it->run_own({n_given ? o.scene_options.sine_euler_n : 0, o.steps, o.dt, o.out_dir});
     }
     if (!it->create) {
         std::fprintf(stderr, "lpi run: %s is a report (lpi report %s)\n", o.scene.c_str(), o.scene.c_str());
@@ -138,11 +143,8 @@ int run_command(int argc, char **argv) {
     const double dt = o.dt > 0.0 ? o.dt : it->run_step;
     Handle h = it->create();
     if (!init_grid.empty()) {
-        int32_t N = 0;
-        if (lpi_sine_euler_size(h.get(), &N) != LPI_OK) {
-            std::fprintf(stderr, "lpi run: --init: %s is not a sine-Euler scene\n", o.scene.c_str());
-            return 2;
-        }
+        int32_t N = 0;  // a scene that takes --init is sine-Euler (Scene::options)
+        check(lpi_sine_euler_size(h.get(), &N), h.get(), "sine-Euler size");
         if (static_cast<std::size_t>(N) * N != init_grid.size()) {
             std::fprintf(stderr, "lpi run: --init: %s has N = %d, the grid is not %d x %d\n", o.scene.c_str(), N,
                          N, N);
@@ -168,13 +170,21 @@ int run_command(int argc, char **argv) {
     if (!o.method.empty()) check_option(lpi_set_method(sys, o.method.c_str()), sys, "--method");
     if (o.threads != 1) check_option(lpi_set_threads(sys, o.threads), sys, "--threads");
     // Wisdom first, so that any planning (the first step's or --planning's)
-    // uses it; measured plans are written back for the next run.
-    if (!o.wisdom.empty() && access(o.wisdom.c_str(), F_OK) == 0)
-        check_option(lpi_fftw_wisdom_import_file(o.wisdom.c_str()), nullptr, "--wisdom");
+    // uses it; measured plans are written back for the next run. A wisdom
+    // file that cannot be read or written fails as any file does (exit
+    // status 1); only a regular one is read (FFTW would wait on a FIFO).
+    struct stat wisdom_file;
+    if (!o.wisdom.empty() && stat(o.wisdom.c_str(), &wisdom_file) == 0) {
+        if (!S_ISREG(wisdom_file.st_mode)) {
+            std::fprintf(stderr, "lpi run: --wisdom: %s is not a regular file\n", o.wisdom.c_str());
+            return 1;
+        }
+        check_option(lpi_fftw_wisdom_import_file(o.wisdom.c_str()), nullptr, "--wisdom", 1);
+    }
     if (!o.planning.empty()) {
         check_option(lpi_sine_euler_set_planning(sys, o.planning.c_str()), sys, "--planning");
         if (!o.wisdom.empty() && o.planning != "estimate" && writes_output())
-            check_option(lpi_fftw_wisdom_export_file(o.wisdom.c_str()), nullptr, "--wisdom");
+            check_option(lpi_fftw_wisdom_export_file(o.wisdom.c_str()), nullptr, "--wisdom", 1);
     }
     // The method in use: --method's, else a new system's default or the
     // checkpoint's (it holds the method).
@@ -220,7 +230,11 @@ int run_command(int argc, char **argv) {
                                          : std::vector<std::size_t>{lpi_dim(sys)};
     data.casimir_count = lpi_casimir_count(sys);
 
-    mkdir(o.out_dir.c_str(), 0777);
+    const std::string no_dir = make_output_dir(o.out_dir);  // every process: all stop alike
+    if (!no_dir.empty()) {
+        std::fprintf(stderr, "lpi run: --out %s\n", no_dir.c_str());
+        return 1;
+    }
     const std::string csv = o.out_dir + "/" + o.scene + ".csv";
     std::vector<std::string> kept;
     if (!o.resume.empty()) {
@@ -388,7 +402,7 @@ int run_command(int argc, char **argv) {
     } else if (!stopped_between_rows) {
         save(done, true);
     }
-    if (std::ferror(f) != 0 || std::fclose(f) != 0) {
+    if (!close_written(f)) {
         std::fprintf(stderr, "lpi run: writing %s failed\n", csv.c_str());
         return 1;
     }
@@ -414,11 +428,14 @@ int run_command(int argc, char **argv) {
                         data_path(o).c_str());
             return 0;
         }
-        const std::size_t drawn = plot_vorticity(o, data, bytes, dt, method);
-        if (drawn > 0)
-            std::printf("wrote %zu vorticity snapshots: %s/vorticity_*.png and .svg\n", drawn, o.out_dir.c_str());
-        else
-            std::printf("gnuplot failed: see %s/vorticity.gp\n", o.out_dir.c_str());
+        switch (plot_vorticity(o, data, bytes, dt, method)) {
+        case Plot::drawn:
+            std::printf("wrote %zu vorticity snapshots: %s/vorticity_*.png and .svg\n", data.snapshot_step.size(),
+                        o.out_dir.c_str());
+            break;
+        case Plot::gnuplot_failed: std::printf("gnuplot failed: see %s/vorticity.gp\n", o.out_dir.c_str()); break;
+        case Plot::not_written: return 1;
+        }
     }
     return 0;
 }

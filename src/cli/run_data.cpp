@@ -186,17 +186,20 @@ std::vector<double> initial_grid(const std::string &path, int *N) {
 
 // Draws every vorticity snapshot of the data as PNG and SVG with gnuplot,
 // which reads the doubles straight from the data file (nothing is copied
-// and nothing deleted). Returns how many were drawn.
-std::size_t plot_vorticity(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
-                           const std::string &method) {
+// and nothing deleted).
+Plot plot_vorticity(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
+                    const std::string &method) {
     const std::size_t N = d.snapshot_shape[0], shots = d.snapshot_step.size();
-    if (shots == 0 || bytes.offset == UINT64_MAX) return 0;
+    if (shots == 0 || bytes.offset == UINT64_MAX) return Plot::gnuplot_failed;
     double scale = 0.0;  // one symmetric colour range for every snapshot
     for (double v : d.snapshots) scale = std::max(scale, std::fabs(v));
     if (!(scale > 0.0)) scale = 1.0;
     const std::string script = o.out_dir + "/vorticity.gp";
     FILE *g = std::fopen(script.c_str(), "w");
-    if (!g) return 0;
+    if (!g) {
+        cannot_write(script);
+        return Plot::not_written;
+    }
     // Grid point (a, b) is x = 2 pi a / N, y = 2 pi b / N: the axes count
     // x / 2 pi, each pixel centred on its point. The array is [a][b], b
     // fastest: gnuplot reads it with x and y swapped back (transpose).
@@ -225,9 +228,7 @@ std::size_t plot_vorticity(const RunOptions &o, const RunData &d, const Snapshot
                          static_cast<unsigned long long>(bytes.offset + 8 * k * N * N), 1.0 / N, 1.0 / N);
     }
     std::fprintf(g, "set output\n");
-    std::fclose(g);
-    if (!run_gnuplot(script)) return 0;
-    return shots;
+    return finish_plot(g, script);
 }
 
 }  // namespace lpi_cli

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "data_files.hpp"
+#include "plots.hpp"
 #include "run_options.hpp"
 
 namespace lpi_cli {
@@ -65,8 +66,8 @@ std::vector<double> initial_grid(const std::string &path, int *N);
 
 // Draws every vorticity snapshot of the data as PNG and SVG with gnuplot,
 // which reads the doubles straight from the data file (nothing is copied
-// and nothing deleted). Returns how many were drawn.
-std::size_t plot_vorticity(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
+// and nothing deleted).
+Plot plot_vorticity(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
                            const std::string &method);
 
 }  // namespace lpi_cli

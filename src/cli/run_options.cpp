@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <set>
 #include <vector>
 
 #include "data_files.hpp"
@@ -26,10 +27,12 @@ void run_usage(FILE *to) {
                  "                    processes may round differently unless they share --wisdom)\n"
                  "  --wisdom FILE     FFTW wisdom: imported first when FILE exists, and written\n"
                  "                    after measured planning, so later runs reuse those plans\n"
+                 "                    (sine-Euler; a file that cannot be read or written: exit 1)\n"
                  "  --N N             sine-Euler size (odd >= 3, default 31, or the --init grid's)\n"
                  "  --init FILE       sine-Euler: the initial vorticity on the N x N grid, from a\n"
-                 "                    .npy array (N, N) (float64 or float32) or an HDF5 file's\n"
-                 "                    /init (N, N) or /vorticity (the last snapshot of an lpi run)\n"
+                 "                    .npy array (N, N) (float64, float32, int64 or int32) or an\n"
+                 "                    HDF5 file's /init (N, N) or /vorticity (the last snapshot\n"
+                 "                    of an lpi run)\n"
                  "  --inertia A,B,C   rigid-body inertias (default 1,2,3)\n"
                  "  --kd K            qg: the deformation wavenumber k_d > 0 (default 1)\n"
                  "  --snapshots K     keep the state (sine-Euler: the vorticity grid, also drawn as\n"
@@ -45,6 +48,8 @@ void run_usage(FILE *to) {
                  "                    would have ended (--steps and --until count from the start\n"
                  "                    of the whole run; the rows and snapshots after the\n"
                  "                    checkpoint's step are replaced)\n"
+                 "  The options that configure a scene (lpi --help lists each scene's in brackets)\n"
+                 "  are refused for a scene that does not take them.\n"
                  "  writes DIR/SCENE.csv: step, time, energy, relative energy error (to the energy\n"
                  "  at step 0), Casimirs; and the data (rows and snapshots) as --format says; a\n"
                  "  progress bar with the time left is shown on a terminal only. Ctrl-C (SIGINT) or\n"
@@ -54,7 +59,7 @@ void run_usage(FILE *to) {
 
 }  // namespace
 
-void parse_run_options(int argc, char **argv, RunOptions &o) {
+bool parse_run_options(int argc, char **argv, RunOptions &o) {
     Arguments args("lpi run", argc, argv);
     const int32_t int32_max = 2147483647;
     while (!args.done()) {
@@ -74,7 +79,6 @@ void parse_run_options(int argc, char **argv, RunOptions &o) {
         else if (arg == "--N") {
             o.scene_options.sine_euler_n = static_cast<int>(args.integer(arg, 3, int32_max));
             if (o.scene_options.sine_euler_n % 2 == 0) args.fail("--N must be odd");
-            o.n_given = true;
         } else if (arg == "--init") o.init = args.value(arg);
         else if (arg == "--format") {
             o.format = args.value(arg);
@@ -91,7 +95,7 @@ void parse_run_options(int argc, char **argv, RunOptions &o) {
             std::copy(I.begin(), I.end(), o.scene_options.inertia);
         } else if (Arguments::is_help(arg)) {
             run_usage(stdout);
-            std::exit(0);
+            return false;
         } else {
             args.refuse_unknown_option(arg);
             if (!o.scene.empty()) args.fail("one scene only ('" + o.scene + "' and '" + arg + "')");
@@ -103,6 +107,24 @@ void parse_run_options(int argc, char **argv, RunOptions &o) {
     if (!o.init.empty() && !o.resume.empty())
         args.fail("--init and --resume exclude each other (the checkpoint holds the state)");
     if (o.format.empty()) o.format = have_hdf5() ? "h5" : "npy";
+    o.given = args.given();
+    return true;
+}
+
+void refuse_options_not_taken(const RunOptions &o, const Scene &scene) {
+    std::set<std::string> allowed(scene.options.begin(), scene.options.end());
+    // A scene run its own way takes its options and these only.
+    if (scene.run_own) allowed.insert({"--steps", "--dt", "--out"});
+    for (const std::string &option : o.given) {
+        if (allowed.count(option)) continue;
+        if (!scene.run_own && !configures_scenes(option)) continue;  // an option of every run
+        std::string takes;
+        for (const std::string &name : scene.options) takes += ", " + name;
+        if (scene.run_own) takes += ", --steps, --dt and --out only";
+        std::fprintf(stderr, "lpi run: %s: %s does not take it (%s)\n", option.c_str(), scene.name.c_str(),
+                     takes.empty() ? "it takes no scene option" : ("it takes " + takes.substr(2)).c_str());
+        std::exit(2);
+    }
 }
 
 }  // namespace lpi_cli

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <set>
 #include <string>
 
 #include "scenes.hpp"
@@ -25,12 +26,17 @@ struct RunOptions {
     std::string resume;        // continue from this checkpoint
     std::string init;          // sine-Euler: the initial vorticity grid from this file
     std::string format;        // of the data: "h5" or "npy" (default: h5 when built with HDF5)
-    bool n_given = false;
+    std::set<std::string> given;  // the options given ("--N", ...)
     SceneOptions scene_options;
 };
 
-// Reads lpi run's arguments; --help prints the usage and exits 0, a bad
-// option exits 2 with a message.
-void parse_run_options(int argc, char **argv, RunOptions &o);
+// Reads lpi run's arguments; false when --help printed the usage instead (the
+// command then succeeds), and a bad option exits 2 with a message.
+bool parse_run_options(int argc, char **argv, RunOptions &o);
+
+// Exits 2 with a message naming the first option given that `scene` does not
+// take: one that configures other scenes (Scene::options), or, for a scene
+// run its own way, any but its own and --steps, --dt and --out.
+void refuse_options_not_taken(const RunOptions &o, const Scene &scene);
 
 }  // namespace lpi_cli

@@ -1,5 +1,6 @@
 #include "scenes.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -50,13 +51,16 @@ std::string format_number(double v) {
 std::string sine_euler_spectrum_unavailable() {
     const std::string no_sine_euler = sine_euler_unavailable();
     if (!no_sine_euler.empty()) return no_sine_euler;
-    Handle probe = sine_euler(3, std::vector<double>(18, 0.0));
+    Handle probe = sine_euler(3, [](int N) { return std::vector<double>(2 * N * N, 0.0); });
     double spectrum[3];
     const int status = lpi_casimirs(probe.get(), spectrum, 3);
     return status == LPI_OK ? "" : lpi_last_error(probe.get());
 }
 
-Handle sine_euler_smooth_field(int N) { return sine_euler(N, smooth_random_field(N, 3.0, 7)); }
+
+// What configures a sine-Euler scene beyond its Hamiltonian: its N, its
+// initial grid and how its transforms run.
+const std::vector<std::string> kSineEulerOptions = {"--N", "--init", "--threads", "--planning", "--wisdom"};
 
 // A work-precision scene: its system, final time and sweep of step sizes
 // (the reference solution is set by the caller).
@@ -81,6 +85,7 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
                                   format_number(I3) + "), m(0) = (1, 0.5, -0.3)",
                               [I1, I2, I3] { return rigid_body(I1, I2, I3, {1.0, 0.5, -0.3}); }, 100.0,
                               {0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625});
+    rigid.options = {"--inertia"};
     rigid.exact_reference = true;
     scenes.push_back(rigid);
 
@@ -102,8 +107,9 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         const int N = options.sine_euler_n;
         s.name = "sine-euler";
         s.description = "sine-Euler (Zeitlin su(N) 2D Euler), N = " + std::to_string(N) +
-                        ", smooth random field, sum |w|^2 = 1 (--N to change N)";
-        s.create = [N] { return sine_euler_smooth_field(N); };
+                        ", smooth random field, sum |w|^2 = 1";
+        s.options = kSineEulerOptions;
+        s.create = [N] { return sine_euler(N, smooth_field); };
         s.unavailable = sine_euler_unavailable;
         s.excluded_methods = {"direct-eq5"};
         s.exclusion_reason = "direct-eq5 (eq. 5 summed term by term, O(N^4): a cross-check of the fast methods) is left out";
@@ -128,8 +134,8 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         long_run.final_time = options.long_run_time;
         long_run.setting = "N = " + std::to_string(N) + ", T = " + format_number(long_run.final_time);
         long_run.description = "the sine-euler field run long: max energy error and Casimir "
-                               "drift against CPU time (--N, --T)";
-        long_run.create = [N] { return sine_euler_smooth_field(N); };
+                               "drift against CPU time";
+        long_run.create = [N] { return sine_euler(N, smooth_field); };
         long_run.sweeps = {
             {"leapfrog", {0.5, 0.25, 0.125}},
             {"mclachlan-4", {2.0, 1.0, 0.5}},
@@ -143,8 +149,9 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         Scene s;
         s.name = long_run.name;
         s.description = long_run.description + ", " + long_run.setting;
+        s.options = {"--N", "--T"};
         s.unavailable = sine_euler_spectrum_unavailable;
-        s.custom_run = [long_run](const std::string &out_dir) { run_long_scene(long_run, out_dir); };
+        s.custom_run = [long_run](const std::string &out_dir) { return run_long_scene(long_run, out_dir); };
         scenes.push_back(s);
     }
     {
@@ -156,18 +163,21 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
             const char *name;
             std::string description;
             std::function<Handle()> create;
+            std::vector<std::string> options;  // beyond kSineEulerOptions
         } family[] = {
             {"sqg", "surface quasi-geostrophy (lambda = 1/|n|), N = " + std::to_string(N),
-             [N] { return sqg_system(N); }},
+             [N] { return sqg_system(N); }, {}},
             {"qg", "quasi-geostrophy, lambda = 1/(|n|^2 + kd^2), kd = " + format_number(kd) + ", N = " +
-                       std::to_string(N) + " (--kd to change kd)",
-             [N, kd] { return qg_system(N, kd); }},
+                       std::to_string(N),
+             [N, kd] { return qg_system(N, kd); }, {"--kd"}},
             {"topography", "2D Euler over a smooth random topography h (q = w + h), N = " + std::to_string(N),
-             [N] { return topography_system(N); }},
+             [N] { return topography_system(N); }, {}},
         };
         for (const auto &member : family) {
-            Scene s = sweep_scene(member.name, member.description + ", smooth random field (--N to change N)",
-                                  member.create, 10.0, {0.4, 0.2, 0.1, 0.05, 0.025});
+            Scene s = sweep_scene(member.name, member.description + ", smooth random field", member.create, 10.0,
+                                  {0.4, 0.2, 0.1, 0.05, 0.025});
+            s.options = kSineEulerOptions;
+            s.options.insert(s.options.end(), member.options.begin(), member.options.end());
             s.unavailable = sine_euler_unavailable;
             s.excluded_methods = {"direct-eq5"};
             s.exclusion_reason = "direct-eq5 (eq. 5 summed term by term, O(N^4): a cross-check of the fast methods) is left out";
@@ -181,7 +191,8 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         Scene s;
         s.name = "rollup";
         s.description = "the paper's closing question: does a smooth sine-Euler field roll up into the "
-                        "highest modes? N = 63, 10^5 leapfrog steps of 0.05 (--N, --steps, --dt)";
+                        "highest modes? N = 63, 10^5 leapfrog steps of 0.05 (--steps, --dt)";
+        s.options = {"--N"};
         s.unavailable = sine_euler_unavailable;
         s.in_default_report = false;
         s.run_own = run_rollup;
@@ -192,6 +203,7 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         s.name = "figure2";
         s.description = "the paper's Figure 2: sine-Euler N = 7, leapfrog, dt = 0.05, 10^5 steps, "
                         "|w| = 1, H(0) = 0.75";
+        s.options = {"--init", "--threads", "--planning", "--wisdom"};  // N = 7
         s.create = figure2_system;
         s.final_time = 5000.0;
         s.run_step = 0.05;
@@ -200,6 +212,12 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         scenes.push_back(s);
     }
     return scenes;
+}
+
+bool configures_scenes(const std::string &option) {
+    for (const Scene &s : builtin_scenes())
+        if (std::find(s.options.begin(), s.options.end(), option) != s.options.end()) return true;
+    return false;
 }
 
 }  // namespace lpi_cli

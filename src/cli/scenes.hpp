@@ -22,6 +22,9 @@ struct OwnRun {
 struct Scene {
     std::string name;
     std::string description;
+    // The options that configure this scene (lpi --help lists them beside
+    // it): any other option that configures scenes is refused for this one.
+    std::vector<std::string> options;
     std::function<Handle()> create;  // configured system with its initial state (empty: report only)
     double final_time = 1.0;
     double run_step = 0.01;          // lpi run's default --dt
@@ -37,8 +40,9 @@ struct Scene {
     std::string exclusion_reason;
     // Why the scene cannot run in this build ("" when it can).
     std::function<std::string()> unavailable = [] { return std::string(); };
-    // A scene that is not a step-size sweep runs this instead (figure2).
-    std::function<void(const std::string &out_dir)> custom_run;
+    // A scene that is not a step-size sweep runs this instead (figure2);
+    // false when an output file was not written (it said why).
+    std::function<bool(const std::string &out_dir)> custom_run;
     // A scene `lpi run` integrates its own way (rollup); returns the exit status.
     std::function<int(const OwnRun &)> run_own;
 };
@@ -52,6 +56,9 @@ struct SceneOptions {
 };
 
 std::vector<Scene> builtin_scenes(const SceneOptions &options = {});
+
+// Whether `option` configures some scene (is in some Scene::options).
+bool configures_scenes(const std::string &option);
 
 // A long-run scene: each method at its own step sizes, run to final_time
 // once per step size, with the maximum energy error and Casimir drift over the
@@ -73,11 +80,13 @@ struct LongRunScene {
     std::string exclusion_reason;  // registered methods left out, and why
 };
 
-void run_long_scene(const LongRunScene &scene, const std::string &out_dir);
+// False when an output file was not written (it said why).
+bool run_long_scene(const LongRunScene &scene, const std::string &out_dir);
 
 // The Figure 2 scene: a long leapfrog run, energy error and Casimir drift
-// against time, written as CSV and PNG under out_dir.
-void run_figure2(const std::string &out_dir);
+// against time, written as CSV and PNG under out_dir. False when an output
+// file was not written (it said why).
+bool run_figure2(const std::string &out_dir);
 
 // The roll-up scene: a smooth sine-Euler field run long (default N = 63,
 // 10^5 leapfrog steps of 0.05), the enstrophy fraction in the highest third of

@@ -207,7 +207,7 @@ std::vector<Case> build_cases(bool quick) {
                        std::vector<std::string> methods) {
             Case k;
             k.name = name;
-            k.create = [=] { return sine_euler(N, w); };
+            k.create = [=] { return sine_euler(N, [&w](int) { return w; }); };
             k.factors = factors;
             k.steps = steps;
             k.methods = std::move(methods);

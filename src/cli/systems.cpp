@@ -26,14 +26,15 @@ Handle pendulum(const std::vector<double> &x) {
     return with_state(std::move(h), x);
 }
 
-Handle sine_euler(int N, const std::vector<double> &w) {
+Handle sine_euler(int N, const std::function<std::vector<double>(int N)> &modes) {
     Handle h;
     check(create_sine_euler(h.out(), N), nullptr, "create sine-Euler");
+    const std::vector<double> w = modes(N);
     check(lpi_sine_euler_set_modes(h.get(), w.data(), w.size()), h.get(), "set modes");
     return h;
 }
 
-Handle figure2_system() { return sine_euler(7, figure2_field()); }
+Handle figure2_system() { return sine_euler(7, [](int) { return figure2_field(); }); }
 
 std::string sine_euler_unavailable() {
     lpi_system *probe = nullptr;

@@ -2,6 +2,7 @@
 // set to its initial state; a failed call stops the command (check).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -11,8 +12,10 @@ namespace lpi_cli {
 
 Handle rigid_body(double I1, double I2, double I3, const std::vector<double> &m);
 Handle pendulum(const std::vector<double> &x);
-// Sine-Euler of size N with the modes `w` (fields.hpp makes them).
-Handle sine_euler(int N, const std::vector<double> &w);
+// Sine-Euler of size N with the modes `modes(N)` (fields.hpp makes them).
+// The system is created first: the library refuses an N too large for
+// memory (exit status 1, its message) before lpi allocates 2 N^2 modes.
+Handle sine_euler(int N, const std::function<std::vector<double>(int N)> &modes);
 // The paper's Figure 2 system: sine-Euler N = 7 with figure2_field().
 Handle figure2_system();
 
