@@ -258,8 +258,14 @@ void require_memory(int N) {
                       states <= SIZE_MAX - tables;
     const std::string what = "sine-Euler N = " + std::to_string(N) + " needs ";
     const std::string parts = " (two working states of 2 N^2 doubles, lambda and the direction tables)";
-    if (!fits)
-        fail(LPI_ERR_NO_MEMORY, what + "more than " + std::to_string(SIZE_MAX) + " bytes" + parts);
+    if (!fits) {  // the same count in floating point, to say how far beyond
+        const double estimate = (2 * 2 + 1) * sizeof(double) * static_cast<double>(n) * static_cast<double>(n) +
+                                static_cast<double>(classes + (prime ? 0 : n)) * static_cast<double>(n);
+        char text[32];
+        std::snprintf(text, sizeof text, "%.3g", estimate);
+        fail(LPI_ERR_NO_MEMORY, what + "about " + text + " bytes (" + gib(estimate) + ")" + parts +
+                                    ", more than an address space holds");
+    }
     bytes = states + tables;
     const std::size_t available = physical_memory();
     if (available != 0 && bytes > available)
