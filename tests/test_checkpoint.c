@@ -739,6 +739,18 @@ static int count_entries(const char *dir) {
     return n;
 }
 
+/* The file at path holds exactly these bytes. */
+static void assert_file_holds(const char *path, const unsigned char *bytes, size_t size) {
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    unsigned char *file = malloc(size + 1);
+    assert_non_null(file);
+    assert_int_equal(fread(file, 1, size + 1, f), size);
+    fclose(f);
+    assert_memory_equal(file, bytes, size);
+    free(file);
+}
+
 static void test_files(void **state) {
     (void)state;
     char dir[] = "checkpoint_XXXXXX";
@@ -755,12 +767,7 @@ static void test_files(void **state) {
     /* The file holds the same bytes as the buffer. */
     size_t size;
     unsigned char *buf = save(sys, &size);
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    unsigned char *file = malloc(size + 1);
-    assert_int_equal(fread(file, 1, size + 1, f), size);
-    fclose(f);
-    assert_memory_equal(file, buf, size);
+    assert_file_holds(path, buf, size);
 
     /* Overwriting replaces the whole file, and loading resumes. */
     assert_int_equal(lpi_step(sys, 0.01, 100), LPI_OK);
@@ -789,7 +796,7 @@ static void test_files(void **state) {
     assert_null(copy);
     LPI_ASSERT_FAILS(NULL, lpi_load(&copy, sub), LPI_ERR_IO, "lpi_load");
     /* A truncated file. */
-    f = fopen(path, "wb");
+    FILE *f = fopen(path, "wb");
     assert_int_equal(fwrite(buf, 1, size / 2, f), size / 2);
     fclose(f);
     LPI_ASSERT_FAILS(NULL, lpi_load(&copy, path), LPI_ERR_FORMAT, "lpi_load");
@@ -805,7 +812,7 @@ static void test_files(void **state) {
     rmdir(sub);
     unlink(path);
     assert_int_equal(rmdir(dir), 0);
-    free(file), free(buf);
+    free(buf);
     lpi_destroy(sys);
 }
 
@@ -873,17 +880,12 @@ static void test_save_targets(void **state) {
     assert_int_equal(lpi_step(sys, 0.01, 10), LPI_OK);
     assert_int_equal(save_with_file_limit(sys, real, 64), LPI_ERR_IO);
     assert_non_null(strstr(lpi_last_error(sys), "cannot write"));
-    FILE *f = fopen(real, "rb");
-    assert_non_null(f);
-    unsigned char *kept = malloc(size + 1);
-    assert_int_equal(fread(kept, 1, size + 1, f), size);
-    fclose(f);
-    assert_memory_equal(kept, old, size);
+    assert_file_holds(real, old, size);
     assert_int_equal(stat(real, &st), 0);
     assert_int_equal(st.st_mode & 07777, 0600);
     assert_int_equal(count_entries(dir), 4); /* no temporary file left */
 
-    free(kept), free(old);
+    free(old);
     unlink(real), unlink(link_path), unlink(dangling), unlink(fifo);
     assert_int_equal(rmdir(dir), 0);
     lpi_destroy(sys);
@@ -1003,16 +1005,11 @@ static void test_save_names_and_failures(void **state) {
     assert_int_equal(status, LPI_ERR_IO);
     assert_non_null(strstr(lpi_last_error(sys), longest));
     assert_int_equal(count_entries(dir), 1);
-    FILE *f = fopen(longest, "rb");
-    assert_non_null(f);
-    unsigned char *file = malloc(size + 1);
-    assert_int_equal(fread(file, 1, size + 1, f), size);
-    fclose(f);
-    assert_memory_equal(file, old, size);
+    assert_file_holds(longest, old, size);
 
     unlink(longest);
     assert_int_equal(rmdir(dir), 0);
-    free(file), free(old);
+    free(old);
     lpi_destroy(sys);
 }
 
