@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "../core/error.hpp"
+#include "../core/lapack.hpp"
 #include "../models/sine_euler.hpp"
 #include "../models/sine_euler/matrix_form.hpp"
 #include "fixed_point.hpp"
@@ -87,11 +88,6 @@ private:
 
 #if LPI_HAVE_FFTW && LPI_HAVE_LAPACK
 
-extern "C" void zgemm_(const char *transa, const char *transb, const int *m, const int *n,
-                       const int *k, const cplx *alpha, const cplx *a, const int *lda,
-                       const cplx *b, const int *ldb, const cplx *beta, cplx *c, const int *ldc,
-                       std::size_t transa_len, std::size_t transb_len);
-
 // Keeps the mode array Hermitian (w_-m = conj(w_m)) after a matrix-form step,
 // where round-off of the transforms breaks it slightly, and restores the
 // inert mode w_0 exactly.
@@ -114,7 +110,7 @@ void symmetrise_modes(int order, const double *w0, double *modes) {
 void multiply(int N, const cplx *A, const cplx *B, cplx *C) {
     const char no = 'N';
     const cplx one = 1.0, zero = 0.0;
-    zgemm_(&no, &no, &N, &N, &N, &one, A, &N, B, &N, &zero, C, &N, 1, 1);
+    lapack::zgemm(&no, &no, &N, &N, &N, &one, A, &N, B, &N, &zero, C, &N, 1, 1);
 }
 
 bool matrix_finite(const std::vector<cplx> &W) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <cstdlib>
 #include <limits>
 #include <map>
 #include <string>
@@ -14,16 +15,20 @@
 
 #include "plots.hpp"
 
-// OpenBLAS's own call, when OpenBLAS is the BLAS the library loaded (weak:
-// null otherwise, and no link dependency).
+// OpenBLAS's own call, when an OpenBLAS is loaded where the program sees it
+// (weak: null otherwise, and no link dependency).
 extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 
 namespace lpi_cli {
 
 // The report measures one core. OpenBLAS would otherwise spread the Casimir
 // spectra (LAPACK) over helper threads that then busy-wait for about a tenth
-// of a second, on the process's CPU clock, inside the next timed steps.
+// of a second, on the process's CPU clock, inside the next timed steps. The
+// library loads LAPACK at the first spectrum (src/core/lapack.cpp), and
+// OpenBLAS reads its thread count from the environment then; one loaded
+// before (preloaded) takes its own call.
 void measure_on_one_core() {
+    setenv("OPENBLAS_NUM_THREADS", "1", 1);
     if (openblas_set_num_threads) openblas_set_num_threads(1);
 }
 

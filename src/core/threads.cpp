@@ -12,9 +12,10 @@
 #include "error.hpp"
 #include "lpi_config.h"
 
+#include <pthread.h>
+
 #if LPI_HAVE_OPENMP
 #include <omp.h>
-#include <pthread.h>
 #endif
 
 namespace lpi {
@@ -38,10 +39,9 @@ void check_thread_count(int n) {
                                   " x the processors available to the process)");
 }
 
-#if LPI_HAVE_OPENMP
-
 namespace {
 
+#if LPI_HAVE_OPENMP
 // The stack size libgomp gives its threads: OMP_STACKSIZE, else
 // GOMP_STACKSIZE ("<number>[B|K|M|G]", kilobytes by default), read once as
 // libgomp does when it loads; 0 when neither is set (default attributes).
@@ -71,6 +71,7 @@ std::size_t openmp_stack_size() {
     }();
     return size;
 }
+#endif
 
 // Probe threads wait until every one of them exists: an exited thread no
 // longer counts against the process limits, and the team needs them all at
@@ -88,13 +89,13 @@ void *wait_at_gate(void *argument) {
     return nullptr;
 }
 
-// Starts `count` threads that all exist at once, then joins them. Returns
-// the error of the first refused thread (0 if none) and its index in *failed.
-int probe_threads(int count, int *failed) {
+// Starts `count` threads with `stack` bytes of stack (0: the default) that
+// all exist at once, then joins them. Returns the error of the first refused
+// thread (0 if none) and its index in *failed.
+int probe_threads(int count, std::size_t stack, int *failed) {
     pthread_attr_t attributes;
     if (int error = pthread_attr_init(&attributes)) return *failed = 0, error;
-    if (const std::size_t stack = openmp_stack_size())
-        pthread_attr_setstacksize(&attributes, stack);
+    if (stack) pthread_attr_setstacksize(&attributes, stack);
     Gate gate;
     std::vector<pthread_t> started;
     int error = 0;
@@ -122,7 +123,24 @@ int probe_threads(int count, int *failed) {
     return error;
 }
 
+// "; the process is at a limit ..." after the reason a thread was refused.
+std::string thread_limit_text(int error) {
+    return " (" + std::generic_category().message(error) +
+           "); the process is at a limit on threads or memory (ulimit -u, ulimit -v, cgroup pids.max)";
+}
+
 }  // namespace
+
+void require_threads_can_start(int count, const std::string &for_what) {
+    if (count < 1) return;
+    int failed = 0;
+    if (const int error = probe_threads(count, 0, &failed))
+        fail(LPI_ERR_NO_MEMORY, for_what + " needs " + std::to_string(count) +
+                                    " threads, and the system refused to start thread " +
+                                    std::to_string(failed + 1) + thread_limit_text(error));
+}
+
+#if LPI_HAVE_OPENMP
 
 void prepare_thread_team(int n) {
     // The largest team this thread's OpenMP pool is known to hold: libgomp
@@ -134,13 +152,11 @@ void prepare_thread_team(int n) {
         return;
     }
     int failed = 0;
-    if (const int error = probe_threads(n - 1, &failed))
-        fail(LPI_ERR_NO_MEMORY,
-             "cannot run " + std::to_string(n) + " threads: the system refused to start thread " +
-                 std::to_string(failed + 2) + " of " + std::to_string(n) + " (" +
-                 std::generic_category().message(error) +
-                 "); the process is at a limit on threads or memory (ulimit -u, ulimit -v, "
-                 "cgroup pids.max): use fewer threads");
+    if (const int error = probe_threads(n - 1, openmp_stack_size(), &failed))
+        fail(LPI_ERR_NO_MEMORY, "cannot run " + std::to_string(n) +
+                                    " threads: the system refused to start thread " +
+                                    std::to_string(failed + 2) + " of " + std::to_string(n) +
+                                    thread_limit_text(error) + ": use fewer threads");
     // Start the team once (a region with a body: an empty one is compiled
     // away). The runtime may cap it (OMP_THREAD_LIMIT); regions asking for n
     // then get the same team, so n is what this thread is ready for.

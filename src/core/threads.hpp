@@ -5,6 +5,8 @@
 // joins the same number of threads itself, where a refusal is a status.
 #pragma once
 
+#include <string>
+
 namespace lpi {
 
 // Threads per processor a system may use at most: enough for any sensible
@@ -24,5 +26,11 @@ void check_thread_count(int n);
 // so the runtime keeps its threads. Throws LPI_ERR_NO_MEMORY, naming the
 // cause, when the system refuses a thread. Without OpenMP, or n <= 1, nothing.
 void prepare_thread_team(int n);
+
+// Starts `count` threads (default stack size) that all exist at once and
+// joins them: for a library that starts as many when it is loaded, and ends
+// the process when the system refuses one (a threaded OpenBLAS). Throws
+// LPI_ERR_NO_MEMORY, saying that for_what needs them, when the system refuses.
+void require_threads_can_start(int count, const std::string &for_what);
 
 }  // namespace lpi

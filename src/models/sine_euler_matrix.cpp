@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "../core/error.hpp"
+#include "../core/lapack.hpp"
 #include "lpi_config.h"
 #include "sine_euler.hpp"
 #include "sine_euler/indexing.hpp"
@@ -89,11 +90,6 @@ void sine_euler_traces(int N, const double *modes, int kmax, double *out) {
 }
 
 #if LPI_HAVE_LAPACK
-extern "C" void zheevd_(const char *jobz, const char *uplo, const int *n, cplx *a, const int *lda,
-                        double *w, cplx *work, const int *lwork, double *rwork, const int *lrwork,
-                        int *iwork, const int *liwork, int *info, std::size_t jobz_len,
-                        std::size_t uplo_len);
-
 void sine_euler_spectrum(int N, const double *modes, double *out) {
     // Row-major W is column-major W^T = conj(W): the same real spectrum.
     std::vector<cplx> W(static_cast<std::size_t>(N) * N);
@@ -108,7 +104,7 @@ void sine_euler_spectrum(int N, const double *modes, double *out) {
     int info = 0, lwork = -1, lrwork = -1, liwork = -1, iwork_query = 0;
     cplx work_query;
     double rwork_query = 0.0;
-    zheevd_(&jobz, &uplo, &N, W.data(), &N, out, &work_query, &lwork, &rwork_query, &lrwork,
+    lapack::zheevd(&jobz, &uplo, &N, W.data(), &N, out, &work_query, &lwork, &rwork_query, &lrwork,
             &iwork_query, &liwork, &info, 1, 1);
     if (info != 0) fail(LPI_ERR_INTERNAL, "zheevd workspace query failed, info = " + std::to_string(info));
     lwork = static_cast<int>(work_query.real());
@@ -117,7 +113,7 @@ void sine_euler_spectrum(int N, const double *modes, double *out) {
     std::vector<cplx> work(std::max(lwork, 1));
     std::vector<double> rwork(std::max(lrwork, 1));
     std::vector<int> iwork(std::max(liwork, 1));
-    zheevd_(&jobz, &uplo, &N, W.data(), &N, out, work.data(), &lwork, rwork.data(), &lrwork,
+    lapack::zheevd(&jobz, &uplo, &N, W.data(), &N, out, work.data(), &lwork, rwork.data(), &lrwork,
             iwork.data(), &liwork, &info, 1, 1);
     if (info != 0) fail(LPI_ERR_INTERNAL, "zheevd failed to converge, info = " + std::to_string(info));
 }

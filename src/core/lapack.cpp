@@ -1,0 +1,87 @@
+// LAPACK loaded when first needed (see the header).
+#include "lapack.hpp"
+
+#include <dlfcn.h>
+#include <sched.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <mutex>
+#include <string>
+
+#include "error.hpp"
+#include "lpi_config.h"
+#include "threads.hpp"
+
+namespace lpi {
+namespace lapack {
+
+namespace {
+
+using Zheevd = void(const char *, const char *, const int *, cplx *, const int *, double *, cplx *, const int *,
+                    double *, const int *, int *, const int *, int *, std::size_t, std::size_t);
+using Zgemm = void(const char *, const char *, const int *, const int *, const int *, const cplx *,
+                   const cplx *, const int *, const cplx *, const int *, const cplx *, cplx *, const int *,
+                   std::size_t, std::size_t);
+
+struct Routines {
+    Zheevd *zheevd = nullptr;
+    Zgemm *zgemm = nullptr;
+};
+
+// The threads a threaded OpenBLAS starts on loading: one per processor this
+// process may run on, or per thread its environment asks for (the first of
+// OPENBLAS_NUM_THREADS, GOTO_NUM_THREADS, OMP_NUM_THREADS set to a positive
+// number, as OpenBLAS reads them), at most one per processor, less the
+// calling thread. Another LAPACK starts none; counting them all the same
+// only asks the system for threads it will give back at once.
+int threads_started_on_loading() {
+    if (std::string(LPI_LAPACK_LIBRARY).find("openblas") == std::string::npos) return 0;
+    cpu_set_t set;
+    const int processors = sched_getaffinity(0, sizeof set, &set) == 0 ? CPU_COUNT(&set) : 1;
+    int asked = 0;
+    for (const char *name : {"OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS"}) {
+        const char *text = std::getenv(name);
+        if (text && (asked = std::atoi(text)) > 0) break;
+    }
+    return std::min(asked > 0 ? asked : processors, processors) - 1;
+}
+
+const Routines &routines() {
+    static std::mutex mutex;
+    static Routines loaded;
+    std::lock_guard<std::mutex> lock(mutex);
+    if (loaded.zheevd) return loaded;
+    const std::string name = LPI_LAPACK_LIBRARY;
+    require_threads_can_start(threads_started_on_loading(), "loading " + name);
+    void *library = ::dlopen(name.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!library) {
+        const char *why = ::dlerror();
+        fail(LPI_ERR_UNSUPPORTED, "LAPACK (" + name + ") cannot be loaded: " + (why ? why : "no reason given"));
+    }
+    Routines found;
+    found.zheevd = reinterpret_cast<Zheevd *>(::dlsym(library, "zheevd_"));
+    found.zgemm = reinterpret_cast<Zgemm *>(::dlsym(library, "zgemm_"));
+    if (!found.zheevd || !found.zgemm)
+        fail(LPI_ERR_UNSUPPORTED, "LAPACK (" + name + ") has no " + (found.zheevd ? "zgemm_" : "zheevd_"));
+    loaded = found;  // the library stays loaded for the life of the process
+    return loaded;
+}
+
+}  // namespace
+
+void zheevd(const char *jobz, const char *uplo, const int *n, cplx *a, const int *lda, double *w,
+            cplx *work, const int *lwork, double *rwork, const int *lrwork, int *iwork, const int *liwork,
+            int *info, std::size_t jobz_len, std::size_t uplo_len) {
+    routines().zheevd(jobz, uplo, n, a, lda, w, work, lwork, rwork, lrwork, iwork, liwork, info, jobz_len,
+                      uplo_len);
+}
+
+void zgemm(const char *transa, const char *transb, const int *m, const int *n, const int *k, const cplx *alpha,
+           const cplx *a, const int *lda, const cplx *b, const int *ldb, const cplx *beta, cplx *c,
+           const int *ldc, std::size_t transa_len, std::size_t transb_len) {
+    routines().zgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc, transa_len, transb_len);
+}
+
+}  // namespace lapack
+}  // namespace lpi
