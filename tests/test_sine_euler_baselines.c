@@ -218,8 +218,10 @@ static void test_modes_stay_exactly_hermitian(void **state) {
     const size_t n = (size_t)N * N;
     double w[2 * 81], out[2 * 81];
     random_field(N, 11, w);
-    const char *methods[] = {"rk4", "implicit-midpoint"};
-    for (int k = 0; k < 2; ++k) {
+    /* direct-eq5 sums each mode's rate on its own: its pairs must still be
+     * exact conjugates (they drifted apart at the flow's instability rate). */
+    const char *methods[] = {"rk4", "implicit-midpoint", "direct-eq5"};
+    for (int k = 0; k < 3; ++k) {
         run(N, w, methods[k], 20.0, 2000, out);
         assert_true(out[1] == 0.0);
         size_t broken = 0;
@@ -232,6 +234,53 @@ static void test_modes_stay_exactly_hermitian(void **state) {
                methods[k], N, broken, n);
         assert_int_equal(broken, 0);
         assert_true(max_abs_diff(out, w, 2 * n) > 1e-3); /* the field did move */
+    }
+}
+
+static int keep_going(const lpi_system *sys, int64_t step, double t, void *user) {
+    (void)sys, (void)step, (void)t, (void)user;
+    return 0;
+}
+static int stop_at_twenty(const lpi_system *sys, int64_t step, double t, void *user) {
+    (void)sys, (void)t, (void)user;
+    return step == 20;
+}
+
+/* Observing changes no bit of a baseline's trajectory, and a stop leaves the
+ * state of a call of that many steps: the matrix methods keep W across the
+ * observations (isomp's first-step guess too), instead of a run per stretch. */
+static void test_observing_changes_nothing(void **state) {
+    (void)state;
+    require_fftw();
+    const int N = 9;
+    const size_t n = 2 * (size_t)N * N;
+    double w[2 * 81], plain[2 * 81], observed[2 * 81];
+    random_field(N, 5, w);
+    const char *methods[] = {"rk4", "direct-eq5", "rk4-matrix", "isomp"};
+    for (int k = 0; k < 4; ++k) {
+        if (k >= 2 && !have_blas) {
+            printf("%s: not checked (built without BLAS/LAPACK)\n", methods[k]);
+            continue;
+        }
+        run(N, w, methods[k], 3.0, 30, plain);
+        lpi_system *sys = sine_euler(N, w);
+        assert_int_equal(lpi_set_method(sys, methods[k]), LPI_OK);
+        assert_int_equal(lpi_set_observer(sys, 1, keep_going, NULL), LPI_OK);
+        assert_int_equal(lpi_step(sys, 0.1, 30), LPI_OK);
+        assert_int_equal(lpi_sine_euler_get_modes(sys, observed, n), LPI_OK);
+        printf("%-10s observed every step: %.1e from the unobserved run\n", methods[k],
+               max_abs_diff(observed, plain, n));
+        assert_memory_equal(observed, plain, sizeof plain);
+        lpi_destroy(sys);
+
+        run(N, w, methods[k], 2.0, 20, plain);
+        sys = sine_euler(N, w);
+        assert_int_equal(lpi_set_method(sys, methods[k]), LPI_OK);
+        assert_int_equal(lpi_set_observer(sys, 10, stop_at_twenty, NULL), LPI_OK);
+        assert_int_equal(lpi_step(sys, 0.1, 1000), LPI_STOPPED);
+        assert_int_equal(lpi_sine_euler_get_modes(sys, observed, n), LPI_OK);
+        assert_memory_equal(observed, plain, sizeof plain);
+        lpi_destroy(sys);
     }
 }
 
@@ -361,6 +410,7 @@ int main(void) {
         cmocka_unit_test(test_rk4_forms_agree),
         cmocka_unit_test(test_orders),
         cmocka_unit_test(test_modes_stay_exactly_hermitian),
+        cmocka_unit_test(test_observing_changes_nothing),
         cmocka_unit_test(test_spectrum_of_overflowing_matrix),
         cmocka_unit_test(test_isomp_isospectral),
         cmocka_unit_test(test_isomp_non_convergence_rolls_back),
