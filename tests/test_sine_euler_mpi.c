@@ -164,6 +164,18 @@ static void test_checkpoint(void **state) {
     lpi_system *none = NULL;
     assert_int_equal(lpi_load_mpi(&none, "no/such/file.lpi", MPI_COMM_WORLD), LPI_ERR_IO);
     assert_null(none);
+    /* An intact checkpoint of a baseline's run: a system spread over
+     * processes cannot step by it (LPI_ERR_UNSUPPORTED, not a bad file). */
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (rank_ == 0) {
+        assert_int_equal(lpi_set_method(single, "rk4"), LPI_OK);
+        assert_int_equal(lpi_step(single, 0.05, 2), LPI_OK);
+        assert_int_equal(lpi_save(single, path), LPI_OK);
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    assert_int_equal(lpi_load_mpi(&none, path, MPI_COMM_WORLD), LPI_ERR_UNSUPPORTED);
+    assert_non_null(strstr(lpi_last_error(NULL), "baseline"));
+    assert_null(none);
     MPI_Barrier(MPI_COMM_WORLD);
     if (rank_ == 0) remove(path);
     lpi_destroy(spread), lpi_destroy(single), lpi_destroy(loaded), lpi_destroy(reloaded);
@@ -352,6 +364,9 @@ static void test_different_arguments(void **state) {
     assert_int_equal(lpi_load_mpi(last ? NULL : &none, "never_written.lpi", MPI_COMM_WORLD), LPI_ERR_INVALID);
     assert_null(none);
 
+    /* A thread count refused on one process is refused on all, and the
+     * count stays (each process bounds it by its own processors). */
+    LPI_ASSERT_FAILS(spread, lpi_set_threads(spread, last ? 0 : 1), LPI_ERR_INVALID, "lpi_set_threads");
     /* Threads per process may differ: the same bits. */
     const int threads = lpi_set_threads(spread, 1 + rank_ % 2);
     assert_true(threads == LPI_OK || threads == LPI_ERR_UNSUPPORTED);

@@ -301,7 +301,10 @@ void restore_checkpoint(System &system, const Checkpoint &cp) {
         }
         system.restore_working_state(cp.state, cp.time);
     } catch (const Error &e) {
-        if (e.status() == LPI_ERR_NO_MEMORY) throw;
+        // Not a bad file: a method this build or this system cannot run (a
+        // baseline on a system spread over processes, a matrix baseline
+        // without LAPACK), or no memory.
+        if (e.status() == LPI_ERR_NO_MEMORY || e.status() == LPI_ERR_UNSUPPORTED) throw;
         fail(LPI_ERR_FORMAT, e.what());
     }
     // An alias ("strang") is resolved on load but never written.

@@ -71,6 +71,11 @@ public:
     // Whether `value` holds on any process (an observer that stops the run
     // on one process stops it on all).
     virtual bool on_any_process(bool value) const { return value; }
+    // Runs action on every process; when it throws on any of them, every
+    // process throws the status and message of the lowest such rank (a
+    // check whose answer may differ between processes, such as a thread
+    // count bounded by each process's processors).
+    virtual void agree_on_every_process(const std::function<void()> &action) const { action(); }
     // Throws LPI_ERR_INVALID on every process when the processes passed
     // different bytes (`what`, named in the message), before anything reads
     // them otherwise: a value refused on one process alone would leave the

@@ -111,12 +111,17 @@ void System::restore_working_state(std::vector<double> state, double time) {
 }
 
 void System::set_threads(int n) {
-    check_thread_count(n);
-    model_->set_threads(n);  // throws, unchanged, if the model refuses n
+    // Each process bounds n by its own processors and limits: every process
+    // takes the outcome of all, and one refused anywhere is refused, and
+    // undone, everywhere.
     try {
-        prepare_thread_team(n);
+        model_->agree_on_every_process([&] {
+            check_thread_count(n);
+            model_->set_threads(n);  // throws, unchanged, if the model refuses n
+            prepare_thread_team(n);
+        });
     } catch (...) {
-        model_->set_threads(threads_);
+        model_->set_threads(threads_);  // accepted before: cannot throw
         throw;
     }
     threads_ = n;

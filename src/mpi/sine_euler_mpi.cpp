@@ -106,6 +106,7 @@ public:
     std::vector<double> whole_state(const double *state) const override;
     void on_one_process(const std::function<void()> &action) const override { comm_->on_root(action); }
     bool on_any_process(bool value) const override { return !comm_->all(!value); }
+    void agree_on_every_process(const std::function<void()> &action) const override { comm_->agree(action); }
     void require_same_on_every_process(const void *bytes, std::size_t size, const std::string &what) const override {
         comm_->require_same(fingerprint(bytes, size), what);
     }
