@@ -4,7 +4,10 @@
 # order), the output is written once (one CSV, each row once, one data file),
 # a run resumed under mpirun from its checkpoint ends bit for bit where the
 # uninterrupted run under mpirun ends, the checkpoint loads in a one-process
-# lpi too, and the commands that do not spread refuse to run under mpirun.
+# lpi too, the commands that do not spread refuse to run under mpirun, and a
+# failure on some processes only (a file rank 0 alone writes, --threads
+# refused by one process) stops every process with the same status, none
+# left waiting (each such run has a time limit: a hang fails).
 #   check_lpi_run_mpi.sh LPI MPIEXEC OUT
 set -eu
 lpi="$1"; mpiexec="$2"; out="$3"
@@ -50,4 +53,46 @@ rc=0; "$mpiexec" -n 2 --oversubscribe "$lpi" run rollup --N 9 --steps 3 --out "$
 "$mpiexec" -n 2 --oversubscribe "$lpi" run sqg --N 9 --dt 0.05 --steps 20 --every 10 --format npy \
     --snapshots 0 --out "$out/sqg2" >/dev/null
 close "$out/sqg1/sqg.csv" "$out/sqg2/sqg.csv" || { echo "lpi run sqg under mpirun -n 2 differs"; exit 1; }
-echo "lpi run under mpirun: P = 1..3 agree with one process, output once, resume bit for bit"
+# Failures on some processes only. rank.sh runs lpi and records its exit
+# status in $out/NAME.rc.RANK, then exits 0 so that mpiexec lets every process
+# finish; with RANK_CPUS ("0,1 0": rank 0 on CPUs 0 and 1, rank 1 on CPU 0)
+# it pins each process's CPUs.
+cat > "$out/rank.sh" <<'EOF'
+#!/bin/sh
+r=${OMPI_COMM_WORLD_RANK:-${PMI_RANK:-${PMIX_RANK:-0}}}
+cpus=$(echo ${RANK_CPUS:-} | cut -s -d' ' -f$((r + 1)))
+[ -z "${RANK_CPUS:-}" ] || set -- taskset -c "${cpus:-0}" "$@"
+"$@"; echo $? > "$RANK_STATUS.$r"
+EOF
+statuses() {  # statuses NAME MPIEXEC-OPTIONS...: each process's exit status of lpi $run_args
+    name="$1"; shift
+    rm -f "$out/$name.rc."*
+    rc=0
+    RANK_STATUS="$out/$name.rc" timeout 60 "$mpiexec" -n 2 --oversubscribe "$@" sh "$out/rank.sh" "$lpi" \
+        $run_args >/dev/null 2>"$out/$name.err" || rc=$?
+    [ "$rc" -ne 124 ] || { echo "hang"; return; }
+    echo $(cat "$out/$name.rc.0" "$out/$name.rc.1" 2>/dev/null)
+}
+fails_everywhere() {  # fails_everywhere NAME MESSAGE: every process exits 1, MESSAGE printed once
+    got=$(statuses "$1")
+    [ "$got" = "1 1" ] || { echo "$1: the processes exit with '$got', not 1 on each:"; cat "$out/$1.err"; exit 1; }
+    [ "$(grep -c -e "$2" "$out/$1.err")" -eq 1 ] || { echo "$1: '$2' not printed once:"; cat "$out/$1.err"; exit 1; }
+}
+short="$run --steps 40"
+mkdir -p "$out/csvdir/sine-euler.csv"  # rank 0 cannot write the CSV,
+run_args="$short --out $out/csvdir"; fails_everywhere csvdir "cannot write"
+mkdir -p "$out/datafail"; : > "$out/datafail/sine-euler"  # nor the .npy files,
+run_args="$short --out $out/datafail"; fails_everywhere datafail "was not written"
+run_args="$short --planning measure --wisdom $out/nodir/w.txt --out $out/wisdom"  # nor the wisdom
+fails_everywhere wisdom "cannot save"
+# --threads 5, within rank 0's bound (4 x 2 CPUs) and beyond rank 1's (4 x 1):
+# accepted or refused, alike on every process.
+if [ "$(nproc)" -ge 2 ] && command -v taskset >/dev/null 2>&1; then
+    run_args="$short --threads 5 --out $out/threads"
+    got=$(export RANK_CPUS="0,1 0"; statuses threads --bind-to none)
+    case "$got" in "0 0" | "2 2") ;; *) echo "--threads 5 on 2 and 1 CPUs: the processes exit with '$got':"
+        cat "$out/threads.err"; exit 1 ;; esac
+else
+    echo "note: --threads on processes with different CPUs not checked (it needs 2 CPUs and taskset)"
+fi
+echo "lpi run under mpirun: P = 1..3 agree with one process, output once, resume bit for bit, failures agreed"

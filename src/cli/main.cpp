@@ -196,5 +196,6 @@ int main(int argc, char **argv) {
         std::fprintf(stderr, "lpi: writing the standard output failed: %s\n", std::strerror(errno));
         if (status == 0) status = 1;
     }
-    return status;
+    // Rank 0 alone prints and draws: every process exits with its status.
+    return agreed_failure(status);
 }

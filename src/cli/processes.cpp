@@ -65,6 +65,24 @@ void synchronize() {
     if (world_size > 1) MPI_Barrier(MPI_COMM_WORLD);
 }
 
+int agreed_failure(int status, const std::string &why) {
+    int first = status != 0 ? world_rank : world_size;
+    if (world_size > 1) MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    if (first == world_size) return 0;
+    std::string message = why;
+    if (world_size > 1) {
+        // Only rank 0 prints (the others' stderr is /dev/null): it takes the
+        // first failing process's status and message.
+        int sizes[2] = {status, static_cast<int>(message.size())};
+        MPI_Bcast(sizes, 2, MPI_INT, first, MPI_COMM_WORLD);
+        status = sizes[0];
+        message.resize(static_cast<std::size_t>(sizes[1]));
+        MPI_Bcast(&message[0], sizes[1], MPI_CHAR, first, MPI_COMM_WORLD);
+    }
+    if (!message.empty()) std::fprintf(stderr, "%s\n", message.c_str());
+    return status;
+}
+
 #else
 
 void start_processes(int *, char ***) {}
@@ -74,6 +92,11 @@ int create_sine_euler(lpi_system **out, int32_t N) { return lpi_sine_euler_creat
 int load_checkpoint(lpi_system **out, const char *path) { return lpi_load(out, path); }
 int agreed_signal(int caught) { return caught; }
 void synchronize() {}
+
+int agreed_failure(int status, const std::string &why) {
+    if (status != 0 && !why.empty()) std::fprintf(stderr, "%s\n", why.c_str());
+    return status;
+}
 
 #endif
 

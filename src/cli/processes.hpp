@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include <liepoisson.h>
 
@@ -29,5 +30,15 @@ int agreed_signal(int caught);
 // Returns once every process has called it (files read before rank 0
 // rewrites them).
 void synchronize();
+// Whether a step that may fail on some processes only failed on any
+// (collective: every process calls it at the same point). Such steps are
+// rank 0's alone (the files it writes) or each process's own (the files it
+// reads, a limit of its own such as --threads): a process that stopped there
+// alone would leave the others waiting forever in the next collective call.
+// `status` is this process's exit status (0 or false: it succeeded), `why`
+// its message (empty: none, or printed already by rank 0). Returns 0 where
+// every process succeeded, else on every process the status of the lowest
+// failing rank, whose message rank 0 prints on standard error.
+int agreed_failure(int status, const std::string &why = "");
 
 }  // namespace lpi_cli

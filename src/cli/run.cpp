@@ -26,13 +26,15 @@ namespace lpi_cli {
 
 namespace {
 
-// Stops the command, naming the option, when the library refused it: a
-// usage error (exit status 2), or with `exit_status` 1 a file it names that
-// could not be read or written.
+// Stops the command, naming the option, when the library refused it on any
+// process: a usage error (exit status 2), or with `exit_status` 1 a file it
+// names that could not be read or written. Collective (agreed_failure): a
+// refusal may be one process's (--threads beyond its CPUs, a wisdom file).
 void check_option(int status, const lpi_system *sys, const char *option, int exit_status = 2) {
-    if (status == LPI_OK) return;
-    std::fprintf(stderr, "lpi run: %s: %s (%s)\n", option, lpi_last_error(sys), lpi_status_name(status));
-    std::exit(exit_status);
+    const std::string why = status == LPI_OK ? ""
+                                             : format("lpi run: %s: %s (%s)", option, lpi_last_error(sys),
+                                                      lpi_status_name(status));
+    if (const int agreed = agreed_failure(status == LPI_OK ? 0 : exit_status, why)) std::exit(agreed);
 }
 
 // Whether `loaded` is a state of the system `fresh` (the scene with these
@@ -113,7 +115,9 @@ int run_command(int argc, char **argv) {
     if (!o.init.empty()) {
         // The grid's N is the scene's.
         int N = n_given ? o.scene_options.sine_euler_n : 0;
-        init_grid = initial_grid(o.init, &N);
+        std::string why;
+        const int status = initial_grid(o.init, &N, init_grid, why);  // each process reads it
+        if (const int agreed = agreed_failure(status, why)) return agreed;
         o.scene_options.sine_euler_n = N;
         all = builtin_scenes(o.scene_options);
         it = find_scene();
@@ -154,10 +158,10 @@ int run_command(int argc, char **argv) {
     }
     if (!o.resume.empty()) {
         Handle loaded;
-        if (load_checkpoint(loaded.out(), o.resume.c_str()) != LPI_OK) {
-            std::fprintf(stderr, "lpi run: --resume: %s\n", lpi_last_error(nullptr));
-            return 1;
-        }
+        // Not spread (another kind), the checkpoint is read by each process.
+        const bool failed = load_checkpoint(loaded.out(), o.resume.c_str()) != LPI_OK;
+        const std::string no_load = failed ? std::string("lpi run: --resume: ") + lpi_last_error(nullptr) : "";
+        if (const int agreed = agreed_failure(failed, no_load)) return agreed;
         const std::string why = mismatch(h.get(), loaded.get());
         if (!why.empty()) {
             std::fprintf(stderr, "lpi run: --resume: %s is not a checkpoint of this scene: %s\n",
@@ -173,18 +177,21 @@ int run_command(int argc, char **argv) {
     // uses it; measured plans are written back for the next run. A wisdom
     // file that cannot be read or written fails as any file does (exit
     // status 1); only a regular one is read (FFTW would wait on a FIFO).
-    struct stat wisdom_file;
-    if (!o.wisdom.empty() && stat(o.wisdom.c_str(), &wisdom_file) == 0) {
-        if (!S_ISREG(wisdom_file.st_mode)) {
-            std::fprintf(stderr, "lpi run: --wisdom: %s is not a regular file\n", o.wisdom.c_str());
-            return 1;
-        }
-        check_option(lpi_fftw_wisdom_import_file(o.wisdom.c_str()), nullptr, "--wisdom", 1);
+    // Each process reads the file, and rank 0 alone writes it: all agree.
+    if (!o.wisdom.empty()) {
+        struct stat wisdom_file;
+        const bool exists = stat(o.wisdom.c_str(), &wisdom_file) == 0;
+        const bool regular = exists && S_ISREG(wisdom_file.st_mode);
+        std::string why;
+        if (exists && !regular) why = "lpi run: --wisdom: " + o.wisdom + " is not a regular file";
+        if (const int agreed = agreed_failure(!why.empty(), why)) return agreed;
+        check_option(regular ? lpi_fftw_wisdom_import_file(o.wisdom.c_str()) : LPI_OK, nullptr, "--wisdom", 1);
     }
     if (!o.planning.empty()) {
         check_option(lpi_sine_euler_set_planning(sys, o.planning.c_str()), sys, "--planning");
-        if (!o.wisdom.empty() && o.planning != "estimate" && writes_output())
-            check_option(lpi_fftw_wisdom_export_file(o.wisdom.c_str()), nullptr, "--wisdom", 1);
+        if (!o.wisdom.empty() && o.planning != "estimate")
+            check_option(writes_output() ? lpi_fftw_wisdom_export_file(o.wisdom.c_str()) : LPI_OK, nullptr,
+                         "--wisdom", 1);
     }
     // The method in use: --method's, else a new system's default or the
     // checkpoint's (it holds the method).
@@ -230,11 +237,10 @@ int run_command(int argc, char **argv) {
                                          : std::vector<std::size_t>{lpi_dim(sys)};
     data.casimir_count = lpi_casimir_count(sys);
 
-    const std::string no_dir = make_output_dir(o.out_dir);  // every process: all stop alike
-    if (!no_dir.empty()) {
-        std::fprintf(stderr, "lpi run: --out %s\n", no_dir.c_str());
-        return 1;
-    }
+    // Every process makes it (or finds it there), each on its own disk.
+    const std::string no_dir = make_output_dir(o.out_dir);
+    if (const int agreed = agreed_failure(!no_dir.empty(), no_dir.empty() ? "" : "lpi run: --out " + no_dir))
+        return agreed;
     const std::string csv = o.out_dir + "/" + o.scene + ".csv";
     std::vector<std::string> kept;
     if (!o.resume.empty()) {
@@ -276,9 +282,10 @@ int run_command(int argc, char **argv) {
     // the others write their rows nowhere.
     synchronize();
     FILE *f = std::fopen(writes_output() ? csv.c_str() : "/dev/null", "w");
-    if (!f) {
-        std::fprintf(stderr, "lpi run: cannot write %s: %s\n", csv.c_str(), std::strerror(errno));
-        return 1;
+    const std::string no_csv = f ? "" : format("lpi run: cannot write %s: %s", csv.c_str(), std::strerror(errno));
+    if (const int agreed = agreed_failure(!f, no_csv)) {
+        if (f) std::fclose(f);
+        return agreed;
     }
     if (kept.empty()) {
         std::fprintf(f, "step,time,energy,energy_error");
@@ -287,15 +294,17 @@ int run_command(int argc, char **argv) {
     }
     for (const std::string &line : kept) std::fprintf(f, "%s\n", line.c_str());
     // Flushed row by row: a killed run leaves complete rows.
-    auto row = [&](int64_t step) {
-        const double H = energy_of(sys);
-        const std::vector<double> c = casimirs_of(sys);
+    auto record = [&](int64_t step, double H, const std::vector<double> &c) {
         add_row(step, lpi_time(sys), H, c);
         std::fprintf(f, "%lld,%.17g,%.17g,%.6e", static_cast<long long>(step), lpi_time(sys), H,
                      data.energy_error.back());
         for (double v : c) std::fprintf(f, ",%.17g", v);
         std::fprintf(f, "\n");
         std::fflush(f);
+    };
+    auto row = [&](int64_t step) {
+        const double H = energy_of(sys);  // collective: every process writes every row
+        record(step, H, casimirs_of(sys));
     };
     auto snapshot = [&](int64_t step) {
         if (o.snapshot_every <= 0 || row_index(step) % o.snapshot_every != 0) return;
@@ -308,17 +317,18 @@ int run_command(int argc, char **argv) {
         data.snapshot_step.push_back(static_cast<double>(step));
         data.snapshot_time.push_back(lpi_time(sys));
     };
-    // A checkpoint that cannot be written stops the run: going on would lose it.
-    auto save_checkpoint = [&](const lpi_system *state, int64_t step) {
-        if (lpi_save(state, o.checkpoint.c_str()) == LPI_OK) return;
-        std::fprintf(stderr, "lpi run: checkpoint not written at step %lld: %s\n",
-                     static_cast<long long>(step), lpi_last_error(state));
-        std::exit(1);
+    // A checkpoint that cannot be written stops the run: going on would lose
+    // it. `status` is lpi_save's (rank 0 alone may save one), agreed by all.
+    auto checkpoint_saved = [&](int status, const lpi_system *state, int64_t step) {
+        const std::string why = status == LPI_OK ? ""
+                                                 : format("lpi run: checkpoint not written at step %lld: %s",
+                                                          static_cast<long long>(step), lpi_last_error(state));
+        if (const int agreed = agreed_failure(status != LPI_OK, why)) std::exit(agreed);
     };
     auto save = [&](int64_t step, bool always) {
         if (o.checkpoint.empty()) return;
         if (!always && (o.checkpoint_every <= 0 || row_index(step) % o.checkpoint_every != 0)) return;
-        save_checkpoint(sys, step);
+        checkpoint_saved(lpi_save(sys, o.checkpoint.c_str()), sys, step);
     };
     const std::vector<Attribute> attributes = {
         {"scene", o.scene, 0.0, true},
@@ -331,12 +341,12 @@ int run_command(int argc, char **argv) {
         {"description", it->description, 0.0, true},
     };
     SnapshotBytes bytes;
-    auto keep_data = [&] {
-        if (!writes_output()) return true;
+    // Writes the data (rank 0 alone): "" or the message saying why not.
+    auto keep_data = [&]() -> std::string {
+        if (!writes_output()) return "";
         const std::string why = write_data(o, data, attributes, bytes);
-        if (why.empty()) return true;
-        std::fprintf(stderr, "lpi run: the data %s was not written: %s\n", data_path(o).c_str(), why.c_str());
-        return false;
+        if (why.empty()) return "";
+        return format("lpi run: the data %s was not written: %s", data_path(o).c_str(), why.c_str());
     };
 
     std::printf("lpi run %s: steps %lld to %lld of %g with %s, output every %lld steps\n", o.scene.c_str(),
@@ -347,7 +357,9 @@ int run_command(int argc, char **argv) {
     // cleanly (before the first step, if it comes that early).
     catch_interrupts();
     save(start, true);
-    if (kept.empty()) row(start);
+    // The start's row when the CSV has none, from H0 and C0 (this state's
+    // then): the CSV each process read may differ, and energy_of is collective.
+    if (kept.empty()) record(start, H0, C0);
     if (o.resume.empty()) snapshot(0);
     Progress progress(start, end);
     Watch watch;
@@ -384,7 +396,9 @@ int run_command(int argc, char **argv) {
                                  "the last row of %s\n",
                          static_cast<long long>(done), static_cast<long long>(next), lpi_last_error(sys),
                          lpi_status_name(status), static_cast<long long>(done), csv.c_str());
-            keep_data();
+            // lpi_step's status is the same on every process: all stop here.
+            const std::string why = keep_data();
+            if (!why.empty()) std::fprintf(stderr, "%s\n", why.c_str());
             return 1;
         }
         done = next;
@@ -394,19 +408,22 @@ int run_command(int argc, char **argv) {
         progress.update(done);
     }
     progress.finish();
-    if (stopped_between_rows && !o.checkpoint.empty() && writes_output()) {
-        Handle at_call_start;
-        check(lpi_load_buffer(at_call_start.out(), call_start_checkpoint.data(), call_start_checkpoint.size()),
-              nullptr, "checkpoint");
-        save_checkpoint(at_call_start.get(), done);
+    if (stopped_between_rows && !o.checkpoint.empty()) {
+        Handle at_call_start;  // one process's system: rank 0 alone saves it
+        int status = LPI_OK;
+        if (writes_output()) {
+            status = lpi_load_buffer(at_call_start.out(), call_start_checkpoint.data(),
+                                     call_start_checkpoint.size());
+            if (status == LPI_OK) status = lpi_save(at_call_start.get(), o.checkpoint.c_str());
+        }
+        checkpoint_saved(status, at_call_start.get(), done);
     } else if (!stopped_between_rows) {
         save(done, true);
     }
-    if (!close_written(f)) {
-        std::fprintf(stderr, "lpi run: writing %s failed\n", csv.c_str());
-        return 1;
-    }
-    if (!keep_data()) return 1;
+    // Rank 0 alone writes the CSV and the data.
+    std::string why = close_written(f) ? "" : "lpi run: writing " + csv + " failed";
+    if (why.empty()) why = keep_data();
+    if (const int agreed = agreed_failure(!why.empty(), why)) return agreed;
     const double H = energy_of(sys);
     if (interrupted_by) {
         const int64_t stop = stopped_between_rows ? watch.stopped_at : done;
@@ -422,6 +439,7 @@ int run_command(int argc, char **argv) {
     std::printf("done: t = %g, %.3f CPU seconds, relative energy error %.3e; wrote %s and %s\n", lpi_time(sys),
                 cpu_seconds() - t0, (H - H0) / std::fabs(H0), csv.c_str(), data_path(o).c_str());
 
+    // Rank 0 alone draws the snapshots: main agrees on the exit status.
     if (writes_output() && data.vorticity && !data.snapshot_step.empty()) {
         if (!have_gnuplot()) {
             std::printf("gnuplot not found: no vorticity images (the snapshots are in %s)\n",

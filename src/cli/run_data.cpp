@@ -136,51 +136,43 @@ void keep_snapshots(const RunOptions &o, int64_t start, RunData &d) {
 }
 
 
-// The initial grid of --init, checked against the system's N. Exits 1 when
-// the file cannot be read, 2 when it holds no N x N grid for this run.
-std::vector<double> initial_grid(const std::string &path, int *N) {
+// The initial grid of --init into `grid`, checked against the system's N:
+// 0, or the exit status with the message in `why`.
+int initial_grid(const std::string &path, int *N, std::vector<double> &grid, std::string &why) {
+    auto refused = [&](int status, const std::string &message) {
+        why = "lpi run: --init " + path + ": " + message;
+        return status;
+    };
     Array a;
-    std::string why;
+    std::string error;
     if (is_hdf5_file(path)) {
         bool found = false;
-        why = read_hdf5(path, "init", a, &found);
-        if (!found && why.rfind("no dataset", 0) == 0) why = read_hdf5(path, "vorticity", a, &found);
-        if (!why.empty() && found) {
-            std::fprintf(stderr, "lpi run: --init %s: %s\n", path.c_str(), why.c_str());
-            std::exit(2);
-        }
-        if (!why.empty() && why.rfind("no dataset", 0) == 0) {
-            std::fprintf(stderr, "lpi run: --init %s: no dataset /init or /vorticity\n", path.c_str());
-            std::exit(2);
-        }
+        error = read_hdf5(path, "init", a, &found);
+        if (!found && error.rfind("no dataset", 0) == 0) error = read_hdf5(path, "vorticity", a, &found);
+        if (!error.empty() && found) return refused(2, error);
+        if (!error.empty() && error.rfind("no dataset", 0) == 0)
+            return refused(2, "no dataset /init or /vorticity");
         // A run's /vorticity holds snapshots (S, N, N): start from the last.
-        if (why.empty() && a.shape.size() == 3 && a.shape[0] > 0) {
+        if (error.empty() && a.shape.size() == 3 && a.shape[0] > 0) {
             const std::size_t size = a.shape[1] * a.shape[2];
             a.values.erase(a.values.begin(), a.values.end() - static_cast<std::ptrdiff_t>(size));
             a.shape.erase(a.shape.begin());
         }
     } else {
-        why = read_npy(path, a);
+        error = read_npy(path, a);
     }
-    if (!why.empty()) {
-        std::fprintf(stderr, "lpi run: --init %s: %s\n", path.c_str(), why.c_str());
-        std::exit(1);
-    }
+    if (!error.empty()) return refused(1, error);
     std::string shape;
     for (std::size_t d : a.shape) shape += (shape.empty() ? "" : ", ") + std::to_string(d);
     if (a.shape.size() != 2 || a.shape[0] != a.shape[1] || a.shape[0] < 3 || a.shape[0] % 2 == 0 ||
-        a.shape[0] > 2147483647u) {
-        std::fprintf(stderr, "lpi run: --init %s: the array has shape (%s), not (N, N) with N odd >= 3\n",
-                     path.c_str(), shape.c_str());
-        std::exit(2);
-    }
-    if (*N > 0 && static_cast<std::size_t>(*N) != a.shape[0]) {
-        std::fprintf(stderr, "lpi run: --init %s: the grid is %s x %s, but --N is %d\n", path.c_str(),
-                     std::to_string(a.shape[0]).c_str(), std::to_string(a.shape[0]).c_str(), *N);
-        std::exit(2);
-    }
+        a.shape[0] > 2147483647u)
+        return refused(2, "the array has shape (" + shape + "), not (N, N) with N odd >= 3");
+    if (*N > 0 && static_cast<std::size_t>(*N) != a.shape[0])
+        return refused(2, "the grid is " + std::to_string(a.shape[0]) + " x " + std::to_string(a.shape[0]) +
+                              ", but --N is " + std::to_string(*N));
     *N = static_cast<int>(a.shape[0]);
-    return a.values;
+    grid = std::move(a.values);
+    return 0;
 }
 
 

@@ -60,9 +60,11 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
 // on stdout (not an error) when they cannot be read.
 void keep_snapshots(const RunOptions &o, int64_t start, RunData &d);
 
-// The initial grid of --init, checked against the system's N. Exits 1 when
-// the file cannot be read, 2 when it holds no N x N grid for this run.
-std::vector<double> initial_grid(const std::string &path, int *N);
+// The initial grid of --init into `grid`, checked against the system's N:
+// 0, or the exit status with the message in `why` (each process reads the
+// file, and lpi run agrees on the outcome): 1 when the file cannot be read,
+// 2 when it holds no N x N grid for this run.
+int initial_grid(const std::string &path, int *N, std::vector<double> &grid, std::string &why);
 
 // Draws every vorticity snapshot of the data as PNG and SVG with gnuplot,
 // which reads the doubles straight from the data file (nothing is copied
