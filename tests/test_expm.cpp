@@ -552,17 +552,25 @@ void test_contracted_components_keep_relative_accuracy(void **) {
         assert_int_equal(static_cast<int>(series.path()),
                          static_cast<int>(lpi::ExpmPath::DiagonalSeries));
         // Pade: a contracted index that feeds a growing one,
-        // [[-s, 0, 0], [1, s, 0], [0, 1, 0]], keeps the relative accuracy of
-        // its exponential (|s| ulps: Pade's own backward error).
+        // [[-s, 0, 0], [1, s, 0], [0, 1, 0]], lower triangular, and its
+        // feeding scaled by B: the index, a component of its own, keeps the
+        // relative accuracy of its exponential however large B (the block is
+        // put in upper triangular order, so pivoting makes no fill-in for
+        // the squarings to multiply; e^-20 came out as -6e-7 at B = 10, and
+        // its entry is exp itself, not 2^s squarings of a Pade value).
         const std::vector<lpi::SparseTerm> triangular = {
             {0, 0, 0, -1.0}, {1, 1, 0, 1.0}, {1, 0, 1, 1.0}, {2, 1, 1, 1.0}};
         lpi::SparseExponential pade(3, triangular);
         assert_int_equal(static_cast<int>(pade.path()), static_cast<int>(lpi::ExpmPath::Pade));
-        y = {0.7, 0.2, -0.4};
-        pade.apply(g, 1.0, y.data());
-        const double fed = static_cast<double>(std::fabs(y[0] - 0.7L * shrink) / (0.7L * shrink));
-        std::printf("Pade, contracted index feeding a growing one, s = %g: rel. error %.2e\n", s, fed);
-        assert_true(fed < (8 + 2 * s) * 2.2e-16);
+        for (double B : {1.0, 10.0, 1e3, 1e6}) {
+            const double feeding[2] = {s, B};
+            y = {0.7, 0.2, -0.4};
+            pade.apply(feeding, 1.0, y.data());
+            const double fed = static_cast<double>(std::fabs(y[0] - 0.7L * shrink) / (0.7L * shrink));
+            std::printf("Pade, contracted index feeding a growing one, s = %g, B = %g: rel. error %.2e\n", s,
+                        B, fed);
+            assert_true(fed < 2 * 2.2e-16);
+        }
         const double t = 0.25, h = 4.0 * s;  // t h = s exactly
         y = {1.1, -0.6, 0.9, 2.5};
         if (s <= 10.0) {  // e^{3 s} overflows nothing; e^{-4 s} is far below 1

@@ -209,6 +209,7 @@ private:
     std::vector<double> powers_;  // per group: exp(k s) - 1, k = -kMaxMultiple .. kMaxMultiple
     std::vector<double> scaled_values_;
     std::vector<BlockEntry> block_;  // per position, block paths
+    std::vector<bool> alone_;        // Pade: per local index, a component of its own
     std::vector<double> scaled_, increment_, dense_, exp_, direct_, pade_scratch_;
 };
 

@@ -6,6 +6,8 @@
 #include <limits>
 #include <string>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "../core/error.hpp"
 #include "expm.hpp"
@@ -75,6 +77,72 @@ void plane_hyperbolic_apply(double a, double b, double c, double d, double &x0, 
     const double grow = std::exp(tau + r), shrink = std::exp(tau - r);
     x0 = grow * u0 + shrink * v0;
     x1 = grow * u1 + shrink * v1;
+}
+
+// The m indices of a block in an order that makes its matrix block upper
+// triangular: edges holds (j, i) for each entry A_ij != 0 off the diagonal
+// (x_j drives x_i). Tarjan's algorithm emits a strongly connected component
+// after every component it reaches, so the driven come first and an entry
+// between two components lies above the diagonal blocks. The dense
+// exponential's pivoting then never picks a row from a later component (the
+// entries below the diagonal blocks are exact zeros), so exp(tA) keeps those
+// zeros and a triangular block's diagonal its relative accuracy. In the
+// order of first appearance, a lower-triangular block was pivoted into
+// fill-in that the squarings multiplied into the contracted coordinate's row
+// (e^-20 came out as -6e-7).
+struct BlockOrder {
+    std::vector<std::uint32_t> order;  // the indices, driven first
+    std::vector<bool> alone;           // per place in order: a component of one index
+};
+
+BlockOrder driven_first(std::size_t m, const std::vector<std::pair<std::uint32_t, std::uint32_t>> &edges) {
+    std::vector<std::size_t> start(m + 1, 0);
+    for (const auto &e : edges) ++start[e.first + 1];
+    for (std::size_t v = 0; v < m; ++v) start[v + 1] += start[v];
+    std::vector<std::uint32_t> adjacency(edges.size());
+    std::vector<std::size_t> cursor(start.begin(), start.end() - 1);
+    for (const auto &e : edges) adjacency[cursor[e.first]++] = e.second;
+    // Iterative Tarjan: a frame is a node and the next of its edges to follow.
+    std::vector<std::int64_t> index(m, -1), low(m, 0);
+    std::vector<bool> on_stack(m, false);
+    std::vector<std::uint32_t> stack;
+    BlockOrder result;
+    std::vector<std::pair<std::uint32_t, std::size_t>> frames;
+    std::int64_t counter = 0;
+    auto visit = [&](std::uint32_t v) {
+        index[v] = low[v] = counter++;
+        stack.push_back(v);
+        on_stack[v] = true;
+        frames.push_back({v, start[v]});
+    };
+    for (std::uint32_t root = 0; root < m; ++root) {
+        if (index[root] >= 0) continue;
+        visit(root);
+        while (!frames.empty()) {
+            const std::uint32_t v = frames.back().first;
+            if (frames.back().second < start[v + 1]) {
+                const std::uint32_t w = adjacency[frames.back().second++];
+                if (index[w] < 0)
+                    visit(w);
+                else if (on_stack[w])
+                    low[v] = std::min(low[v], index[w]);
+                continue;
+            }
+            frames.pop_back();
+            if (!frames.empty()) low[frames.back().first] = std::min(low[frames.back().first], low[v]);
+            if (low[v] != index[v]) continue;
+            const std::size_t first = result.order.size();
+            std::uint32_t w;
+            do {
+                w = stack.back();
+                stack.pop_back();
+                on_stack[w] = false;
+                result.order.push_back(w);
+            } while (w != v);
+            result.alone.resize(result.order.size(), result.order.size() - first == 1);
+        }
+    }
+    return result;
 }
 
 // The increment form x + (exp(A) - I) x rounds x once, which keeps the
@@ -175,8 +243,23 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
     if (!acyclic || (any_diagonal && (m <= 2 || !commuting))) {
         path_ = m <= 2 ? ExpmPath::Plane : ExpmPath::Pade;
         depth_ = 0;
-        moved_ = std::move(touched);
-        for (const Position &e : positions) block_.push_back({e.row, e.col});
+        // The plane's closed form takes any order; the Pade block is put in
+        // block upper triangular form (driven_first).
+        std::vector<std::uint32_t> order(m), new_of(m);
+        for (std::uint32_t v = 0; v < m; ++v) order[v] = v;
+        if (path_ == ExpmPath::Pade) {
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+            for (const Position &e : positions)
+                if (!diagonal(e)) edges.push_back({e.col, e.row});
+            BlockOrder block = driven_first(m, edges);
+            order = std::move(block.order);
+            alone_ = std::move(block.alone);
+        }
+        for (std::uint32_t k = 0; k < m; ++k) {
+            new_of[order[k]] = k;
+            moved_.push_back(touched[order[k]]);
+        }
+        for (const Position &e : positions) block_.push_back({new_of[e.row], new_of[e.col]});
     } else {
         // The series of N: the moved indices (level >= 1) by level are in
         // topological order; each position goes with the node of its row.
@@ -477,13 +560,21 @@ void SparseExponential::apply_pade(double t, double *x) {
     // diagonal contracts by more than half (exp - 1 below -1/2) takes exp(tA)
     // itself instead, as the scalings do: x + increment would keep of a
     // contracted component only the accuracy of x (scaling and squaring
-    // keeps a triangular block's diagonal to its relative accuracy). x is
+    // keeps a triangular block's diagonal to its relative accuracy, in the
+    // block upper triangular order of driven_first). x is
     // left untouched when the exact flow is not representable.
+    // An index that is a component of its own (driven_first) has e^(tA_rr)
+    // as its diagonal entry of exp(tA), exactly: taken from expm1 and exp
+    // themselves, not from 2^s squarings, each of which doubled its error.
+    for (std::size_t r = 0; r < m; ++r)
+        if (alone_[r]) exp_[r * m + r] = std::expm1(dense_[r * m + r]);
     bool contracted = false;
     for (std::size_t r = 0; r < m; ++r) contracted |= exp_[r * m + r] < -0.5;
     if (contracted) {
         direct_.resize(dense_.size());
         expm_dense(m, dense_.data(), direct_.data(), pade_scratch_);
+        for (std::size_t r = 0; r < m; ++r)
+            if (alone_[r]) direct_[r * m + r] = std::exp(dense_[r * m + r]);
     }
     scaled_values_.resize(m);
     bool finite = true;
