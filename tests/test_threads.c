@@ -1,4 +1,5 @@
-/* Separate handles on separate threads: every kind of system (sine-Euler
+/* Separate handles on separate threads (and on the threads of a host's
+ * OpenMP region, and in a child of fork): every kind of system (sine-Euler
  * included, so FFTW plans are made concurrently under the library's planner
  * lock) gives, to the bit, the result of the same run on one thread; failed
  * calls without a handle keep their message per thread. Thread counts are
@@ -12,6 +13,9 @@
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "lpi_test.h"
 
@@ -248,6 +252,91 @@ static void test_refused_threads_give_a_status(void **state) {
                  "was killed by signal", WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
 }
 
+/* The modes of sine_euler_15 after 20 steps of 0.01 with `threads` threads,
+ * stepped on the calling thread; 0 on success. */
+static int fifteen_after_20_steps(int threads, double *w) {
+    lpi_system *sys = sine_euler_15();
+    if (!sys) return 100;
+    int status = lpi_set_threads(sys, threads);
+    if (status == LPI_OK) status = lpi_step(sys, 0.01, 20);
+    if (status == LPI_OK) status = lpi_sine_euler_get_modes(sys, w, 2 * 15 * 15);
+    lpi_destroy(sys);
+    return status;
+}
+
+/* A host program that steps its handles from its own OpenMP parallel region
+ * (one handle a thread, or one handle on the master thread alone) gets the
+ * bits of a serial run: the library's one-thread flows use plain loops, not
+ * work sharing that would bind to the host's team (it skipped lines, waited
+ * at barriers the other threads never reached, and indexed block buffers by
+ * the host's thread numbers). */
+static void test_steps_inside_a_host_parallel_region(void **state) {
+    (void)state;
+#ifndef _OPENMP
+    LPI_SKIP("a host parallel region: this test is built without OpenMP");
+#else
+    double serial[2 * 15 * 15];
+    if (fifteen_after_20_steps(1, serial) != LPI_OK) LPI_SKIP("built without FFTW: no sine-Euler system");
+    double each[2][2 * 15 * 15], master[2 * 15 * 15];
+    int status[2] = {-1, -1}, master_status = -1;
+#pragma omp parallel num_threads(2)
+    {
+        const int me = omp_get_thread_num();
+        status[me] = fifteen_after_20_steps(1, each[me]);
+    }
+#pragma omp parallel num_threads(2)
+    {
+#pragma omp master
+        master_status = fifteen_after_20_steps(1, master);
+    }
+    for (int i = 0; i < 2; ++i) {
+        assert_int_equal(status[i], LPI_OK);
+        assert_memory_equal(each[i], serial, sizeof serial);
+    }
+    assert_int_equal(master_status, LPI_OK);
+    assert_memory_equal(master, serial, sizeof serial);
+#endif
+}
+
+/* In a child of fork(2), the thread that forked after the library ran a team
+ * of threads on it is refused more than one thread (LPI_ERR_UNSUPPORTED: its
+ * libgomp pool was not copied, and a team would wait forever); one thread,
+ * and another thread of the child, run as usual. Runs after the tests that
+ * start teams on this thread. */
+static void *child_thread_steps(void *w) {
+    static int status;
+    status = fifteen_after_20_steps(2, w);
+    return &status;
+}
+static void test_fork_after_threads(void **state) {
+    (void)state;
+    double parent[2 * 15 * 15];
+    const int status = fifteen_after_20_steps(2, parent);
+    if (status == LPI_ERR_UNSUPPORTED || status == 100)
+        LPI_SKIP("fork after threads: built without FFTW or without OpenMP");
+    assert_int_equal(status, LPI_OK);
+    fflush(stdout);
+    const pid_t child = fork();
+    assert_true(child >= 0);
+    if (child == 0) {
+        alarm(60); /* a hang ends the child, and the test fails */
+        double w[2 * 15 * 15];
+        if (fifteen_after_20_steps(2, w) != LPI_ERR_UNSUPPORTED) _exit(1);
+        if (fifteen_after_20_steps(1, w) != LPI_OK || memcmp(w, parent, sizeof w) != 0) _exit(2);
+        pthread_t other;
+        void *result = NULL;
+        if (pthread_create(&other, NULL, child_thread_steps, w) != 0) _exit(3);
+        pthread_join(other, &result);
+        if (*(int *)result != LPI_OK || memcmp(w, parent, sizeof w) != 0) _exit(4);
+        _exit(0);
+    }
+    int wait_status = 0;
+    assert_int_equal(waitpid(child, &wait_status, 0), child);
+    if (!WIFEXITED(wait_status) || WEXITSTATUS(wait_status) != 0)
+        fail_msg("the child of fork %s %d", WIFEXITED(wait_status) ? "failed check" : "was killed by signal",
+                 WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : WTERMSIG(wait_status));
+}
+
 static void test_thread_count_bound(void **state) {
     (void)state;
     lpi_system *sys = sine_euler_15();
@@ -271,6 +360,8 @@ int main(void) {
         cmocka_unit_test(test_refused_threads_give_a_status),
         cmocka_unit_test(test_handles_on_threads),
         cmocka_unit_test(test_thread_count_bound),
+        cmocka_unit_test(test_steps_inside_a_host_parallel_region),
+        cmocka_unit_test(test_fork_after_threads),
     };
     return lpi_run_tests(tests);
 }

@@ -142,11 +142,30 @@ void require_threads_can_start(int count, const std::string &for_what) {
 
 #if LPI_HAVE_OPENMP
 
+namespace {
+
+// The largest team this thread's OpenMP pool is known to hold: libgomp keeps
+// the threads of the last team started on a thread (a team of one starts
+// none) and lets the surplus go when a smaller team starts.
+thread_local int ready = 1;
+// libgomp does not rebuild a thread's pool in a child of fork(2): a team
+// started there on the forking thread waits forever for threads that were
+// not copied. The child handler marks the forking thread's pool lost when it
+// had one; a new thread of the child starts a pool of its own.
+thread_local bool pool_lost = false;
+void mark_pool_lost_in_child() {
+    if (ready > 1) pool_lost = true;
+}
+[[maybe_unused]] const int fork_handler = pthread_atfork(nullptr, nullptr, mark_pool_lost_in_child);
+
+}  // namespace
+
 void prepare_thread_team(int n) {
-    // The largest team this thread's OpenMP pool is known to hold: libgomp
-    // keeps the threads of the last team started on a thread (a team of one
-    // starts none) and lets the surplus go when a smaller team starts.
-    thread_local int ready = 1;
+    if (n > 1 && pool_lost)
+        fail(LPI_ERR_UNSUPPORTED, "cannot run " + std::to_string(n) + " threads on this thread of a child of "
+                                  "fork(2): the library ran OpenMP threads on it before the fork, and "
+                                  "libgomp does not start them again in a child (use one thread here, or "
+                                  "another thread of the child)");
     if (n <= ready) {
         if (n > 1) ready = n;
         return;

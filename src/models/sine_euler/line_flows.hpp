@@ -42,26 +42,25 @@ inline int lines_in_block(int lines, int b) { return lines - b * kBlock < kBlock
 template <class MoveBlock>
 void run_line_flows(LineTransforms &T, int N, int lines, int threads, double factor, MoveBlock &&move_block) {
     const int blocks = blocks_of(lines);
-    // The loops' work sharing binds to the team that calls them: all of
-    // `threads`, or this thread alone, without starting a team of one.
-    auto flows = [&] {
+    auto phase = [&](int l) { write_phase(N, l, factor, T.spectrum(), T.phase()); };
 #if LPI_HAVE_OPENMP
-#pragma omp for schedule(static)
-#endif
-        for (int l = 0; l < N; ++l) write_phase(N, l, factor, T.spectrum(), T.phase());
-#if LPI_HAVE_OPENMP
-#pragma omp for schedule(static)
-#endif
-        for (int b = 0; b < blocks; ++b) move_block(b, T.block(static_cast<std::size_t>(this_thread())));
-    };
     if (threads > 1 && blocks > 1) {
-#if LPI_HAVE_OPENMP
 #pragma omp parallel num_threads(threads)
-#endif
-        flows();
-    } else {
-        flows();
+        {
+#pragma omp for schedule(static)
+            for (int l = 0; l < N; ++l) phase(l);
+#pragma omp for schedule(static)
+            for (int b = 0; b < blocks; ++b) move_block(b, T.block(static_cast<std::size_t>(this_thread())));
+        }
+        return;
     }
+#endif
+    // One thread: plain loops. Work sharing outside a region of the library's
+    // own would bind to the caller's enclosing OpenMP team, if it has one
+    // (a host program stepping its handles from a parallel region), and share
+    // out, or wait at a barrier for, threads working on other handles.
+    for (int l = 0; l < N; ++l) phase(l);
+    for (int b = 0; b < blocks; ++b) move_block(b, T.block(0));
 }
 
 // The flow count of `steps` steps of `flows_per_step` flows: LPI_ERR_INVALID
