@@ -583,6 +583,47 @@ void test_contracted_components_keep_relative_accuracy(void **) {
     }
 }
 
+// A scaling past e^709 whose product is a double: exp(a) overflows, z e^a
+// does not (a zero or tiny component), and the flow returns it (they were
+// refused as overflows: inf times 0, inf times 1e-300). A product that does
+// not fit is refused, x untouched.
+void test_scalings_past_the_range_of_exp(void **) {
+    const std::vector<lpi::SparseTerm> loop = {{0, 0, 0, 1.0}};
+    lpi::SparseExponential grow(1, loop);
+    assert_int_equal(static_cast<int>(grow.path()), static_cast<int>(lpi::ExpmPath::Plane));
+    const double a = 800.0;
+    std::vector<double> y = {1e-300};
+    grow.apply(&a, 1.0, y.data());
+    const long double exact = 1e-300L * std::exp(800.0L);
+    const double error = static_cast<double>(std::fabs(y[0] - exact) / exact);
+    std::printf("1x1 plane, 1e-300 e^800: %.17g, rel. error %.2e\n", y[0], error);
+    assert_true(error < 4 * 2.2e-16);
+    y = {0.0};
+    grow.apply(&a, 1.0, y.data());
+    assert_true(y[0] == 0.0);
+    y = {1.0};
+    try {
+        grow.apply(&a, 1.0, y.data());
+        fail_msg("e^800 was not refused");
+    } catch (const lpi::Error &e) {
+        assert_int_equal(e.status(), LPI_ERR_NONFINITE);
+    }
+    assert_true(y[0] == 1.0);
+    // DiagonalSeries, weights 1, 1, 8 and a shear: [[1, 0, 0], [1, 1, 0],
+    // [0, 0, 8]] times 100 on (1, 1, 0) is (e^100, 101 e^100, 0).
+    const std::vector<lpi::SparseTerm> graded = {
+        {0, 0, 0, 1.0}, {1, 1, 0, 1.0}, {1, 0, 0, 1.0}, {2, 2, 0, 8.0}};
+    lpi::SparseExponential series(3, graded);
+    assert_int_equal(static_cast<int>(series.path()), static_cast<int>(lpi::ExpmPath::DiagonalSeries));
+    const double g = 100.0;
+    y = {1.0, 1.0, 0.0};
+    series.apply(&g, 1.0, y.data());
+    const long double e100 = std::exp(100.0L);
+    assert_true(std::fabs(y[0] - e100) / e100 < 4 * 2.2e-16);
+    assert_true(std::fabs(y[1] - 101.0L * e100) / (101.0L * e100) < 8 * 2.2e-16);
+    assert_true(y[2] == 0.0);
+}
+
 // The size of an n x n matrix is counted without wrapping: a dimension whose
 // bytes overflow a size_t is refused (LPI_ERR_NO_MEMORY), not allocated small.
 void test_square_entries_refuse_overflow(void **) {
@@ -617,6 +658,7 @@ int main() {
         cmocka_unit_test(test_diagonal_series),
         cmocka_unit_test(test_contracted_components_keep_relative_accuracy),
         cmocka_unit_test(test_deep_series_and_summed_terms),
+        cmocka_unit_test(test_scalings_past_the_range_of_exp),
         cmocka_unit_test(test_square_entries_refuse_overflow),
     };
     return lpi_run_tests(tests);

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace lpi {
@@ -86,9 +87,14 @@ inline void expm1_powers(double s, int largest, double *E) {
 // bias near the identity), except where exp(a) contracts z by more than half.
 // There growth is close to -1 and z + growth z would keep only the accuracy of
 // z itself, a relative error e^-a times the round-off, so z is scaled by
-// exp(a) instead. The DiagonalSeries path and the compiled flows share it.
+// exp(a) instead; and where exp(a) overflows, z e^a may still be a double
+// (scaled_beyond_range). The DiagonalSeries path, the 1x1 plane and the
+// compiled flows share it.
+double scaled_beyond_range(double z, double a);
 inline double scaled_by_exponential(double z, double growth, double a) {
-    return growth < -0.5 ? z * std::exp(a) : z + growth * z;
+    if (growth < -0.5) return z * std::exp(a);
+    if (growth <= std::numeric_limits<double>::max()) return z + growth * z;
+    return scaled_beyond_range(z, a);
 }
 // Whether exp(a) - 1 may fall below -1/2: not for |a| <= 1/2, where it is at
 // least e^-1/2 - 1 > -0.4 however it is rounded, so a flow whose exponents

@@ -338,6 +338,21 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
     shear_ = path_ == ExpmPath::Nilpotent && depth_ == 1 && further_terms_.empty();
 }
 
+// z e^a where e^a overflows: 0 for z = 0 (the exact flow of 0), else
+// z e^r 2^k with a = k ln 2 + r, |r| <= ln 2 / 2, ln 2 in Cody and Waite's two
+// parts (k ln2_hi is exact for the |k| < 2^21 reached here), so a tiny z
+// scaled past e^709 is a double when its product is. Beyond a = 1500 no
+// nonzero double z gives a finite product: an overflow.
+double scaled_beyond_range(double z, double a) {
+    if (z == 0.0) return z;
+    if (a > 1500.0) return z * std::numeric_limits<double>::infinity();
+    constexpr double kInverseLn2 = 1.4426950408889634, kLn2High = 6.93147180369123816490e-01,
+                     kLn2Low = 1.90821492927058770002e-10;
+    const double k = std::nearbyint(a * kInverseLn2);
+    const double r = (a - k * kLn2High) - k * kLn2Low;
+    return std::ldexp(z * std::exp(r), static_cast<int>(k));
+}
+
 void fail_flow_overflow(std::size_t component) {
     fail(LPI_ERR_NONFINITE, "the exact flow overflows (component " + std::to_string(component) + ")");
 }
@@ -510,42 +525,44 @@ void SparseExponential::apply_plane(double t, double *x) {
     double A[4] = {0.0, 0.0, 0.0, 0.0};
     for (std::size_t j = 0; j < block_.size(); ++j) A[block_[j].row * 2 + block_[j].col] = scaled_[j];
     check_norm(std::max(std::fabs(A[0]) + std::fabs(A[2]), std::fabs(A[1]) + std::fabs(A[3])), t);
-    const bool pair = moved_.size() == 2;
-    const double x0 = x[moved_[0]], x1 = pair ? x[moved_[1]] : 0.0;
-    const double tau = pair ? 0.5 * (A[0] + A[3]) : A[0], p = 0.5 * (A[0] - A[3]);
+    const double x0 = x[moved_[0]];
+    if (moved_.size() == 1) {  // x0 e^a, as the diagonal scalings take it
+        const double y0 = scaled_by_exponential(x0, std::expm1(A[0]), A[0]);
+        increment_[0] = y0 - x0;  // only to name a non-finite component
+        if (!std::isfinite(y0)) fail_nonfinite();
+        x[moved_[0]] = y0;
+        return;
+    }
+    const double x1 = x[moved_[1]];
+    const double tau = 0.5 * (A[0] + A[3]), p = 0.5 * (A[0] - A[3]);
     const double delta = p * p + A[1] * A[2];
-    const bool apart = pair && delta > 0.0 && std::sqrt(delta) > kIncrementFormLimit;
+    const bool apart = delta > 0.0 && std::sqrt(delta) > kIncrementFormLimit;
     if (apart || tau < -kIncrementFormLimit) {
         double y0 = x0, y1 = x1;
         if (apart) {
             plane_hyperbolic_apply(A[0], A[1], A[2], A[3], y0, y1);
-        } else if (pair) {  // e^tau (C x + S N x), C and S as plane_expm1 forms them
+        } else {  // e^tau (C x + S N x), C and S as plane_expm1 forms them
             double W[4];
             plane_expm1(A[0] - tau, A[1], A[2], A[3] - tau, W);  // traceless: C - 1 +- S p, S b, S c
             const double scale = std::exp(tau);
             y0 = scale * ((x0 + W[0] * x0) + W[1] * x1);
             y1 = scale * (W[2] * x0 + (x1 + W[3] * x1));
-        } else {
-            y0 = std::exp(tau) * x0;
         }
         increment_[0] = y0 - x0;  // only to name a non-finite component
-        if (pair) increment_[1] = y1 - x1;
+        increment_[1] = y1 - x1;
         if (!std::isfinite(y0) || !std::isfinite(y1)) fail_nonfinite();
         x[moved_[0]] = y0;
-        if (pair) x[moved_[1]] = y1;
+        x[moved_[1]] = y1;
         return;
     }
-    double W[4] = {0.0, 0.0, 0.0, 0.0};
-    if (pair)
-        plane_expm1(A[0], A[1], A[2], A[3], W);
-    else
-        W[0] = std::expm1(A[0]);
+    double W[4];
+    plane_expm1(A[0], A[1], A[2], A[3], W);
     // x += (exp(tA) - I) x, rounded once; untouched when not representable.
     increment_[0] = W[0] * x0 + W[1] * x1;
-    if (pair) increment_[1] = W[2] * x0 + W[3] * x1;
-    if (!std::isfinite(increment_[0]) || (pair && !std::isfinite(increment_[1]))) fail_nonfinite();
+    increment_[1] = W[2] * x0 + W[3] * x1;
+    if (!std::isfinite(increment_[0]) || !std::isfinite(increment_[1])) fail_nonfinite();
     x[moved_[0]] = x0 + increment_[0];
-    if (pair) x[moved_[1]] = x1 + increment_[1];
+    x[moved_[1]] = x1 + increment_[1];
 }
 
 void SparseExponential::apply_pade(double t, double *x) {
