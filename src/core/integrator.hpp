@@ -44,7 +44,8 @@ public:
     // Advances n >= 1 steps with an optional observer. The default runs
     // advance() in chunks of observer.every steps, which is exact for methods
     // whose steps share nothing; the splitting integrator overrides it to
-    // keep merging flows across the observed steps.
+    // keep merging flows across the observed steps, and the sine-Euler
+    // matrix methods to keep their matrix form.
     virtual RunOutcome run(Model &model, double *state, double dt, std::int64_t n,
                            const StepObserver &observer, StepsInProgress &progress);
     // Piece flows (or vector-field evaluations) per step in a long run.
