@@ -385,7 +385,17 @@ function modes(sys::System)
     _call(h -> C.lpi_sine_euler_get_modes(h, Ptr{Cdouble}(pointer(buf)), 2 * N * N), sys)
     permutedims(buf)
 end
+# C sees only the element count, which a 49 x 1 array shares with 7 x 7: an
+# array of any other shape than N x N is refused here (LPI_ERR_SIZE), before
+# the library is called, so nothing changes.
+function _require_square(sys::System, w::AbstractMatrix, what::AbstractString)
+    N = sine_euler_size(sys)
+    size(w) == (N, N) ||
+        throw(LiePoissonError(-3, status_name(-3), "$what must be $N x $N, not $(size(w, 1)) x $(size(w, 2))"))
+    nothing
+end
 function set_modes!(sys::System, w::AbstractMatrix{<:Number})
+    _require_square(sys, w, "modes")
     buf = Matrix{ComplexF64}(permutedims(w))
     _call(h -> C.lpi_sine_euler_set_modes(h, Ptr{Cdouble}(pointer(buf)), 2 * length(buf)), sys)
 end
@@ -396,6 +406,7 @@ function grid(sys::System)
     permutedims(buf)
 end
 function set_grid!(sys::System, w::AbstractMatrix{<:Real})
+    _require_square(sys, w, "grid")
     buf = Matrix{Float64}(permutedims(w))
     _call(h -> C.lpi_sine_euler_set_grid(h, buf, length(buf)), sys)
 end
@@ -419,6 +430,8 @@ end
 # (lambda[a+1, b+1] and f[a+1, b+1] belong to mode (a, b); f = nothing for 0).
 function set_hamiltonian!(sys::System, lambda::AbstractMatrix{<:Real},
                           f::Union{Nothing,AbstractMatrix{<:Number}} = nothing)
+    _require_square(sys, lambda, "lambda")
+    f === nothing || _require_square(sys, f, "f")
     lam = Matrix{Float64}(permutedims(lambda))
     if f === nothing
         _call(h -> C.lpi_sine_euler_set_hamiltonian(h, lam, length(lam), C_NULL, 0), sys)
