@@ -163,6 +163,7 @@ static void test_checkpoint(void **state) {
     /* A file that is not there: LPI_ERR_IO on every process. */
     lpi_system *none = NULL;
     assert_int_equal(lpi_load_mpi(&none, "no/such/file.lpi", MPI_COMM_WORLD), LPI_ERR_IO);
+    assert_int_equal(lpi_load_mpi(&none, "", MPI_COMM_WORLD), LPI_ERR_INVALID);
     assert_null(none);
     /* An intact checkpoint of a baseline's run: a system spread over
      * processes cannot step by it (LPI_ERR_UNSUPPORTED, not a bad file). */

@@ -11,6 +11,7 @@
 using lpi::capi::Arguments;
 using lpi::capi::guarded;
 using lpi::capi::require;
+using lpi::capi::require_path;
 using lpi::capi::Text;
 
 namespace {
@@ -50,8 +51,7 @@ extern "C" {
 LPI_API int lpi_save(const lpi_system *sys, const char *path) {
     return guarded(sys, "lpi_save", Arguments(Text{path}), [&] {
         require(sys, "system");
-        require(path, "path");
-        if (!*path) lpi::fail(LPI_ERR_INVALID, "path is empty");
+        require_path(path);
         const std::vector<unsigned char> bytes = lpi::encode_checkpoint(sys->system);
         // Written once when the system is spread over processes.
         sys->system.model().on_one_process([&] { lpi::write_file_atomically(path, bytes.data(), bytes.size()); });
@@ -60,7 +60,7 @@ LPI_API int lpi_save(const lpi_system *sys, const char *path) {
 
 LPI_API int lpi_load(lpi_system **out, const char *path) {
     return load(out, "lpi_load", path, [&](Bytes &bytes) {
-        require(path, "path");
+        require_path(path);
         bytes.owned = lpi::read_checkpoint_file(path);
         bytes.data = bytes.owned.data();
         bytes.size = bytes.owned.size();

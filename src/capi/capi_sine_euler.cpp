@@ -14,6 +14,7 @@ using lpi::capi::Arguments;
 using lpi::capi::guarded;
 using lpi::capi::guarded_local_read;
 using lpi::capi::require;
+using lpi::capi::require_path;
 using lpi::capi::Text;
 
 namespace {
@@ -172,14 +173,14 @@ LPI_API int lpi_sine_euler_get_planning(const lpi_system *sys, const char **rigo
 
 LPI_API int lpi_fftw_wisdom_import_file(const char *path) {
     return guarded(nullptr, "lpi_fftw_wisdom_import_file", [&] {
-        require(path, "path");
+        require_path(path);
         lpi::fftw_wisdom_import_file(path);
     });
 }
 
 LPI_API int lpi_fftw_wisdom_export_file(const char *path) {
     return guarded(nullptr, "lpi_fftw_wisdom_export_file", [&] {
-        require(path, "path");
+        require_path(path);
         lpi::fftw_wisdom_export_file(path);
     });
 }

@@ -196,6 +196,12 @@ inline void require(const void *pointer, const char *what) {
     if (!pointer) lpi::fail(LPI_ERR_NULL, std::string(what) + " is NULL");
 }
 
+// A file name: not NULL, not empty (which no system call takes as a name).
+inline void require_path(const char *path) {
+    require(path, "path");
+    if (!*path) lpi::fail(LPI_ERR_INVALID, "path is empty");
+}
+
 // Creates a handle around a model built by make(); *out is NULL on failure.
 template <class Make>
 int create(lpi_system **out, const char *function, Make &&make) noexcept {

@@ -14,6 +14,7 @@
 using lpi::capi::Arguments;
 using lpi::capi::guarded;
 using lpi::capi::require;
+using lpi::capi::require_path;
 using lpi::capi::Text;
 
 namespace {
@@ -45,7 +46,7 @@ LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
         const lpi::mpi::Communicator &reader = *communicator;
         require_same_arguments(reader, Arguments(out, Text{path}));
         require(out, "out");
-        require(path, "path");
+        require_path(path);
         // Rank 0 reads; every process decodes the same bytes.
         std::vector<unsigned char> bytes;
         double size = 0.0;
