@@ -622,6 +622,43 @@ void test_scalings_past_the_range_of_exp(void **) {
     assert_true(std::fabs(y[0] - e100) / e100 < 4 * 2.2e-16);
     assert_true(std::fabs(y[1] - 101.0L * e100) / (101.0L * e100) < 8 * 2.2e-16);
     assert_true(y[2] == 0.0);
+
+    // The 2x2 plane: real eigenvalues +-720 ([[a, 0], [c, -a]], the flow of
+    // sl(2)'s h), and a rotation under e^720 ([[a, b], [-b, a]]). A component
+    // that is 0 in the growing direction came out NaN (inf times 0) and was
+    // refused, naming the component that shrinks.
+    const std::vector<lpi::SparseTerm> hyperbolic_terms = {{0, 0, 0, 1.0}, {1, 1, 0, -1.0}, {1, 0, 1, 1.0}};
+    lpi::SparseExponential hyperbolic(2, hyperbolic_terms);
+    assert_int_equal(static_cast<int>(hyperbolic.path()), static_cast<int>(lpi::ExpmPath::Plane));
+    const double ac[2] = {720.0, 1.0};
+    const long double ea = std::exp(720.0L), e_minus_a = std::exp(-720.0L);
+    auto close = [](double got, long double exact, double ulps) {
+        return std::fabs(got - exact) <= ulps * 2.2e-16 * std::fabs(exact);
+    };
+    y = {0.0, 1.0};
+    hyperbolic.apply(ac, 1.0, y.data());
+    assert_true(y[0] == 0.0);
+    assert_true(std::fabs(y[1] - e_minus_a) <= 4.95e-324);  // subnormal: to the last one
+    y = {1e-300, 0.0};
+    hyperbolic.apply(ac, 1.0, y.data());
+    assert_true(close(y[0], 1e-300L * ea, 4));
+    assert_true(close(y[1], 1e-300L * (ea - e_minus_a) / 1440.0L, 8));
+    const std::vector<lpi::SparseTerm> spiral_terms = {
+        {0, 0, 0, 1.0}, {1, 1, 0, 1.0}, {0, 1, 1, 1.0}, {1, 0, 1, -1.0}};
+    lpi::SparseExponential spiral(2, spiral_terms);
+    assert_int_equal(static_cast<int>(spiral.path()), static_cast<int>(lpi::ExpmPath::Plane));
+    y = {1e-300, 0.0};
+    spiral.apply(ac, 1.0, y.data());
+    assert_true(close(y[0], 1e-300L * ea * std::cos(1.0L), 8));
+    assert_true(close(y[1], -1e-300L * ea * std::sin(1.0L), 8));
+    y = {1.0, 0.0};  // e^720 itself: refused, x untouched
+    try {
+        spiral.apply(ac, 1.0, y.data());
+        fail_msg("e^720 was not refused");
+    } catch (const lpi::Error &e) {
+        assert_int_equal(e.status(), LPI_ERR_NONFINITE);
+    }
+    assert_true(y[0] == 1.0 && y[1] == 0.0);
 }
 
 // The size of an n x n matrix is counted without wrapping: a dimension whose

@@ -96,6 +96,13 @@ inline double scaled_by_exponential(double z, double growth, double a) {
     if (growth <= std::numeric_limits<double>::max()) return z + growth * z;
     return scaled_beyond_range(z, a);
 }
+// z exp(a), past the range of exp as well: the 2x2 plane's eigencomponents
+// and its e^tau, where a tiny component under a growth beyond e^709 is a
+// double (and inf times 0 was not).
+inline double times_exponential(double z, double a) {
+    const double e = std::exp(a);
+    return e <= std::numeric_limits<double>::max() ? z * e : scaled_beyond_range(z, a);
+}
 // Whether exp(a) - 1 may fall below -1/2: not for |a| <= 1/2, where it is at
 // least e^-1/2 - 1 > -0.4 however it is rounded, so a flow whose exponents
 // are all that small takes z + growth z without asking, with the same bits.

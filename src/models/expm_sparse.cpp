@@ -74,9 +74,8 @@ void plane_hyperbolic_apply(double a, double b, double c, double d, double &x0, 
     // P+ x and P- x = (I - P+) x, each formed from x directly.
     const double u0 = plus00 * x0 + up_b * x1, u1 = up_c * x0 + plus11 * x1;
     const double v0 = plus11 * x0 - up_b * x1, v1 = plus00 * x1 - up_c * x0;
-    const double grow = std::exp(tau + r), shrink = std::exp(tau - r);
-    x0 = grow * u0 + shrink * v0;
-    x1 = grow * u1 + shrink * v1;
+    x0 = times_exponential(u0, tau + r) + times_exponential(v0, tau - r);
+    x1 = times_exponential(u1, tau + r) + times_exponential(v1, tau - r);
 }
 
 // The m indices of a block in an order that makes its matrix block upper
@@ -152,6 +151,8 @@ BlockOrder driven_first(std::size_t m, const std::vector<std::pair<std::uint32_t
 // contracts by more than half, or real eigenvalues tau +- r with r beyond
 // it) the plane path applies exp(A) itself.
 constexpr double kIncrementFormLimit = 0.6931471805599453;
+// ln(DBL_MAX): exp of anything larger overflows.
+constexpr double kLargestExponent = 709.782712893384;
 
 }  // namespace
 
@@ -537,16 +538,17 @@ void SparseExponential::apply_plane(double t, double *x) {
     const double tau = 0.5 * (A[0] + A[3]), p = 0.5 * (A[0] - A[3]);
     const double delta = p * p + A[1] * A[2];
     const bool apart = delta > 0.0 && std::sqrt(delta) > kIncrementFormLimit;
-    if (apart || tau < -kIncrementFormLimit) {
+    // Past ln(DBL_MAX), exp(tau) - 1 overflows, and e^tau is applied last.
+    const bool beyond_range = tau > kLargestExponent;
+    if (apart || tau < -kIncrementFormLimit || beyond_range) {
         double y0 = x0, y1 = x1;
         if (apart) {
             plane_hyperbolic_apply(A[0], A[1], A[2], A[3], y0, y1);
         } else {  // e^tau (C x + S N x), C and S as plane_expm1 forms them
             double W[4];
             plane_expm1(A[0] - tau, A[1], A[2], A[3] - tau, W);  // traceless: C - 1 +- S p, S b, S c
-            const double scale = std::exp(tau);
-            y0 = scale * ((x0 + W[0] * x0) + W[1] * x1);
-            y1 = scale * (W[2] * x0 + (x1 + W[3] * x1));
+            y0 = times_exponential((x0 + W[0] * x0) + W[1] * x1, tau);
+            y1 = times_exponential(W[2] * x0 + (x1 + W[3] * x1), tau);
         }
         increment_[0] = y0 - x0;  // only to name a non-finite component
         increment_[1] = y1 - x1;
