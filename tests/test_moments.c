@@ -440,6 +440,50 @@ static void test_product_piece_errors(void **state) {
     lpi_destroy(bad);
 }
 
+static int unit_h(double u, double *out, void *user) { /* H = u */
+    (void)user;
+    *out = u;
+    return 0;
+}
+static int unit_dh(double u, double *out, void *user) {
+    (void)u; (void)user;
+    *out = 1.0;
+    return 0;
+}
+/* T = x3 + x8, recording whether it was ever handed a non-finite moment. */
+static int watching_gradient(size_t n, const double *x, double *g, void *user) {
+    for (size_t p = 0; p < n; ++p) {
+        if (!isfinite(x[p])) *(int *)user = 1;
+        g[p] = 1.0;
+    }
+    return 0;
+}
+static int watching_energy(size_t n, const double *x, double *h, void *user) {
+    (void)n; (void)user;
+    *h = x[0] + x[1];
+    return 0;
+}
+
+/* A product flow whose result overflows (x4 = 1e308 grows by e^(2 lambda t))
+ * fails its own step, naming the piece, before it writes anything: the next
+ * piece's callback was handed inf, and the call failed blaming it. */
+static void test_product_piece_overflow(void **state) {
+    (void)state;
+    lpi_system *sys = NULL;
+    int saw_nonfinite = 0;
+    assert_int_equal(lpi_moments_create(&sys), LPI_OK);
+    assert_int_equal(lpi_moments_add_product_piece(sys, unit_h, unit_dh, NULL), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 2, kT, watching_gradient, watching_energy, &saw_nonfinite),
+                     LPI_OK);
+    const double x[8] = {1.0, 1.0, 1.0, 1e308, 1.0, 1.0, 1.0, 1.0};
+    assert_int_equal(lpi_set_state(sys, x, 8), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "leapfrog"), LPI_OK);
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 1.0, 3), LPI_ERR_NONFINITE, "lpi_step");
+    assert_non_null(strstr(lpi_last_error(sys), "piece 0 (product H(x1 x3)): the exact flow overflows"));
+    assert_false(saw_nonfinite);
+    lpi_destroy(sys);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_built_in_casimirs_and_rank),
@@ -450,6 +494,7 @@ int main(void) {
         cmocka_unit_test(test_product_piece_far_from_identity),
         cmocka_unit_test(test_separable_case),
         cmocka_unit_test(test_product_piece_errors),
+        cmocka_unit_test(test_product_piece_overflow),
     };
     return lpi_run_tests(tests);
 }

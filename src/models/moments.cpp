@@ -20,6 +20,7 @@
 #include <cmath>
 
 #include "../core/error.hpp"
+#include "../core/text.hpp"
 #include "../core/system.hpp"
 #include "generic.hpp"
 #include "moments_algebra.hpp"
@@ -159,10 +160,39 @@ public:
                  lpi_scalar_fn dh, void *user)
         : Piece(std::move(label)), constants_(constants), h_(h), dh_(dh), user_(user) {}
 
+    // Formed in a copy and written only when every moment is finite: the
+    // next piece's callback never sees an overflowed state.
     void flow(double t, double *x) override {
+        constexpr int dim = MomentAlgebra::dim;
+        double y[dim];
+        std::copy(x, x + dim, y);
+        advance(t, y);
+        for (int i = 0; i < dim; ++i)
+            if (!std::isfinite(y[i]))
+                fail(LPI_ERR_NONFINITE,
+                     label() + ": the exact flow overflows (component " + std::to_string(i) + ")");
+        std::copy(y, y + dim, x);
+    }
+
+    double energy(const double *x) const override {
+        double value = 0.0;
+        const int rc = h_(x[0] * x[2], &value, user_);
+        check(rc, value, "H");
+        return value;
+    }
+
+    void add_vector_field(const double *x, double *rate) const override {
+        const double mu = derivative(x[0] * x[2]);
+        const std::uint32_t sigma[2] = {0, 2};
+        const double g[2] = {mu * x[2], mu * x[0]};
+        add_poisson_times(constants_, sigma, 2, g, x, rate);
+    }
+
+private:
+    void advance(double t, double *x) const {
         const double b = x[0], a = x[2];
         if (!std::isfinite(a * b))
-            fail(LPI_ERR_OVERFLOW, "x1 x3 = " + std::to_string(b) + " * " + std::to_string(a) +
+            fail(LPI_ERR_OVERFLOW, "x1 x3 = " + number_text(b) + " * " + number_text(a) +
                                        " overflows in " + label());
         const double mu = derivative(a * b);
         const double lambda = 4.0 * x[1] * mu;
@@ -204,21 +234,6 @@ public:
         x[2] = a + a * (shrink_minus_1 * (2.0 + shrink_minus_1));  // e^{-lambda t} - 1
     }
 
-    double energy(const double *x) const override {
-        double value = 0.0;
-        const int rc = h_(x[0] * x[2], &value, user_);
-        check(rc, value, "H");
-        return value;
-    }
-
-    void add_vector_field(const double *x, double *rate) const override {
-        const double mu = derivative(x[0] * x[2]);
-        const std::uint32_t sigma[2] = {0, 2};
-        const double g[2] = {mu * x[2], mu * x[0]};
-        add_poisson_times(constants_, sigma, 2, g, x, rate);
-    }
-
-private:
     // 2 ln 2: beyond it x1 or x3 contracts by more than a quarter in one flow
     // (or, x2^2 > x1 x3, the eigenvalues +-r t of tM are that far from 0),
     // and the increment form above would keep of a contracted moment only the
