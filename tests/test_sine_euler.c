@@ -776,6 +776,21 @@ static void test_bad_input(void **state) {
     memcpy(bad, w, sizeof w);
     bad[2 * (1 * N + 2)] += 1e-17;
     lpi_system *other = sine_euler(N, bad);
+    /* The tolerance is 1e-10 max |w_m| (a modulus): for w_(0,1) = 1 + i,
+     * sqrt(2) 1e-10. It was 1e-10 times the largest component. */
+    memset(bad, 0, sizeof bad);
+    bad[2 * 1] = 1.0, bad[2 * 1 + 1] = 1.0;
+    bad[2 * (N - 1)] = 1.0 + 1.3e-10, bad[2 * (N - 1) + 1] = -1.0;
+    assert_int_equal(lpi_sine_euler_set_modes(other, bad, 2 * n), LPI_OK);
+    bad[2 * (N - 1)] = 1.0 + 1.5e-10;
+    LPI_ASSERT_FAILS(other, lpi_sine_euler_set_modes(other, bad, 2 * n), LPI_ERR_INVALID,
+                     "lpi_sine_euler_set_modes");
+    bad[2 * (N - 1)] = 1.0, bad[1] = 1.3e-10; /* w_0's imaginary part, in the message */
+    assert_int_equal(lpi_sine_euler_set_modes(other, bad, 2 * n), LPI_OK);
+    bad[1] = 1.5e-10;
+    LPI_ASSERT_FAILS(other, lpi_sine_euler_set_modes(other, bad, 2 * n), LPI_ERR_INVALID,
+                     "lpi_sine_euler_set_modes");
+    assert_non_null(strstr(lpi_last_error(other), "imaginary part is 1.5e-10 "));
     lpi_destroy(other);
 
     LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_modes(sys, w, 2 * n - 1), LPI_ERR_SIZE,

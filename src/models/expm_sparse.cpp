@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "../core/error.hpp"
+#include "../core/text.hpp"
 #include "expm.hpp"
 
 namespace lpi {
@@ -371,7 +372,7 @@ void SparseExponential::check_norm(double norm, double t) const {
     // with a Casimir error above about 2^kMaxSquarings unit round-offs.
     if (!std::isfinite(norm))
         fail(LPI_ERR_NONFINITE, "the matrix t A of the exact flow overflows (t = " +
-                                    std::to_string(t) + ")");
+                                    number_text(t) + ")");
     if (norm > std::ldexp(kPadeTheta13, kMaxSquarings)) {
         char text[160];
         std::snprintf(text, sizeof text,

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "../core/error.hpp"
+#include "../core/text.hpp"
 #include "models.hpp"
 
 namespace lpi {
@@ -69,7 +70,7 @@ private:
 void check_inertia(const char *name, double I) {
     if (!std::isfinite(I)) fail(LPI_ERR_NONFINITE, std::string("inertia ") + name + " is not finite");
     if (!(I > 0.0))
-        fail(LPI_ERR_INVALID, std::string("inertia ") + name + " must be > 0, got " + std::to_string(I));
+        fail(LPI_ERR_INVALID, std::string("inertia ") + name + " must be > 0, got " + number_text(I));
     if (!std::isfinite(1.0 / I))
         fail(LPI_ERR_INVALID, std::string("inertia ") + name + " is too small: 1/" + name + " overflows");
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "../../core/error.hpp"
+#include "../../core/text.hpp"
 #include "indexing.hpp"
 #include "transforms.hpp"
 
@@ -54,18 +55,18 @@ void state_from_public(int N, const double *x, double *state) {
 
 void public_from_modes(int N, const double *w, double *x) {
     const std::size_t size = 2 * static_cast<std::size_t>(N) * N;
-    double largest = 0.0;
-    for (std::size_t i = 0; i < size; ++i) {
+    for (std::size_t i = 0; i < size; ++i)
         if (!std::isfinite(w[i]))
             fail(LPI_ERR_NONFINITE, "mode (" + std::to_string(i / 2 / N) + ", " +
                                         std::to_string(i / 2 % N) + ") at index " +
                                         std::to_string(i) + " is not finite");
-        largest = std::max(largest, std::fabs(w[i]));
-    }
-    const double tolerance = 1e-10 * largest;
+    // 1e-10 max |w_m|, the moduli scaled first so that none overflows.
+    double tolerance = 0.0;
+    for (std::size_t i = 0; i < size; i += 2)
+        tolerance = std::max(tolerance, std::hypot(1e-10 * w[i], 1e-10 * w[i + 1]));
     if (std::fabs(w[1]) > tolerance)
         fail(LPI_ERR_INVALID, "modes are not Hermitian: w(0,0) must be real, its imaginary part is " +
-                                  std::to_string(w[1]));
+                                  number_text(w[1]) + " (tolerance " + number_text(tolerance, 3) + ")");
     x[0] = w[0];
     for_half_plane(N, [&](std::size_t i, int a, int b) {
         const std::size_t m = mode_index(a, b, N), minus = mirror_index(a, b, N);
