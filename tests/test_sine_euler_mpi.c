@@ -360,6 +360,14 @@ static void test_different_arguments(void **state) {
     lpi_system *none = NULL;
     assert_int_equal(lpi_sine_euler_create_mpi(last ? NULL : &none, N, MPI_COMM_WORLD), LPI_ERR_INVALID);
     assert_null(none);
+    /* Different N: the same message on every process, naming both values. */
+    if (size_ > 1) {
+        assert_int_equal(lpi_sine_euler_create_mpi(&none, last ? N + 2 : N, MPI_COMM_WORLD), LPI_ERR_INVALID);
+        assert_null(none);
+        char expected[96];
+        snprintf(expected, sizeof expected, "different N (%d on rank 0, %d on rank %d)", N, N + 2, size_ - 1);
+        assert_non_null(strstr(lpi_last_error(NULL), expected));
+    }
     assert_int_equal(lpi_load_mpi(&none, last ? NULL : "never_written.lpi", MPI_COMM_WORLD), LPI_ERR_INVALID);
     assert_null(none);
     assert_int_equal(lpi_load_mpi(last ? NULL : &none, "never_written.lpi", MPI_COMM_WORLD), LPI_ERR_INVALID);

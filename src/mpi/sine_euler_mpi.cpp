@@ -364,10 +364,12 @@ TransformTiming SineEulerMpi::time_transforms(std::size_t flows_per_step, std::i
 
 std::unique_ptr<Model> make_sine_euler_mpi(int N, std::shared_ptr<const mpi::Communicator> communicator) {
     const std::vector<long long> orders = communicator->allgather(static_cast<long long>(N));
-    for (long long n : orders)
-        if (n != N)
+    // Compared with rank 0's, so that every process names the same pair.
+    for (std::size_t rank = 1; rank < orders.size(); ++rank)
+        if (orders[rank] != orders[0])
             fail(LPI_ERR_INVALID, "the processes passed different N (" + std::to_string(orders[0]) +
-                                      " on rank 0, " + std::to_string(n) + " elsewhere)");
+                                      " on rank 0, " + std::to_string(orders[rank]) + " on rank " +
+                                      std::to_string(rank) + ")");
     if (N < 3 || N % 2 == 0)
         fail(LPI_ERR_INVALID, "N must be odd and >= 3 (Zeitlin's su(N) truncation), got " +
                                   std::to_string(N));
