@@ -260,6 +260,27 @@ static void test_failing_step_names_step_and_time(void **state) {
     LPI_ASSERT_FAILS(sys, lpi_step(sys, 1e200, 10), LPI_ERR_NONFINITE, "lpi_step");
     assert_non_null(strstr(lpi_last_error(sys), "after step 3 of this call (t = 3e+200"));
     lpi_destroy(sys);
+
+    /* Without an observer: the check that found it (step 256), not the end
+     * of the call (it named step 1000000). */
+    sys = rigid_body("rk4");
+    const double huge[3] = {1e150, 1e150, 1e150};
+    assert_int_equal(lpi_set_state(sys, huge, 3), LPI_OK);
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 1.0, 1000000), LPI_ERR_NONFINITE, "lpi_step");
+    assert_non_null(strstr(lpi_last_error(sys), "after step 256 of this call (t = 256;"));
+    lpi_destroy(sys);
+
+    /* The baselines name the step a callback failed in, as the splittings do
+     * (it was the whole stretch between observations): rk4 calls the
+     * gradient 4 times a step, so call 18 is step 5's. */
+    assert_int_equal(lpi_generic_create(&sys, 3, 3, i, j, k, c), LPI_OK);
+    assert_int_equal(lpi_set_state(sys, kM0, 3), LPI_OK);
+    cd = (countdown){0, 18};
+    assert_int_equal(lpi_add_piece(sys, 1, axis, failing_gradient, energy_0, &cd), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "rk4"), LPI_OK);
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.25, 10), LPI_ERR_CALLBACK, "lpi_step");
+    assert_non_null(strstr(lpi_last_error(sys), "in step 5 of this call (t = 1 .. 1.25)"));
+    lpi_destroy(sys);
 }
 
 static void test_observer_arguments(void **state) {

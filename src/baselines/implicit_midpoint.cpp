@@ -17,14 +17,15 @@ public:
     ImplicitMidpoint(std::size_t size, ImplicitSettings settings)
         : settings_(settings), midpoint_(size), rate_(size) {}
 
-    bool advance(Model &model, double *x, double dt, std::int64_t n) override {
+    std::int64_t advance(Model &model, double *x, double dt, std::int64_t n,
+                         StepsInProgress &progress) override {
         const std::size_t size = midpoint_.size();
         std::int64_t iterations = 0;
-        const bool finite = run_checked_steps(
-            n, [&](std::int64_t step) { iterations += this->step(model, x, dt, step); },
+        const std::int64_t found = run_checked_steps(
+            n, progress, [&](std::int64_t) { iterations += this->step(model, x, dt); },
             [&] { return all_finite(x, size); });
         average_iterations_ = static_cast<double>(iterations) / static_cast<double>(n);
-        return finite;
+        return found;
     }
 
     // Vector-field evaluations per step, averaged over the last advance.
@@ -34,14 +35,14 @@ public:
 
 private:
     // One step; returns the iterations it took.
-    int step(Model &model, double *x, double dt, std::int64_t step) {
+    int step(Model &model, double *x, double dt) {
         const std::size_t size = midpoint_.size();
         // Midpoint y solves y = x + (h/2) f(y); start from the explicit Euler guess.
         model.vector_field(x, rate_.data());
         for (std::size_t i = 0; i < size; ++i) midpoint_[i] = x[i] + 0.5 * dt * rate_[i];
         double largest = 0.0;
         for (std::size_t i = 0; i < size; ++i) largest = std::max(largest, std::fabs(x[i]));
-        const FixedPointTest test(settings_, largest, "implicit midpoint", step);
+        const FixedPointTest test(settings_, largest, "implicit midpoint");
         bool converged = false;
         int iterations = 0;
         while (iterations < settings_.max_iterations && !converged) {

@@ -11,10 +11,11 @@ class RungeKutta4 final : public Integrator {
 public:
     explicit RungeKutta4(std::size_t size) : size_(size), stages_(size) {}
 
-    bool advance(Model &model, double *x, double dt, std::int64_t n) override {
+    std::int64_t advance(Model &model, double *x, double dt, std::int64_t n,
+                         StepsInProgress &progress) override {
         auto rate = [&model](const double *y, double *k) { model.vector_field(y, k); };
         return run_checked_steps(
-            n, [&](std::int64_t) { stages_.step(x, dt, rate); },
+            n, progress, [&](std::int64_t) { stages_.step(x, dt, rate); },
             [&] { return all_finite(x, size_); });
     }
     std::size_t evaluations_per_step() const override { return 4; }

@@ -41,11 +41,12 @@ public:
     }
 
     // The stages of rk4 on the modes, so the two agree to round-off.
-    bool advance(Model &model, double *x, double dt, std::int64_t n) override {
+    std::int64_t advance(Model &model, double *x, double dt, std::int64_t n,
+                         StepsInProgress &progress) override {
         const sine_euler::Hamiltonian H = static_cast<const SineEulerModel &>(model).hamiltonian();
         auto rate = [this, &H](const double *y, double *k) { this->rate(H, y, k); };
         return run_checked_steps(
-            n, [&](std::int64_t) { stages_.step(x, dt, rate); },
+            n, progress, [&](std::int64_t) { stages_.step(x, dt, rate); },
             [&] { return all_finite(x, size_); });
     }
 
@@ -131,9 +132,14 @@ bool matrix_finite(const std::vector<cplx> &W) {
 // run so every step stays in matrix form.
 class MatrixIntegrator : public Integrator {
 public:
-    bool advance(Model &model, double *state, double dt, std::int64_t n) override {
-        StepsInProgress progress;
-        return run(model, state, dt, n, StepObserver{}, progress).end != RunOutcome::NonFinite;
+    // Unused (run() is overridden), as the interface asks: the steps counted
+    // from progress.first.
+    std::int64_t advance(Model &model, double *state, double dt, std::int64_t n,
+                         StepsInProgress &progress) override {
+        const std::int64_t first = progress.first;
+        const RunOutcome outcome = run(model, state, dt, n, StepObserver{}, progress);
+        progress = {first - 1 + progress.first, first - 1 + progress.last};
+        return outcome.end == RunOutcome::NonFinite ? outcome.steps : 0;
     }
 
     // W is kept across observations: the observer sees the modes of W, as a
@@ -152,11 +158,12 @@ public:
         for (std::int64_t done = 0; done < n;) {
             const std::int64_t count = std::min(chunk, n - done);
             progress = {done + 1, done + count};
-            const bool finite = run_checked_steps(count, [&](std::int64_t s) { step(dt, done + s); },
-                                                  [&] { return matrix_finite(W_); });
+            const std::int64_t found = run_checked_steps(
+                count, progress, [&](std::int64_t s) { step(dt, done + s); },
+                [&] { return matrix_finite(W_); });
             done += count;
             end_stretch(done);
-            if (!finite) return {RunOutcome::NonFinite, done};
+            if (found) return {RunOutcome::NonFinite, done - count + found};
             form_.to_modes(W_.data(), state);
             symmetrise_modes(N_, w0, state);
             if (!all_finite(state, 2 * size_)) return {RunOutcome::NonFinite, done};
@@ -259,7 +266,7 @@ private:
         // B Wt B = -c^2 P Wt P, symmetrised so Wt stays exactly Hermitian.
         const double quad = -0.25 * h * h * c_ * c_;
         const std::size_t n = static_cast<std::size_t>(N);
-        const FixedPointTest test(settings_, largest, "isomp", s);
+        const FixedPointTest test(settings_, largest, "isomp");
         bool converged = false;
         for (int k = 0; k < settings_.max_iterations && !converged; ++k) {
             form_.stream(*hamiltonian_, mid, P_.data());

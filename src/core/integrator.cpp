@@ -22,7 +22,8 @@ RunOutcome Integrator::run(Model &model, double *state, double dt, std::int64_t 
     while (done < n) {
         const std::int64_t count = chunk < n - done ? chunk : n - done;
         progress = {done + 1, done + count};
-        if (!advance(model, state, dt, count)) return {RunOutcome::NonFinite, done + count};
+        if (const std::int64_t found = advance(model, state, dt, count, progress))
+            return {RunOutcome::NonFinite, done + found};
         done += count;
         if (observer.every > 0 && done % observer.every == 0 && observer.observe(done))
             return {RunOutcome::Stopped, done};
@@ -44,9 +45,14 @@ public:
             largest_ = std::max(largest_, std::fabs(program_.back().weight + program_.front().weight));
     }
 
-    bool advance(Model &model, double *state, double dt, std::int64_t n) override {
-        StepsInProgress progress;
-        return run(model, state, dt, n, StepObserver{}, progress).end != RunOutcome::NonFinite;
+    // Unused (run() is overridden), as the interface asks: the steps counted
+    // from progress.first.
+    std::int64_t advance(Model &model, double *state, double dt, std::int64_t n,
+                         StepsInProgress &progress) override {
+        const std::int64_t first = progress.first;
+        const RunOutcome outcome = run(model, state, dt, n, StepObserver{}, progress);
+        progress = {first - 1 + progress.first, first - 1 + progress.last};
+        return outcome.end == RunOutcome::NonFinite ? outcome.steps : 0;
     }
 
     // An observed step ends with its own last flow, on a copy kept aside: the

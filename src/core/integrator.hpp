@@ -37,10 +37,14 @@ struct StepsInProgress {
 class Integrator {
 public:
     virtual ~Integrator() = default;
-    // Advances n >= 1 steps of size dt in place. Returns false as soon as the
-    // state is found non-finite (checked every few steps and at the end); the
-    // caller then restores its copy.
-    virtual bool advance(Model &model, double *state, double dt, std::int64_t n) = 0;
+    // Advances n >= 1 steps of size dt in place: steps progress.first ..
+    // progress.first + n - 1 of the call, progress narrowed to the step being
+    // computed (what a failure thrown from it names). Returns 0 when the
+    // state stayed finite (checked every few steps and at the end), else as
+    // soon as it is found non-finite, the steps of these n done then; the
+    // caller restores its copy.
+    virtual std::int64_t advance(Model &model, double *state, double dt, std::int64_t n,
+                                 StepsInProgress &progress) = 0;
     // Advances n >= 1 steps with an optional observer. The default runs
     // advance() in chunks of observer.every steps, which is exact for methods
     // whose steps share nothing; the splitting integrator overrides it to
@@ -74,16 +78,21 @@ bool all_finite(const double *x, std::size_t n);
 // How often long runs look for a non-finite state, in steps.
 constexpr std::int64_t kFiniteCheckInterval = 256;
 
-// Runs step(s) for s = 0 .. n-1, asking finite() every kFiniteCheckInterval
-// steps and at the end: false as soon as it answers false (the loop of every
-// baseline's advance()).
+// Runs step(s) for s = 0 .. n-1, steps progress.first + s of the call,
+// progress naming the one being computed, and asks finite() every
+// kFiniteCheckInterval steps and at the end: advance()'s result, 0 or the
+// steps done when it first answered false (the loop of every baseline's
+// advance()).
 template <class Step, class Finite>
-bool run_checked_steps(std::int64_t n, Step &&step, Finite &&finite) {
+std::int64_t run_checked_steps(std::int64_t n, StepsInProgress &progress, Step &&step,
+                               Finite &&finite) {
+    const std::int64_t first = progress.first;
     for (std::int64_t s = 0; s < n; ++s) {
+        progress = {first + s, first + s};
         step(s);
-        if ((s + 1) % kFiniteCheckInterval == 0 && !finite()) return false;
+        if ((s + 1) % kFiniteCheckInterval == 0 && !finite()) return s + 1;
     }
-    return finite();
+    return finite() ? 0 : n;
 }
 
 }  // namespace lpi
