@@ -140,7 +140,8 @@ LPI_API int lpi_set_observer(lpi_system *sys, int64_t every, lpi_observer_fn fn,
         // While fn runs the handle is Observing: fn may read it, not change it.
         sys->system.set_observer(every, [sys, fn, user](std::int64_t step, double t) {
             lpi::capi::ActivityScope observing(sys, lpi::capi::Activity::Observing);
-            return fn(sys, step, t, user) != 0;
+            return lpi::call_user([&] { return fn(sys, step, t, user); },
+                                  [] { return std::string("the observer callback"); }) != 0;
         });
     });
 }

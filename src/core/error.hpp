@@ -23,4 +23,18 @@ private:
     throw Error(status, message);
 }
 
+// Calls a user callback. A C++ exception thrown from it (a callback written
+// in C++) is the user's failure: LPI_ERR_CALLBACK naming the callback
+// (name() is formed only then), not an internal error of the library.
+template <class Call, class Name>
+decltype(auto) call_user(Call &&call, Name &&name) {
+    try {
+        return call();
+    } catch (const std::exception &e) {
+        fail(LPI_ERR_CALLBACK, name() + " threw an exception: " + e.what());
+    } catch (...) {
+        fail(LPI_ERR_CALLBACK, name() + " threw an exception");
+    }
+}
+
 }  // namespace lpi

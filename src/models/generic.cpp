@@ -258,7 +258,8 @@ public:
 
     double energy(const double *x) const override {
         double h = 0.0;
-        const int rc = energy_(sigma_.size(), gather(x), &h, user_);
+        const int rc = call_user([&] { return energy_(sigma_.size(), gather(x), &h, user_); },
+                                 [&] { return "the energy callback of " + label(); });
         if (rc != 0)
             fail(LPI_ERR_CALLBACK, "the energy callback of " + label() + " returned " +
                                        std::to_string(rc));
@@ -293,7 +294,8 @@ private:
     }
 
     void gradient(const double *x) const {
-        const int rc = grad_(sigma_.size(), gather(x), g_.data(), user_);
+        const int rc = call_user([&] { return grad_(sigma_.size(), gather(x), g_.data(), user_); },
+                                 [&] { return "the gradient callback of " + label(); });
         bool finite = true;
         for (std::size_t p = 0; p < g_.size(); ++p) finite &= std::isfinite(g_[p]);
         if (rc != 0 || !finite) fail_gradient(rc);
@@ -352,7 +354,8 @@ double GenericModel::energy(const double *state) const {
 void GenericModel::casimirs(const double *state, double *out) const {
     for (std::size_t q = 0; q < casimirs_.size(); ++q) {
         double value = 0.0;
-        const int rc = casimirs_[q].fn(dim(), state, &value, casimirs_[q].user);
+        const int rc = call_user([&] { return casimirs_[q].fn(dim(), state, &value, casimirs_[q].user); },
+                                 [&] { return "the callback of Casimir " + std::to_string(q); });
         if (rc != 0)
             fail(LPI_ERR_CALLBACK, "the callback of Casimir " + std::to_string(q) + " returned " +
                                        std::to_string(rc));

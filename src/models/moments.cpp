@@ -176,7 +176,8 @@ public:
 
     double energy(const double *x) const override {
         double value = 0.0;
-        const int rc = h_(x[0] * x[2], &value, user_);
+        const int rc = call_user([&] { return h_(x[0] * x[2], &value, user_); },
+                                 [&] { return "the H callback of " + label(); });
         check(rc, value, "H");
         return value;
     }
@@ -286,7 +287,8 @@ private:
 
     double derivative(double u) const {
         double value = 0.0;
-        const int rc = dh_(u, &value, user_);
+        const int rc = call_user([&] { return dh_(u, &value, user_); },
+                                 [&] { return "the H' callback of " + label(); });
         check(rc, value, "H'");
         return value;
     }
