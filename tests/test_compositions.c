@@ -263,6 +263,10 @@ static void test_set_composition_bad_input(void **state) {
         {4, {0.2, 0.3, 0.2, 0.3}, LPI_ERR_INVALID, "gammas[0] = 0.20000000000000001 but gammas[3]"},
         {5, {0.28, 0.62546642846767, -0.81093285693534, 0.28, 0.62546642846767}, LPI_ERR_INVALID,
          "not symmetric"},
+        /* Huge weights whose sum is off by far more than 1e-10 (1e-14 of
+         * their magnitude would pass them): not consistent. */
+        {3, {1e14, -2e14, 1e14}, LPI_ERR_INVALID, "sum to 0,"},
+        {3, {1e13, 1.0 - 2e13 + 0.05, 1e13}, LPI_ERR_INVALID, "to 1e-10 at most"},
     };
     size_t flows_before = 0, flows_after = 0;
     assert_int_equal(lpi_flows_per_step(sys, &flows_before), LPI_OK);
