@@ -116,7 +116,9 @@ LPI_API int lpi_rigid_body_create(lpi_system **out, double I1, double I2, double
  * changed. Every case: either side of the separatrix, the separatrix,
  * symmetric bodies (closed form), near and on the axes; a steady rotation
  * comes back unchanged. Error a few 1e-15 |m|, growing like the round-off
- * times the number of turns. LPI_ERR_UNSUPPORTED for other systems. */
+ * times the number of turns. LPI_ERR_UNSUPPORTED for other systems;
+ * LPI_ERR_NONFINITE where t times the rate |m| / I overflows, LPI_ERR_OVERFLOW
+ * for inertias more than 2^1022 apart. */
 LPI_API int lpi_rigid_body_exact(const lpi_system *sys, double t, double *out);
 
 /* Planar pendulum on e(2): H = x3^2/2 + x2, Casimir x1^2 + x2^2.

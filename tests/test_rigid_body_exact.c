@@ -393,6 +393,24 @@ static void test_bad_input(void **state) {
     LPI_ASSERT_FAILS(body, lpi_rigid_body_exact(body, NAN, out), LPI_ERR_NONFINITE, "lpi_rigid_body_exact");
     LPI_ASSERT_FAILS(pendulum, lpi_rigid_body_exact(pendulum, 1.0, out), LPI_ERR_UNSUPPORTED,
                      "lpi_rigid_body_exact");
+    /* t times the rate scale |m| / I past DBL_MAX: the phase is not
+     * representable (the state is ordinary: it was named an overflow). */
+    lpi_system *fast = NULL;
+    const double m[3] = {1.0, 0.5, 1.0};
+    assert_int_equal(lpi_rigid_body_create(&fast, 1e-10, 2e-10, 3e-10), LPI_OK);
+    assert_int_equal(lpi_set_state(fast, m, 3), LPI_OK);
+    LPI_ASSERT_FAILS(fast, lpi_rigid_body_exact(fast, 1e300, out), LPI_ERR_NONFINITE, "lpi_rigid_body_exact");
+    assert_non_null(strstr(lpi_last_error(fast), "phase of the solution"));
+    assert_int_equal(lpi_rigid_body_exact(fast, 1e290, out), LPI_OK);
+    lpi_destroy(fast);
+    /* Inertias 2^1100 apart: their ratio is no double (a NaN was named an
+     * overflow of the solution's component 0). */
+    lpi_system *spread = NULL;
+    assert_int_equal(lpi_rigid_body_create(&spread, 1e-165, 1.0, 1e165), LPI_OK);
+    assert_int_equal(lpi_set_state(spread, m, 3), LPI_OK);
+    LPI_ASSERT_FAILS(spread, lpi_rigid_body_exact(spread, 1.0, out), LPI_ERR_OVERFLOW, "lpi_rigid_body_exact");
+    assert_non_null(strstr(lpi_last_error(spread), "ratio of the inertias"));
+    lpi_destroy(spread);
     lpi_destroy(body);
     lpi_destroy(pendulum);
 }

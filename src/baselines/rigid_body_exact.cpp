@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../core/error.hpp"
+#include "../core/text.hpp"
 #include "elliptic.hpp"
 
 namespace lpi {
@@ -129,6 +131,18 @@ void rigid_body_exact(const double inertia[3], const double m0[3], double t, dou
         m[k] = std::ldexp(m0[k], -m_exponent);
     }
     const double scaled_t = std::ldexp(t, m_exponent - i_exponent);
+    // |m| is conserved, so the solution itself is always a double; what may
+    // not be is the phase (t times the rate scale |m| / I) or, for inertias
+    // more than 2^1022 apart, the smallest scaled to the largest.
+    if (!std::isfinite(scaled_t))
+        fail(LPI_ERR_NONFINITE, "t = " + number_text(t) + " times the rate scale |m| / I = 2^" +
+                                    std::to_string(m_exponent - i_exponent) +
+                                    " overflows a double: the phase of the solution is not representable");
+    for (int k = 0; k < 3; ++k)
+        if (!std::isnormal(I[k]))
+            fail(LPI_ERR_OVERFLOW, "the ratio of the inertias " + number_text(inertia[k]) + " and 2^" +
+                                       std::to_string(i_exponent) +
+                                       " overflows a double: the exact solution needs it");
     // Components below 2^-1074 of the largest vanish at this scale: what is
     // left is a steady rotation to far below round-off (they would need
     // t ~ 700 / rate to grow into view), and the amplitudes need two nonzero.
