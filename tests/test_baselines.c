@@ -97,12 +97,50 @@ static void test_implicit_options_bad_input(void **state) {
     lpi_destroy(sys);
 }
 
+/* so(3) by structure constants whose one piece counts its gradient calls:
+ * one a vector-field evaluation. */
+static const double kInertia1 = 1.0;
+static int counting_gradient(size_t n, const double *x, double *g, void *user) {
+    ++*(long *)user;
+    return lpi_test_axis_gradient(n, x, g, (void *)&kInertia1);
+}
+static int axis_energy(size_t n, const double *x, double *h, void *user) {
+    (void)user;
+    return lpi_test_axis_energy(n, x, h, (void *)&kInertia1);
+}
+
+/* lpi_flows_per_step counts implicit-midpoint's evaluations as they are
+ * made: the starting guess's and one an iteration (it left out the guess's). */
+static void test_midpoint_counts_its_evaluations(void **state) {
+    (void)state;
+    static const int32_t i[] = {0, 1, 2}, j[] = {1, 2, 0}, k[] = {2, 0, 1};
+    static const double c[] = {1, 1, 1};
+    lpi_system *sys = NULL;
+    long calls = 0;
+    assert_int_equal(lpi_generic_create(&sys, 3, 3, i, j, k, c), LPI_OK);
+    const int32_t axis = 0;
+    assert_int_equal(lpi_add_piece(sys, 1, &axis, counting_gradient, axis_energy, &calls), LPI_OK);
+    const double m[3] = {1.0, 0.5, -0.3};
+    assert_int_equal(lpi_set_state(sys, m, 3), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "implicit-midpoint"), LPI_OK);
+    for (int loose = 0; loose < 2; ++loose) {
+        assert_int_equal(lpi_set_implicit_options(sys, loose ? 1e-3 : 1e-13, 100), LPI_OK);
+        calls = 0;
+        assert_int_equal(lpi_step(sys, 0.1, 10), LPI_OK);
+        size_t flows = 0;
+        assert_int_equal(lpi_flows_per_step(sys, &flows), LPI_OK);
+        assert_int_equal(flows, (calls + 9) / 10); /* per step, rounded up */
+    }
+    lpi_destroy(sys);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_poisson_flags),
         cmocka_unit_test(test_midpoint_non_convergence_rolls_back),
         cmocka_unit_test(test_midpoint_keeps_quadratic_invariants),
         cmocka_unit_test(test_implicit_options_bad_input),
+        cmocka_unit_test(test_midpoint_counts_its_evaluations),
     };
     return lpi_run_tests(tests);
 }

@@ -28,9 +28,10 @@ public:
         return found;
     }
 
-    // Vector-field evaluations per step, averaged over the last advance.
+    // Vector-field evaluations per step, averaged over the last advance: the
+    // starting guess's and one an iteration.
     std::size_t evaluations_per_step() const override {
-        return static_cast<std::size_t>(std::ceil(std::max(1.0, average_iterations_)));
+        return static_cast<std::size_t>(std::ceil(1.0 + std::max(1.0, average_iterations_)));
     }
 
 private:
