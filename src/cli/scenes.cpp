@@ -84,7 +84,7 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
                               "free rigid body, I = (" + format_number(I1) + ", " + format_number(I2) + ", " +
                                   format_number(I3) + "), m(0) = (1, 0.5, -0.3)",
                               [I1, I2, I3] { return rigid_body(I1, I2, I3, {1.0, 0.5, -0.3}); }, 100.0,
-                              {0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625});
+                              {0.8, 0.4, 0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625});
     rigid.options = {"--inertia"};
     rigid.exact_reference = true;
     scenes.push_back(rigid);
@@ -92,7 +92,7 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
     Scene pendulum_scene = sweep_scene(
         "pendulum", "planar pendulum H = x3^2/2 + x2, x(0) = (sin 2, -cos 2, 0.3)",
         [] { return pendulum({std::sin(2.0), -std::cos(2.0), 0.3}); }, 100.0,
-        {0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625});
+        {0.8, 0.4, 0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625});
     pendulum_scene.reference_method = "rk4";
     pendulum_scene.reference_step = 2e-4;
     scenes.push_back(pendulum_scene);
