@@ -132,14 +132,9 @@ bool matrix_finite(const std::vector<cplx> &W) {
 // run so every step stays in matrix form.
 class MatrixIntegrator : public Integrator {
 public:
-    // Unused (run() is overridden), as the interface asks: the steps counted
-    // from progress.first.
     std::int64_t advance(Model &model, double *state, double dt, std::int64_t n,
                          StepsInProgress &progress) override {
-        const std::int64_t first = progress.first;
-        const RunOutcome outcome = run(model, state, dt, n, StepObserver{}, progress);
-        progress = {first - 1 + progress.first, first - 1 + progress.last};
-        return outcome.end == RunOutcome::NonFinite ? outcome.steps : 0;
+        return advance_through_run(model, state, dt, n, progress);
     }
 
     // W is kept across observations: the observer sees the modes of W, as a

@@ -31,6 +31,14 @@ RunOutcome Integrator::run(Model &model, double *state, double dt, std::int64_t 
     return {RunOutcome::Done, n};
 }
 
+std::int64_t Integrator::advance_through_run(Model &model, double *state, double dt, std::int64_t n,
+                                             StepsInProgress &progress) {
+    const std::int64_t first = progress.first;
+    const RunOutcome outcome = run(model, state, dt, n, StepObserver{}, progress);
+    progress = {first - 1 + progress.first, first - 1 + progress.last};
+    return outcome.end == RunOutcome::NonFinite ? outcome.steps : 0;
+}
+
 namespace {
 
 // Composes exact piece flows. When a step begins and ends with the same piece
@@ -45,14 +53,9 @@ public:
             largest_ = std::max(largest_, std::fabs(program_.back().weight + program_.front().weight));
     }
 
-    // Unused (run() is overridden), as the interface asks: the steps counted
-    // from progress.first.
     std::int64_t advance(Model &model, double *state, double dt, std::int64_t n,
                          StepsInProgress &progress) override {
-        const std::int64_t first = progress.first;
-        const RunOutcome outcome = run(model, state, dt, n, StepObserver{}, progress);
-        progress = {first - 1 + progress.first, first - 1 + progress.last};
-        return outcome.end == RunOutcome::NonFinite ? outcome.steps : 0;
+        return advance_through_run(model, state, dt, n, progress);
     }
 
     // An observed step ends with its own last flow, on a copy kept aside: the

@@ -56,6 +56,12 @@ public:
     virtual std::size_t evaluations_per_step() const = 0;
     // The largest |multiple of dt| that one flow or stage of a step takes.
     virtual double largest_step_fraction() const { return 1.0; }
+
+protected:
+    // advance() for an integrator that overrides run(): its steps counted
+    // from progress.first.
+    std::int64_t advance_through_run(Model &model, double *state, double dt, std::int64_t n,
+                                     StepsInProgress &progress);
 };
 
 // How implicit methods solve their equations (fixed-point iteration).
