@@ -131,6 +131,11 @@ void rigid_body_exact(const double inertia[3], const double m0[3], double t, dou
         m[k] = std::ldexp(m0[k], -m_exponent);
     }
     const double scaled_t = std::ldexp(t, m_exponent - i_exponent);
+    // Components below 2^-1074 of the largest vanish at this scale: what is
+    // left is a steady rotation to far below round-off (they would need
+    // t ~ 700 / rate to grow into view), and the amplitudes need two nonzero.
+    if ((m[0] == 0.0) + (m[1] == 0.0) + (m[2] == 0.0) >= 2) return;
+
     // |m| is conserved, so the solution itself is always a double; what may
     // not be is the phase (t times the rate scale |m| / I) or, for inertias
     // more than 2^1022 apart, the smallest scaled to the largest.
@@ -143,10 +148,6 @@ void rigid_body_exact(const double inertia[3], const double m0[3], double t, dou
             fail(LPI_ERR_OVERFLOW, "the ratio of the inertias " + number_text(inertia[k]) + " and 2^" +
                                        std::to_string(i_exponent) +
                                        " overflows a double: the exact solution needs it");
-    // Components below 2^-1074 of the largest vanish at this scale: what is
-    // left is a steady rotation to far below round-off (they would need
-    // t ~ 700 / rate to grow into view), and the amplitudes need two nonzero.
-    if ((m[0] == 0.0) + (m[1] == 0.0) + (m[2] == 0.0) >= 2) return;
 
     if (I[0] == I[1]) {
         symmetric_top(I, m, 2, scaled_t, out);
