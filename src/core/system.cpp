@@ -164,7 +164,11 @@ bool System::step(double dt, std::int64_t nsteps) {
         watch.every = observe_every_;
         watch.observe = [&](std::int64_t done) {
             time_ = start + dt * static_cast<double>(done);
-            return model_->on_any_process(observer_(done, time_));
+            // An observer that fails (throws) on one process fails the call
+            // on every one: none is left waiting in the next collective.
+            bool stop = false;
+            model_->agree_on_every_process([&] { stop = observer_(done, time_); });
+            return model_->on_any_process(stop);
         };
     }
     saved_ = state_;
