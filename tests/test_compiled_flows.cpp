@@ -36,6 +36,15 @@ int quadratic_gradient(size_t n, const double *x, double *g, void *user) {
     for (size_t p = 0; p < n; ++p) g[p] = q->alpha[p] + q->beta[p] * x[p];
     return 0;
 }
+// A gradient of 1 in each index that records (in user) whether it was ever
+// handed a non-finite coordinate.
+int watching_gradient(size_t n, const double *x, double *g, void *user) {
+    for (size_t p = 0; p < n; ++p) {
+        if (!std::isfinite(x[p])) *static_cast<int *>(user) = 1;
+        g[p] = 1.0;
+    }
+    return 0;
+}
 int quadratic_energy(size_t n, const double *x, double *h, void *user) {
     const Quadratic *q = static_cast<const Quadratic *>(user);
     *h = 0.0;
@@ -147,6 +156,23 @@ void test_compiled_flow_refuses_overflow(void **) {
     double after[8];
     EXPECT_OK(sys, lpi_get_state(sys, after, 8));
     assert_memory_equal(after, x, sizeof x);
+    lpi_destroy(sys);
+
+    // Every increment finite, x2 + its increment not (-1e308 - 1e308): the
+    // new value is what is checked, and the next piece never sees it (it
+    // was written, and the next piece's callback was handed -inf).
+    EXPECT_OK(NULL, lpi_moments_create(&sys));
+    Quadratic steep = {};
+    steep.alpha[0] = 1e-300, steep.alpha[1] = 1e300;  // x2' = -2a x1 - 4b x4 = -1e308
+    EXPECT_OK(sys, lpi_add_piece(sys, 2, indices, quadratic_gradient, quadratic_energy, &steep));
+    int saw_nonfinite = 0;
+    const int32_t kinetic[2] = {2, 7};
+    EXPECT_OK(sys, lpi_add_piece(sys, 2, kinetic, watching_gradient, quadratic_energy, &saw_nonfinite));
+    EXPECT_OK(sys, lpi_set_method(sys, "lie-trotter"));
+    const double edge[8] = {1.0, -1e308, 0.5, 2.5e7, 0.0, 0.6, 0.3, 0.8};
+    EXPECT_OK(sys, lpi_set_state(sys, edge, 8));
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 1.0, 1), LPI_ERR_NONFINITE, "exact flow overflows (component 1)");
+    assert_false(saw_nonfinite);
     lpi_destroy(sys);
 }
 

@@ -345,7 +345,7 @@ void expect_refusal(lpi::SparseExponential &exponential, const double *g, double
         fail_msg("apply did not refuse (%s)", words);
     } catch (const lpi::Error &e) {
         assert_int_equal(e.status(), status);
-        assert_non_null(std::strstr(e.what(), words));
+        if (!std::strstr(e.what(), words)) fail_msg("message '%s' does not say '%s'", e.what(), words);
     }
     for (std::size_t i = 0; i < x.size(); ++i) assert_true(x[i] == before[i]);
 }
@@ -377,6 +377,17 @@ void test_refusals_leave_x_unchanged(void **) {
     assert_int_equal(static_cast<int>(pade.path()), static_cast<int>(lpi::ExpmPath::Pade));
     const double large = 1e11;
     expect_refusal(pade, &large, 1.0, x, LPI_ERR_INVALID, "squarings");
+
+    // Every increment finite, a new value not (1.5e308 + 1.5e308): the new
+    // values are what is checked; each path wrote inf.
+    const std::vector<double> edge = {1.5e308, 1.5e308, 1.5e308, 1.5e308};
+    const double one[2] = {1.0, 1.0};
+    expect_refusal(series, one, 1.0, edge, LPI_ERR_NONFINITE, "component 1");
+    expect_refusal(shear, one, 1.0, edge, LPI_ERR_NONFINITE, "component 1");
+    const double turn[2] = {0.5, -0.5};  // a rotation by 0.5: 1.5e308 (cos + sin) > DBL_MAX
+    expect_refusal(closed, turn, 1.0, edge, LPI_ERR_NONFINITE, "component 0");
+    const double small = 0.5;
+    expect_refusal(pade, &small, 1.0, edge, LPI_ERR_NONFINITE, "overflows");
 }
 
 // Deep nilpotent patterns (depth above the unrolled widths: lanes at run
@@ -651,6 +662,14 @@ void test_scalings_past_the_range_of_exp(void **) {
     spiral.apply(ac, 1.0, y.data());
     assert_true(close(y[0], 1e-300L * ea * std::cos(1.0L), 8));
     assert_true(close(y[1], -1e-300L * ea * std::sin(1.0L), 8));
+    // Just below ln DBL_MAX, e^tau inside exp(tA) - I overflowed where the
+    // flow of a small x does not (refused at 709.5, returned at 712).
+    const double near_range[2] = {709.5, 1.0};
+    const long double e709 = std::exp(709.5L);
+    y = {1e-300, 0.0};
+    spiral.apply(near_range, 1.0, y.data());
+    assert_true(close(y[0], 1e-300L * e709 * std::cos(1.0L), 8));
+    assert_true(close(y[1], -1e-300L * e709 * std::sin(1.0L), 8));
     y = {1.0, 0.0};  // e^720 itself: refused, x untouched
     try {
         spiral.apply(ac, 1.0, y.data());

@@ -221,10 +221,10 @@ template <class Algebra, unsigned Mask>
 struct Piece {
     static constexpr Plan P = plan<Algebra>(Mask);
 
-    // The first node, in order, whose increment is not finite.
-    static long first_nonfinite(const double *increment) {
+    // The first node, in order, whose new value is not finite.
+    static long first_nonfinite(const double *values) {
         for (int n = 0; n < P.nodes; ++n)
-            if (!std::isfinite(increment[P.order[n]])) return P.order[n];
+            if (!std::isfinite(values[P.order[n]])) return P.order[n];
         return -1;
     }
 
@@ -279,13 +279,14 @@ struct Piece {
             });
             increment[v] = total;
         });
-        // 0 z is 0 for a finite z and NaN otherwise: one test for all.
-        double probe = 0.0;
-        unroll<0, P.nodes>([&](auto n) { probe += 0.0 * increment[P.order[n]]; });
-        if (probe != probe) return first_nonfinite(increment);
         double y[Algebra::dim];  // exp(tN) x
         unroll<0, Algebra::dim>([&](auto v) { y[v] = x[v]; });
         unroll<0, P.nodes>([&](auto n) { y[P.order[n]] = c[P.order[n]][0] + increment[P.order[n]]; });
+        // 0 z is 0 for a finite z and NaN otherwise: one test for all, of
+        // the new values (x + a finite increment may overflow).
+        double probe = 0.0;
+        unroll<0, P.nodes>([&](auto n) { probe += 0.0 * y[P.order[n]]; });
+        if (probe != probe) return first_nonfinite(y);
         double scaled[P.scalings > 0 ? P.scalings : 1];
         unroll<0, P.scalings>([&](auto d) {
             constexpr Scaling S = P.scaling[d];

@@ -196,7 +196,8 @@ private:
     void apply_plane(double t, double *x);  // a block of order 1 or 2
     void apply_pade(double t, double *x);
     void check_norm(double norm, double t) const;
-    // Throws LPI_ERR_NONFINITE naming the first non-finite increment.
+    // Throws LPI_ERR_NONFINITE naming the first moved index whose entry of
+    // increment_ (its new value, or its increment on the plane path) is not finite.
     [[noreturn]] void fail_nonfinite() const;
 
     ExpmPath path_ = ExpmPath::Nilpotent;

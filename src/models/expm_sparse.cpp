@@ -152,8 +152,6 @@ BlockOrder driven_first(std::size_t m, const std::vector<std::pair<std::uint32_t
 // contracts by more than half, or real eigenvalues tau +- r with r beyond
 // it) the plane path applies exp(A) itself.
 constexpr double kIncrementFormLimit = 0.6931471805599453;
-// ln(DBL_MAX): exp of anything larger overflows.
-constexpr double kLargestExponent = 709.782712893384;
 
 }  // namespace
 
@@ -403,7 +401,7 @@ void SparseExponential::scale_entries(const double *g, double t) {
 // in `Lanes` lanes that the compiler unrolls (0: lanes_ at run time).
 // Lanes beyond a node's level hold exact zeros. A node's component is read
 // (into c_v[0]) before it is written, and written as x + increment, rounded
-// once. Returns false, x restored, when an increment is not finite.
+// once. Returns false, x restored, when a new value is not finite.
 template <std::size_t Lanes>
 bool SparseExponential::sweep(double *x) {
     const std::size_t lanes = Lanes ? Lanes : lanes_;
@@ -432,9 +430,11 @@ bool SparseExponential::sweep(double *x) {
             total += term;
             if (k + 1 < lanes) own[k + 1] = term;
         }
-        increment_[v] = total;
-        finite &= std::isfinite(total);
-        x[node.global] = own[0] + total;
+        // The new value, checked itself: x + a finite increment may overflow.
+        const double next = own[0] + total;
+        increment_[v] = next;  // only to name a non-finite component
+        finite &= std::isfinite(next);
+        x[node.global] = next;
     }
     if (finite) return true;
     for (std::size_t v = 0; v < nodes_.size(); ++v) x[nodes_[v].global] = coefficients[v * lanes];
@@ -452,11 +452,11 @@ inline bool SparseExponential::shear(const double *g, double t, double *x) {
         double sum = 0.0;
         for (std::uint32_t i = 0; i < nodes_[v].fixed_columns; ++i, ++term, ++column)
             sum += t * (term->coefficient * g[term->parameter]) * x[*column];
-        increment_[v] = sum;
-        finite &= std::isfinite(sum);
+        increment_[v] = x[nodes_[v].global] + sum;  // the new value, written once all are finite
+        finite &= std::isfinite(increment_[v]);
     }
     if (!finite) return false;
-    for (std::size_t v = 0; v < nodes_.size(); ++v) x[nodes_[v].global] += increment_[v];
+    for (std::size_t v = 0; v < nodes_.size(); ++v) x[nodes_[v].global] = increment_[v];
     return true;
 }
 
@@ -539,33 +539,34 @@ void SparseExponential::apply_plane(double t, double *x) {
     const double tau = 0.5 * (A[0] + A[3]), p = 0.5 * (A[0] - A[3]);
     const double delta = p * p + A[1] * A[2];
     const bool apart = delta > 0.0 && std::sqrt(delta) > kIncrementFormLimit;
-    // Past ln(DBL_MAX), exp(tau) - 1 overflows, and e^tau is applied last.
-    const bool beyond_range = tau > kLargestExponent;
-    if (apart || tau < -kIncrementFormLimit || beyond_range) {
-        double y0 = x0, y1 = x1;
-        if (apart) {
-            plane_hyperbolic_apply(A[0], A[1], A[2], A[3], y0, y1);
-        } else {  // e^tau (C x + S N x), C and S as plane_expm1 forms them
-            double W[4];
-            plane_expm1(A[0] - tau, A[1], A[2], A[3] - tau, W);  // traceless: C - 1 +- S p, S b, S c
-            y0 = times_exponential((x0 + W[0] * x0) + W[1] * x1, tau);
-            y1 = times_exponential(W[2] * x0 + (x1 + W[3] * x1), tau);
+    if (!apart && tau >= -kIncrementFormLimit) {
+        double W[4];
+        plane_expm1(A[0], A[1], A[2], A[3], W);
+        // x += (exp(tA) - I) x, rounded once.
+        const double y0 = x0 + (W[0] * x0 + W[1] * x1), y1 = x1 + (W[2] * x0 + W[3] * x1);
+        if (std::isfinite(y0) && std::isfinite(y1)) {
+            x[moved_[0]] = y0;
+            x[moved_[1]] = y1;
+            return;
         }
-        increment_[0] = y0 - x0;  // only to name a non-finite component
-        increment_[1] = y1 - x1;
-        if (!std::isfinite(y0) || !std::isfinite(y1)) fail_nonfinite();
-        x[moved_[0]] = y0;
-        x[moved_[1]] = y1;
-        return;
+        // Not representable this way: W holds e^tau, which may overflow
+        // (tau near ln DBL_MAX) where the flow of a small x does not. Below,
+        // e^tau is applied last; a flow that does overflow is refused there.
     }
-    double W[4];
-    plane_expm1(A[0], A[1], A[2], A[3], W);
-    // x += (exp(tA) - I) x, rounded once; untouched when not representable.
-    increment_[0] = W[0] * x0 + W[1] * x1;
-    increment_[1] = W[2] * x0 + W[3] * x1;
-    if (!std::isfinite(increment_[0]) || !std::isfinite(increment_[1])) fail_nonfinite();
-    x[moved_[0]] = x0 + increment_[0];
-    x[moved_[1]] = x1 + increment_[1];
+    double y0 = x0, y1 = x1;
+    if (apart) {
+        plane_hyperbolic_apply(A[0], A[1], A[2], A[3], y0, y1);
+    } else {  // e^tau (C x + S N x), C and S as plane_expm1 forms them
+        double W[4];
+        plane_expm1(A[0] - tau, A[1], A[2], A[3] - tau, W);  // traceless: C - 1 +- S p, S b, S c
+        y0 = times_exponential((x0 + W[0] * x0) + W[1] * x1, tau);
+        y1 = times_exponential(W[2] * x0 + (x1 + W[3] * x1), tau);
+    }
+    increment_[0] = y0 - x0;  // only to name a non-finite component
+    increment_[1] = y1 - x1;
+    if (!std::isfinite(y0) || !std::isfinite(y1)) fail_nonfinite();
+    x[moved_[0]] = y0;
+    x[moved_[1]] = y1;
 }
 
 void SparseExponential::apply_pade(double t, double *x) {
@@ -603,9 +604,9 @@ void SparseExponential::apply_pade(double t, double *x) {
         const double *row = (direct ? direct_.data() : exp_.data()) + r * m;
         double s = 0.0;
         for (std::size_t c = 0; c < m; ++c) s += row[c] * x[moved_[c]];
-        increment_[r] = s;  // only to name a non-finite component
         scaled_values_[r] = direct ? s : x[moved_[r]] + s;
-        finite &= std::isfinite(s);
+        increment_[r] = scaled_values_[r];  // only to name a non-finite component
+        finite &= std::isfinite(scaled_values_[r]);
     }
     if (!finite) fail_nonfinite();
     for (std::size_t r = 0; r < m; ++r) x[moved_[r]] = scaled_values_[r];
