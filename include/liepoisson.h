@@ -117,8 +117,8 @@ LPI_API int lpi_rigid_body_create(lpi_system **out, double I1, double I2, double
  * symmetric bodies (closed form), near and on the axes; a steady rotation
  * comes back unchanged. Error a few 1e-15 |m|, growing like the round-off
  * times the number of turns. LPI_ERR_UNSUPPORTED for other systems;
- * LPI_ERR_NONFINITE where t times the rate |m| / I overflows, LPI_ERR_OVERFLOW
- * for inertias more than 2^1022 apart. */
+ * LPI_ERR_NONFINITE where t times the body's rates (about |m| / I) overflows,
+ * LPI_ERR_OVERFLOW for inertias more than 2^1022 apart. */
 LPI_API int lpi_rigid_body_exact(const lpi_system *sys, double t, double *out);
 
 /* Planar pendulum on e(2): H = x3^2/2 + x2, Casimir x1^2 + x2^2.
@@ -203,11 +203,11 @@ LPI_API const char *lpi_method_reference(int i);
 /* Makes the method a symmetric composition of leapfrog with the n >= 1 weights
  * gammas (step i takes gammas[i] * dt), named "custom". The weights must be
  * finite (else LPI_ERR_NONFINITE), sum to 1 within 1e-14 times the sum of
- * their absolute values and be symmetric, gammas[i] = gammas[n-1-i] within a
- * relative 1e-14 (else LPI_ERR_INVALID); weights whose sum of absolute values
- * overflows a double are refused with LPI_ERR_OVERFLOW. Mirrored pairs are
- * replaced by their mean, so the composition is exactly symmetric. The array
- * is copied. */
+ * their absolute values and within 1e-10, and be symmetric, gammas[i] =
+ * gammas[n-1-i] within a relative 1e-14 (else LPI_ERR_INVALID); weights whose
+ * sum of absolute values overflows a double are refused with LPI_ERR_OVERFLOW.
+ * Mirrored pairs are replaced by their mean, so the composition is exactly
+ * symmetric. The array is copied. */
 LPI_API int lpi_set_composition(lpi_system *sys, size_t n, const double *gammas);
 
 /* Exact piece flows per step in a long run of the current method, after the
@@ -386,7 +386,8 @@ LPI_API int lpi_set_threads(lpi_system *sys, int32_t n);
  * most size bytes including the NUL and sets *length to the length without
  * it; LPI_ERR_SIZE when size <= *length (buf may then be NULL with size 0).
  * A file that cannot be opened, read or written: LPI_ERR_IO (the message
- * gives the path and the reason); text that is not wisdom: LPI_ERR_INVALID. */
+ * gives the path and the reason); text that is not wisdom, or an empty path:
+ * LPI_ERR_INVALID. */
 LPI_API int lpi_fftw_wisdom_import_file(const char *path);
 LPI_API int lpi_fftw_wisdom_export_file(const char *path);
 LPI_API int lpi_fftw_wisdom_import_string(const char *wisdom);

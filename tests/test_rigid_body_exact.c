@@ -403,6 +403,25 @@ static void test_bad_input(void **state) {
     assert_non_null(strstr(lpi_last_error(fast), "phase of the solution"));
     assert_int_equal(lpi_rigid_body_exact(fast, 1e290, out), LPI_OK);
     lpi_destroy(fast);
+    /* The rates go with |m| over the smallest inertia, not the largest. */
+    const double spread_inertia[3][3] = {{1e-10, 2e-10, 1.0}, {1.0, 1.0, 1e-300}};
+    const double spread_t[2] = {1e300, 1e10};
+    for (int c = 0; c < 2; ++c) {
+        assert_int_equal(lpi_rigid_body_create(&fast, spread_inertia[c][0], spread_inertia[c][1],
+                                               spread_inertia[c][2]), LPI_OK);
+        assert_int_equal(lpi_set_state(fast, m, 3), LPI_OK);
+        LPI_ASSERT_FAILS(fast, lpi_rigid_body_exact(fast, spread_t[c], out), LPI_ERR_NONFINITE,
+                         "lpi_rigid_body_exact");
+        assert_non_null(strstr(lpi_last_error(fast), "phase of the solution"));
+        lpi_destroy(fast);
+    }
+    /* A steady rotation comes back unchanged at any t. */
+    const double steady[3] = {1e300, 1e-300, 0.0};
+    assert_int_equal(lpi_rigid_body_create(&fast, 1, 2, 3), LPI_OK);
+    assert_int_equal(lpi_set_state(fast, steady, 3), LPI_OK);
+    assert_int_equal(lpi_rigid_body_exact(fast, 1e20, out), LPI_OK);
+    assert_memory_equal(out, steady, sizeof steady);
+    lpi_destroy(fast);
     /* Inertias 2^1100 apart: their ratio is no double (a NaN was named an
      * overflow of the solution's component 0). */
     lpi_system *spread = NULL;

@@ -137,12 +137,8 @@ void rigid_body_exact(const double inertia[3], const double m0[3], double t, dou
     if ((m[0] == 0.0) + (m[1] == 0.0) + (m[2] == 0.0) >= 2) return;
 
     // |m| is conserved, so the solution itself is always a double; what may
-    // not be is the phase (t times the rate scale |m| / I) or, for inertias
-    // more than 2^1022 apart, the smallest scaled to the largest.
-    if (!std::isfinite(scaled_t))
-        fail(LPI_ERR_NONFINITE, "t = " + number_text(t) + " times the rate scale |m| / I = 2^" +
-                                    std::to_string(m_exponent - i_exponent) +
-                                    " overflows a double: the phase of the solution is not representable");
+    // not be is, for inertias more than 2^1022 apart, the smallest scaled to
+    // the largest, or (below) the phase, t times the body's rates.
     for (int k = 0; k < 3; ++k)
         if (!std::isnormal(I[k]))
             fail(LPI_ERR_OVERFLOW, "the ratio of the inertias " + number_text(inertia[k]) + " and 2^" +
@@ -158,6 +154,10 @@ void rigid_body_exact(const double inertia[3], const double m0[3], double t, dou
     } else {
         triaxial_body(I, m, scaled_t, out);
     }
+    for (int k = 0; k < 3; ++k)
+        if (!std::isfinite(out[k]))
+            fail(LPI_ERR_NONFINITE, "t = " + number_text(t) + " times the body's rates (|m| / I) "
+                                    "overflows a double: the phase of the solution is not representable");
     for (int k = 0; k < 3; ++k) out[k] = std::ldexp(out[k], m_exponent);
 }
 
