@@ -20,15 +20,23 @@ public:
     std::int64_t advance(Model &model, double *x, double dt, std::int64_t n,
                          StepsInProgress &progress) override {
         const std::size_t size = midpoint_.size();
-        std::int64_t iterations = 0;
+        // Counted over the whole call (its stretches between observations
+        // are advances of their own), as isomp counts.
+        if (progress.first == 1) call_iterations_ = 0, call_steps_ = 0;
+        std::int64_t steps = 0;
         const std::int64_t found = run_checked_steps(
-            n, progress, [&](std::int64_t) { iterations += this->step(model, x, dt); },
+            n, progress,
+            [&](std::int64_t) {
+                ++steps;
+                call_iterations_ += this->step(model, x, dt);
+            },
             [&] { return all_finite(x, size); });
-        average_iterations_ = static_cast<double>(iterations) / static_cast<double>(n);
+        call_steps_ += steps;
+        average_iterations_ = static_cast<double>(call_iterations_) / static_cast<double>(call_steps_);
         return found;
     }
 
-    // Vector-field evaluations per step, averaged over the last advance: the
+    // Vector-field evaluations per step, averaged over the last call: the
     // starting guess's and one an iteration.
     std::size_t evaluations_per_step() const override {
         return static_cast<std::size_t>(std::ceil(1.0 + std::max(1.0, average_iterations_)));
@@ -64,6 +72,7 @@ private:
 
     ImplicitSettings settings_;
     std::vector<double> midpoint_, rate_;
+    std::int64_t call_iterations_ = 0, call_steps_ = 0;
     double average_iterations_ = 0.0;
 };
 
