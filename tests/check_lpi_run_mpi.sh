@@ -95,4 +95,12 @@ if [ "$(nproc)" -ge 2 ] && command -v taskset >/dev/null 2>&1; then
 else
     echo "note: --threads on processes with different CPUs not checked (it needs 2 CPUs and taskset)"
 fi
+# Processes started with different options (an MPMD launch): refused on
+# every process before any call (they waited in different collectives).
+rc=0
+timeout 60 "$mpiexec" --oversubscribe -n 1 "$lpi" $short --out "$out/mpmd" --method yoshida-6 : \
+    -n 1 "$lpi" $short --out "$out/mpmd" >/dev/null 2>"$out/mpmd.err" || rc=$?
+[ "$rc" -ne 124 ] || { echo "different options per process: hang"; exit 1; }
+[ "$rc" -ne 0 ] && grep -q "different command lines" "$out/mpmd.err" ||
+    { echo "different options per process: exit status $rc:"; cat "$out/mpmd.err"; exit 1; }
 echo "lpi run under mpirun: P = 1..3 agree with one process, output once, resume bit for bit, failures agreed"

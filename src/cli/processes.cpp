@@ -26,6 +26,23 @@ bool launched_by_mpi() {
 
 void finalize() { MPI_Finalize(); }
 
+// Whether every process was given rank 0's command line. The processes make
+// the same calls in the same order only if they parse the same options: an
+// option refused, or a call made, on some processes alone (an MPMD launch,
+// `mpirun -np 1 lpi ... : -np 1 lpi ...`) left the others waiting forever.
+bool same_command_line(int argc, char **argv) {
+    std::string line;
+    for (int i = 0; i < argc; ++i) line.append(argv[i]).push_back('\0');
+    long long size = static_cast<long long>(line.size());
+    MPI_Bcast(&size, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+    std::string first(static_cast<std::size_t>(size), '\0');
+    if (world_rank == 0) first = line;
+    MPI_Bcast(&first[0], static_cast<int>(size), MPI_CHAR, 0, MPI_COMM_WORLD);
+    int same = first == line;
+    MPI_Allreduce(MPI_IN_PLACE, &same, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    return same != 0;
+}
+
 }  // namespace
 
 void start_processes(int *argc, char ***argv) {
@@ -37,6 +54,11 @@ void start_processes(int *argc, char ***argv) {
     MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);
     if (world_rank != 0) {
         if (!std::freopen("/dev/null", "w", stdout) || !std::freopen("/dev/null", "w", stderr)) std::exit(1);
+    }
+    if (world_size > 1 && !same_command_line(*argc, *argv)) {
+        std::fprintf(stderr, "lpi: the processes were given different command lines; every process "
+                             "of an MPI run must run the same lpi command with the same options\n");
+        std::exit(2);
     }
 }
 
