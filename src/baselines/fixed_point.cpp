@@ -8,7 +8,9 @@ namespace lpi {
 
 void FixedPointTest::diverged() const {
     fail(LPI_ERR_NO_CONVERGENCE, std::string(method_) +
-                                     ": fixed-point iteration diverged (dt too large for the iteration)");
+                                     ": fixed-point iteration diverged to a change that is not finite "
+                                     "(dt too large for the iteration, or a state so large that its "
+                                     "products overflow)");
 }
 
 void FixedPointTest::failed() const {
