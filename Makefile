@@ -92,11 +92,12 @@ check-tsan: deps
 # The cmocka tests of $(BUILD) under valgrind. VALGRIND_SKIP leaves out the
 # two slowest (minutes each under valgrind) and test_expm, whose long double
 # references need x87 80-bit arithmetic that valgrind performs in 64 bits
-# (its assertions then fail), and test_sine_euler_mpi, which runs under
-# mpirun (valgrind reports Open MPI's own allocations and its shared-memory
-# transport). `make check-valgrind VALGRIND_SKIP=` runs all.
+# (its assertions then fail), and the MPI tests (test_sine_euler_mpi and
+# test_sine_euler_mpi_observer), which run under mpirun (valgrind reports
+# Open MPI's own allocations and its shared-memory transport).
+# `make check-valgrind VALGRIND_SKIP=` runs all.
 # A test that exits 77 had nothing to run in this build (see tests/lpi_test.h).
-VALGRIND_SKIP ?= test_compositions test_sine_euler test_expm test_sine_euler_mpi
+VALGRIND_SKIP ?= test_compositions test_sine_euler test_expm test_sine_euler_mpi test_sine_euler_mpi_observer
 check-valgrind: build
 	@set -e; for t in $(BUILD)/tests/test_* $(BUILD)/tests/example_user_system; do \
 	    name=$$(basename $$t); \
