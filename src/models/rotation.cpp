@@ -16,6 +16,22 @@ void compensated_add(double &x, double &carry, double increment) {
     x = t;
 }
 
+namespace {
+
+// The rotation of a pair too large for its increments (up to 2 |x|): applied
+// to [x, carry] scaled by 1/4, exactly, and scaled back.
+[[gnu::cold, gnu::noinline]] void rotate_large_pair(double *x, double *carry, int i, int j,
+                                                    double c_minus_1, double s) {
+    double xs[2] = {0.25 * x[i], 0.25 * x[j]}, cs[2] = {0.25 * carry[i], 0.25 * carry[j]};
+    const double xi = xs[0] + cs[0], xj = xs[1] + cs[1];
+    compensated_add(xs[0], cs[0], c_minus_1 * xi + s * xj);
+    compensated_add(xs[1], cs[1], c_minus_1 * xj - s * xi);
+    x[i] = 4.0 * xs[0], carry[i] = 4.0 * cs[0];
+    x[j] = 4.0 * xs[1], carry[j] = 4.0 * cs[1];
+}
+
+}  // namespace
+
 void rotate_pair(double *x, double *carry, int i, int j, double angle) {
     // The increment (c - 1) x + s y, with c - 1 = -2 sin^2(a/2), is small for
     // small angles, so its own rounding errors are scaled down by the angle.
@@ -23,8 +39,12 @@ void rotate_pair(double *x, double *carry, int i, int j, double angle) {
     const double c_minus_1 = -2.0 * h * h;
     const double s = std::sin(angle);
     const double xi = x[i] + carry[i], xj = x[j] + carry[j];
-    compensated_add(x[i], carry[i], c_minus_1 * xi + s * xj);
-    compensated_add(x[j], carry[j], c_minus_1 * xj - s * xi);
+    const double di = c_minus_1 * xi + s * xj, dj = c_minus_1 * xj - s * xi;
+    // Above DBL_MAX / 3 an increment may overflow where the rotated pair
+    // does not (a state of 8e307 failed a step as non-finite).
+    if (!std::isfinite(di) || !std::isfinite(dj)) return rotate_large_pair(x, carry, i, j, c_minus_1, s);
+    compensated_add(x[i], carry[i], di);
+    compensated_add(x[j], carry[j], dj);
 }
 
 }  // namespace lpi
