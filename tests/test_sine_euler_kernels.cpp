@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <numeric>
 #include <vector>
 
 #include "lpi_config.h"
@@ -134,13 +135,151 @@ void test_phase_is_the_complex_arithmetic(void **) {
                         // exp(t Lambda_l) = u_{l+d} conj(u_{l-d}), conjugated for sign = -1.
                         std::complex<double> exact = u[(l + d) % N] * std::conj(u[((l - d) % N + N) % N]);
                         if (sign < 0) exact = std::conj(exact);
-                        const std::complex<double> reference = (exact - 1.0) / n * std::complex<double>(zr, zi);
-                        worst = std::max(worst, std::abs(reference - std::complex<double>(expected[e], expected[e + 1])));
+                        const std::complex<double> reference =
+                            (exact - 1.0) / n * std::complex<double>(zr, zi);
+                        worst = std::max(
+                            worst, std::abs(reference - std::complex<double>(expected[e], expected[e + 1])));
                     }
                 apply_phase(N, d0, count, tables.data(), sign, x.data());
                 assert_memory_equal(x.data(), expected.data(), sizeof(double) * x.size());
             }
         std::printf("N = %3d: phase to the bit; against exp(i phi) - 1: %.1e\n", N, worst);
+        assert_true(worst < 1e-15);
+    }
+}
+
+// Row runs: every direction's runs hold one of each conjugate pair of lines
+// c != 0 (M lines), the Row directions' runs are the LineBlocks, and the
+// other directions' runs are long enough (at least kMinRun lines in a cycle)
+// where row_runs gives any. gather_run reads element s of line i at (row +
+// s k1, column + i + s k2) and scatter_run adds the increments there and
+// writes the conjugates at the mirror modes, touching nothing else. Sizes with
+// cycles L = N / gcd(k1, N) of 25 and 15 (75), 35, 21 and 15 (105: General
+// directions), 25 (125), and 15 and 5 (135: Column blocks remain).
+const int kRunSizes[] = {75, 105, 125, 135};
+
+void test_row_runs_follow_the_lines(void **) {
+    Random random{11};
+    for (int N : kRunSizes) {
+        const LineBlocks blocks(N);
+        int streamed = 0, kept = 0;
+        for (const Direction &D : projective_line(N)) {
+            const std::vector<RowRun> runs = row_runs(D, N);
+            if (runs.empty()) {
+                ++kept;
+                assert_true(N / std::gcd(D.k1, N) < kMinRun);
+                continue;
+            }
+            if (D.k1 == 1) {
+                assert_int_equal(runs.size(), blocks.count());
+                for (int b = 0; b < blocks.count(); ++b) {
+                    assert_int_equal(runs[b].row, 0);
+                    assert_int_equal(runs[b].column, blocks.first_line(b));
+                    assert_int_equal(runs[b].count, blocks.lines(b));
+                }
+            } else {
+                ++streamed;
+            }
+            std::vector<char> line_seen(N, 0);
+            const std::vector<double> w = hermitian_field(N, random);
+            for (std::size_t r = 0; r < runs.size(); ++r) {
+                const RowRun &run = runs[r];
+                assert_true(run.count >= 1 && run.count <= kBlock);
+                const int first_lane = static_cast<int>(r * N / runs.size());
+                std::vector<double> x(2 * static_cast<std::size_t>(N) * run.count);
+                gather_run(run, D.k2, N, first_lane, w.data(), x.data());
+                std::vector<double> increment(x.size()), expected = w;
+                std::vector<char> moved(static_cast<std::size_t>(N) * N, 0);
+                for (int i = 0; i < run.count; ++i) {
+                    // c = p x k of the line through p = (row, column + i)
+                    const long long c = (static_cast<long long>(run.row) * D.k2 -
+                                         static_cast<long long>(run.column + i) * D.k1) %
+                                        N;
+                    const int line = static_cast<int>(c < 0 ? c + N : c);
+                    assert_int_not_equal(line, 0);
+                    assert_int_equal(line_seen[line] + line_seen[(N - line) % N], 0);  // each pair once
+                    line_seen[line] = 1;
+                    for (int s = 0; s < N; ++s) {
+                        const long long a = run.row + static_cast<long long>(s) * D.k1,
+                                        b = run.column + i + static_cast<long long>(s) * D.k2;
+                        const std::size_t e = static_cast<std::size_t>(s) * run.count + i;
+                        const std::size_t m = mode_at(static_cast<int>(a % N), static_cast<int>(b % N), N);
+                        const std::size_t mirror =
+                            mode_at(static_cast<int>(-(a % N)), static_cast<int>(-(b % N)), N);
+                        assert_memory_equal(&x[2 * e], &w[2 * m], 2 * sizeof(double));
+                        increment[2 * e] = random.next();
+                        increment[2 * e + 1] = random.next();
+                        expected[2 * m] = w[2 * m] + increment[2 * e];
+                        expected[2 * m + 1] = w[2 * m + 1] + increment[2 * e + 1];
+                        expected[2 * mirror] = expected[2 * m];
+                        expected[2 * mirror + 1] = -expected[2 * m + 1];
+                        assert_int_equal(moved[m] + moved[mirror], 0);  // each mode once
+                        moved[m] = moved[mirror] = 1;
+                    }
+                }
+                std::vector<double> scattered = w;
+                scatter_run(run, D.k2, N, first_lane, increment.data(), scattered.data());
+                assert_memory_equal(scattered.data(), expected.data(), sizeof(double) * w.size());
+            }
+            int lines = 0;
+            for (char seen : line_seen) lines += seen;
+            assert_int_equal(lines, blocks.M);
+        }
+        std::printf(
+            "N = %3d: %3d directions in row runs besides the Row ones, %2d in Column or General blocks\n", N,
+            streamed, kept);
+        assert_true(streamed > 0);
+    }
+}
+
+// apply_phase_lines multiplies line i, of any c = -offsets[i], by the same
+// written-out arithmetic of (e - 1) / N to the bit, on tables in order of l,
+// and that is (exp(t Lambda_l) - 1) / N with exp(t Lambda_l) = u_{l-c}
+// conj(u_{l+c}) from std::polar.
+void test_phase_lines_any_c(void **) {
+    Random random{5};
+    for (int N : kPhaseSizes) {
+        std::vector<double> spectrum(2 * static_cast<std::size_t>(N));
+        for (double &b : spectrum) b = random.next();
+        const double factor = 0.9;
+        std::vector<double> tables(phase_table_doubles(N));
+        for (int l = 0; l < N; ++l) write_phase(N, l, factor, spectrum.data(), tables.data(), false);
+        std::vector<std::complex<double>> v(N), u(N);
+        for (int j = 0; j < N; ++j) {
+            const double phi = factor * spectrum[2 * j], half = std::sin(0.5 * phi);
+            v[j] = {-2.0 * half * half, std::sin(phi)};
+            u[j] = std::polar(1.0, phi);
+        }
+        double worst = 0.0;
+        for (int count : {1, 5, kBlock}) {
+            int offsets[kBlock];
+            for (int i = 0; i < count; ++i)  // c of every kind: 0, and spread over Z_N
+                offsets[i] = i == 0 ? 0 : static_cast<int>((random.next() + 1.0) * 0.5 * N) % N;
+            std::vector<double> x(2 * static_cast<std::size_t>(N) * count);
+            for (double &z : x) z = random.next();
+            std::vector<double> expected(x.size());
+            for (int l = 0; l < N; ++l)
+                for (int i = 0; i < count; ++i) {
+                    const int d = offsets[i];
+                    const std::size_t e = 2 * (static_cast<std::size_t>(l) * count + i);
+                    const std::complex<double> p = v[(l + d) % N], q = v[(l - d + N) % N];
+                    const double n = N, pr = p.real() / n, pi = p.imag() / n, Qr = q.real() / n,
+                                 Qi = q.imag() / n, qr = q.real(), qi = q.imag();
+                    const double er = (pr + Qr) + (pr * qr + pi * qi);
+                    const double ei = ((pi - Qi) + (pi * qr - pr * qi)) * 1.0;
+                    const double zr = x[e], zi = x[e + 1];
+                    expected[e] = er * zr - ei * zi;
+                    expected[e + 1] = er * zi + ei * zr;
+                    const int c = (N - d) % N;
+                    const std::complex<double> exact = u[(l - c + N) % N] * std::conj(u[(l + c) % N]);
+                    const std::complex<double> reference = (exact - 1.0) / n * std::complex<double>(zr, zi);
+                    worst = std::max(
+                        worst, std::abs(reference - std::complex<double>(expected[e], expected[e + 1])));
+                }
+            apply_phase_lines(N, offsets, count, tables.data(), x.data());
+            assert_memory_equal(x.data(), expected.data(), sizeof(double) * x.size());
+        }
+        std::printf("N = %3d: phase of any c to the bit; against exp(i phi) - 1: %.1e\n", N, worst);
         assert_true(worst < 1e-15);
     }
 }
@@ -151,6 +290,8 @@ int main() {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gather_scatter_follow_the_lines),
         cmocka_unit_test(test_phase_is_the_complex_arithmetic),
+        cmocka_unit_test(test_row_runs_follow_the_lines),
+        cmocka_unit_test(test_phase_lines_any_c),
     };
     return lpi_run_tests(tests);
 }

@@ -78,25 +78,62 @@ inline void store_pair(double *low, double *high, const Complex2 &v) {
 // o = s m + d0 (slope m = k2, or k1), and its conjugate mirror at position
 // -(o + i) mod N of lane -s. Rows: lane s starts at s N and positions step by
 // 1; columns: lane s starts at s and positions step by N.
-// Calls f(s, o) for the N lanes, from first_lane on, cyclically.
+// Calls f(s, lane, o) (lane = s) for the N lanes, from first_lane on,
+// cyclically.
 template <class F>
 inline void for_each_lane(int N, int slope, int d0, int first_lane, F &&f) {
     int o = modulo(d0 + static_cast<std::int64_t>(first_lane) * slope, N);
     for (int k = 0, s = first_lane; k < N; ++k, s = s + 1 < N ? s + 1 : 0) {
-        f(s, o);
+        f(s, s, o);
         o += slope;
         if (o >= N) o -= N;
     }
 }
 
+// A RowRun's element s lies in row run.row + s k1, at position run.column +
+// s k2 of it. Calls f(s, row, o) for the N elements row by row, rows in
+// increasing order (cyclically, from row run.row + (first_lane / g) g on):
+// row run.row + q g holds the g elements s = q v + j L (mod N), j = 0 ..
+// g-1 (run.classes = g, run.cycle = L, run.step = v), called one after
+// another, so that consecutive rows are g rows apart, a stride the hardware
+// prefetchers follow (s in order would jump k1 rows at a time). For Row
+// directions (g = 1, v = 1) this is for_each_lane, which is called instead.
+template <class F>
+inline void for_each_run_lane(int N, const RowRun &run, int k2, int first_lane, F &&f) {
+    const int g = run.classes, L = run.cycle;
+    const int q0 = first_lane / g;
+    int s = static_cast<int>(static_cast<std::int64_t>(q0) * run.step % L);
+    int o = modulo(run.column + static_cast<std::int64_t>(s) * k2, N);
+    const int row_slope = modulo(static_cast<std::int64_t>(run.step) * k2, N);  // o per row
+    const int wrap_slope = modulo(static_cast<std::int64_t>(L) * k2, N);        // o per L in s
+    for (int k = 0, q = q0; k < L; ++k, q = q + 1 < L ? q + 1 : 0) {
+        const int row = run.row + q * g;
+        for (int j = 0, sj = s, oj = o; j < g; ++j) {
+            f(sj, row, oj);
+            sj += L;
+            oj += wrap_slope;
+            if (oj >= N) oj -= N;
+        }
+        s += run.step;
+        o += row_slope;
+        if (o >= N) o -= N;
+        if (s >= L) {
+            s -= L;
+            o -= wrap_slope;
+            if (o < 0) o += N;
+        }
+    }
+}
+
 // Count > 0: the block size, known at compile time (full blocks); 0: count.
-template <bool Rows, int Count>
-inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
-                        const double *__restrict w, double *__restrict x) {
-    const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
+// Lanes: calls its argument f(s, lane, o) for every element (for_each_lane,
+// for_each_run_lane).
+template <bool Rows, int Count, class Lanes>
+inline void gather_runs(int N, int count, Lanes &&lanes, const double *__restrict w, double *__restrict x) {
+    const std::size_t lane_length = Rows ? N : 1, step = Rows ? 1 : N;
     const int n = Count > 0 ? Count : count;
-    for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
-        const double *src = w + 2 * lane * s;
+    lanes([&](int s, int lane, int o) {
+        const double *src = w + 2 * lane_length * lane;
         double *dst = x + 2 * static_cast<std::size_t>(s) * n;
         const int first = o <= N - n ? n : N - o;  // the run wraps at most once
         for (int i = 0; i < first; ++i) {
@@ -143,14 +180,14 @@ inline void put_run(int N, int p0, int n, const double *__restrict increment, do
     }
 }
 
-template <bool Rows, int Count>
-inline void scatter_runs(int N, int slope, int d0, int count, int first_lane,
-                         const double *__restrict x, double *w) {
-    const std::size_t lane = Rows ? N : 1;
+template <bool Rows, int Count, class Lanes>
+inline void scatter_runs(int N, int count, Lanes &&lanes, const double *__restrict x, double *w) {
+    const std::size_t lane_length = Rows ? N : 1;
     const int n = Count > 0 ? Count : count;
-    for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
+    lanes([&](int s, int lane, int o) {
         const double *src = x + 2 * static_cast<std::size_t>(s) * n;
-        double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
+        double *dst = w + 2 * lane_length * lane,
+               *mirror = w + 2 * lane_length * static_cast<std::size_t>(lane == 0 ? 0 : N - lane);
         if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
             put_run<Rows>(N, o, n, src, dst, mirror);
         } else {
@@ -213,14 +250,16 @@ inline void scatter_general(const Direction &D, int N, int d0, int count, const 
 LPI_SIMD_CLONES
 void gather_block(const Direction &D, int N, int d0, int count, int first_lane, const double *w,
                   double *x) {
+    const int slope = D.layout == Direction::Row ? D.k2 : D.k1;
+    auto lanes = [&](auto &&f) { for_each_lane(N, slope, d0, first_lane, f); };
     switch (D.layout) {
         case Direction::Row:
-            if (count == kBlock) gather_runs<true, kBlock>(N, D.k2, d0, count, first_lane, w, x);
-            else gather_runs<true, 0>(N, D.k2, d0, count, first_lane, w, x);
+            if (count == kBlock) gather_runs<true, kBlock>(N, count, lanes, w, x);
+            else gather_runs<true, 0>(N, count, lanes, w, x);
             break;
         case Direction::Column:
-            if (count == kBlock) gather_runs<false, kBlock>(N, D.k1, d0, count, first_lane, w, x);
-            else gather_runs<false, 0>(N, D.k1, d0, count, first_lane, w, x);
+            if (count == kBlock) gather_runs<false, kBlock>(N, count, lanes, w, x);
+            else gather_runs<false, 0>(N, count, lanes, w, x);
             break;
         case Direction::General: gather_general(D, N, d0, count, w, x); break;
     }
@@ -229,17 +268,39 @@ void gather_block(const Direction &D, int N, int d0, int count, int first_lane, 
 LPI_SIMD_CLONES
 void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
                    double *w) {
+    const int slope = D.layout == Direction::Row ? D.k2 : D.k1;
+    auto lanes = [&](auto &&f) { for_each_lane(N, slope, d0, first_lane, f); };
     switch (D.layout) {
         case Direction::Row:
-            if (count == kBlock) scatter_runs<true, kBlock>(N, D.k2, d0, count, first_lane, x, w);
-            else scatter_runs<true, 0>(N, D.k2, d0, count, first_lane, x, w);
+            if (count == kBlock) scatter_runs<true, kBlock>(N, count, lanes, x, w);
+            else scatter_runs<true, 0>(N, count, lanes, x, w);
             break;
         case Direction::Column:
-            if (count == kBlock) scatter_runs<false, kBlock>(N, D.k1, d0, count, first_lane, x, w);
-            else scatter_runs<false, 0>(N, D.k1, d0, count, first_lane, x, w);
+            if (count == kBlock) scatter_runs<false, kBlock>(N, count, lanes, x, w);
+            else scatter_runs<false, 0>(N, count, lanes, x, w);
             break;
         case Direction::General: scatter_general(D, N, d0, count, x, w); break;
     }
+}
+
+LPI_SIMD_CLONES
+void gather_run(const RowRun &run, int k2, int N, int first_lane, const double *w, double *x) {
+    auto lanes = [&](auto &&f) { for_each_run_lane(N, run, k2, first_lane, f); };
+    auto rows = [&](auto &&f) { for_each_lane(N, k2, run.column, first_lane, f); };
+    if (run.classes == 1 && run.count == kBlock) gather_runs<true, kBlock>(N, run.count, rows, w, x);
+    else if (run.classes == 1) gather_runs<true, 0>(N, run.count, rows, w, x);
+    else if (run.count == kBlock) gather_runs<true, kBlock>(N, run.count, lanes, w, x);
+    else gather_runs<true, 0>(N, run.count, lanes, w, x);
+}
+
+LPI_SIMD_CLONES
+void scatter_run(const RowRun &run, int k2, int N, int first_lane, const double *x, double *w) {
+    auto lanes = [&](auto &&f) { for_each_run_lane(N, run, k2, first_lane, f); };
+    auto rows = [&](auto &&f) { for_each_lane(N, k2, run.column, first_lane, f); };
+    if (run.classes == 1 && run.count == kBlock) scatter_runs<true, kBlock>(N, run.count, rows, x, w);
+    else if (run.classes == 1) scatter_runs<true, 0>(N, run.count, rows, x, w);
+    else if (run.count == kBlock) scatter_runs<true, kBlock>(N, run.count, lanes, x, w);
+    else scatter_runs<true, 0>(N, run.count, lanes, x, w);
 }
 
 // Line i of the block (d = d0 + i) has c = sigma d, so exp(t Lambda_l) =
@@ -307,6 +368,39 @@ void apply_phase(int N, int d0, int count, const double *tables, double sign, do
                                                 tables + 3 * array, tables + 4 * array, tables + 5 * array};
     if (count == kBlock) phase_rows<kBlock>(N, d0, count, arrays, sign, x);
     else phase_rows<0>(N, d0, count, arrays, sign, x);
+}
+
+// Line by line, four rows l at a time: line i (d = offsets[i] = -c) reads
+// P_{l+d} at entry l + d and (Q, q)_{l-d} at entry N + l - d of tables
+// written in order of l (write_phase with mirrored = false), both running
+// forwards along the line, so that no two lines need neighbouring c. The
+// arithmetic is phase_product's, with sign +1: exp(t Lambda_l) =
+// u_{l-c} conj(u_{l+c}) = u_{l+d} conj(u_{l-d}).
+LPI_SIMD_CLONES
+void apply_phase_lines(int N, const int *offsets, int count, const double *tables, double *x) {
+    const std::size_t array = 2 * static_cast<std::size_t>(N);
+    const double *const arrays[kPhaseArrays] = {tables,             tables + array,     tables + 2 * array,
+                                                tables + 3 * array, tables + 4 * array, tables + 5 * array};
+    const std::size_t n = count, rows = N, fours = rows / 4 * 4, row = 2 * n;
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t d = static_cast<std::size_t>(offsets[i]);
+        double *z = x + 2 * i;
+        for (std::size_t l = 0; l < fours; l += 4) {
+            double *z0 = z + l * row;
+            const Complex2 z02 = load_pair(z0, z0 + 2 * row), z13 = load_pair(z0 + row, z0 + 3 * row);
+            Complex2 zr = even_parts(z02, z13), zi = odd_parts(z02, z13);
+            phase_product(arrays, l + d, rows + l - d, 1.0, zr, zi);
+            store_pair(z0, z0 + 2 * row, even_parts(zr, zi));
+            store_pair(z0 + row, z0 + 3 * row, odd_parts(zr, zi));
+        }
+        for (std::size_t l = fours; l < rows; ++l) {
+            double *zl = z + l * row;
+            double zr = zl[0], zi = zl[1];
+            phase_product(arrays, l + d, rows + l - d, 1.0, zr, zi);
+            zl[0] = zr;
+            zl[1] = zi;
+        }
+    }
 }
 
 }  // namespace sine_euler
