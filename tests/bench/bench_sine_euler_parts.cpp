@@ -96,14 +96,9 @@ void measure(int N) {
                 const int count = run ? run->count : blocks.lines(block);
                 const int d0 = blocks.first_line(block);
                 const int first_lane = run ? block * N / count_of_blocks : blocks.first_lane(block);
-                int offsets[kBlock];  // d = -c of each line of a row run (as the model
-                                      // forms them)
+                int lines[kBlock];  // the lines of a row run, as the model forms them
                 if (run)
-                    for (int i = 0; i < count; ++i)
-                        offsets[i] = modulo(static_cast<std::int64_t>(i) * D.k1 -
-                                                (static_cast<std::int64_t>(run->row) * D.k2 -
-                                                 static_cast<std::int64_t>(run->column) * D.k1),
-                                            N);
+                    for (int i = 0; i < count; ++i) lines[i] = run_line(D, *run, i, N);
                 clock = Clock::now();
                 if (run)
                     gather_run(*run, D.k2, N, first_lane, w.data(), x);
@@ -117,7 +112,7 @@ void measure(int N) {
                 else if (D.k1 == 1)
                     apply_phase(N, run->column, count, T.phase(), 1.0, x);
                 else
-                    apply_phase_lines(N, offsets, count, T.phase(), x);
+                    apply_phase_lines(N, lines, count, T.phase(), -D.sigma, x);
                 sum[Phase] += seconds_since(clock);
                 T.backward(count, x);
                 sum[Transforms] += seconds_since(clock);

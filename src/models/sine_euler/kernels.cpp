@@ -78,13 +78,12 @@ inline void store_pair(double *low, double *high, const Complex2 &v) {
 // o = s m + d0 (slope m = k2, or k1), and its conjugate mirror at position
 // -(o + i) mod N of lane -s. Rows: lane s starts at s N and positions step by
 // 1; columns: lane s starts at s and positions step by N.
-// Calls f(s, lane, o) (lane = s) for the N lanes, from first_lane on,
-// cyclically.
+// Calls f(s, o) for the N lanes, from first_lane on, cyclically.
 template <class F>
 inline void for_each_lane(int N, int slope, int d0, int first_lane, F &&f) {
     int o = modulo(d0 + static_cast<std::int64_t>(first_lane) * slope, N);
     for (int k = 0, s = first_lane; k < N; ++k, s = s + 1 < N ? s + 1 : 0) {
-        f(s, s, o);
+        f(s, o);
         o += slope;
         if (o >= N) o -= N;
     }
@@ -126,14 +125,13 @@ inline void for_each_run_lane(int N, const RowRun &run, int k2, int first_lane, 
 }
 
 // Count > 0: the block size, known at compile time (full blocks); 0: count.
-// Lanes: calls its argument f(s, lane, o) for every element (for_each_lane,
-// for_each_run_lane).
-template <bool Rows, int Count, class Lanes>
-inline void gather_runs(int N, int count, Lanes &&lanes, const double *__restrict w, double *__restrict x) {
-    const std::size_t lane_length = Rows ? N : 1, step = Rows ? 1 : N;
+template <bool Rows, int Count>
+inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
+                        const double *__restrict w, double *__restrict x) {
+    const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
     const int n = Count > 0 ? Count : count;
-    lanes([&](int s, int lane, int o) {
-        const double *src = w + 2 * lane_length * lane;
+    for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
+        const double *src = w + 2 * lane * s;
         double *dst = x + 2 * static_cast<std::size_t>(s) * n;
         const int first = o <= N - n ? n : N - o;  // the run wraps at most once
         for (int i = 0; i < first; ++i) {
@@ -180,14 +178,14 @@ inline void put_run(int N, int p0, int n, const double *__restrict increment, do
     }
 }
 
-template <bool Rows, int Count, class Lanes>
-inline void scatter_runs(int N, int count, Lanes &&lanes, const double *__restrict x, double *w) {
-    const std::size_t lane_length = Rows ? N : 1;
+template <bool Rows, int Count>
+inline void scatter_runs(int N, int slope, int d0, int count, int first_lane,
+                         const double *__restrict x, double *w) {
+    const std::size_t lane = Rows ? N : 1;
     const int n = Count > 0 ? Count : count;
-    lanes([&](int s, int lane, int o) {
+    for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
         const double *src = x + 2 * static_cast<std::size_t>(s) * n;
-        double *dst = w + 2 * lane_length * lane,
-               *mirror = w + 2 * lane_length * static_cast<std::size_t>(lane == 0 ? 0 : N - lane);
+        double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
         if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
             put_run<Rows>(N, o, n, src, dst, mirror);
         } else {
@@ -250,16 +248,14 @@ inline void scatter_general(const Direction &D, int N, int d0, int count, const 
 LPI_SIMD_CLONES
 void gather_block(const Direction &D, int N, int d0, int count, int first_lane, const double *w,
                   double *x) {
-    const int slope = D.layout == Direction::Row ? D.k2 : D.k1;
-    auto lanes = [&](auto &&f) { for_each_lane(N, slope, d0, first_lane, f); };
     switch (D.layout) {
         case Direction::Row:
-            if (count == kBlock) gather_runs<true, kBlock>(N, count, lanes, w, x);
-            else gather_runs<true, 0>(N, count, lanes, w, x);
+            if (count == kBlock) gather_runs<true, kBlock>(N, D.k2, d0, count, first_lane, w, x);
+            else gather_runs<true, 0>(N, D.k2, d0, count, first_lane, w, x);
             break;
         case Direction::Column:
-            if (count == kBlock) gather_runs<false, kBlock>(N, count, lanes, w, x);
-            else gather_runs<false, 0>(N, count, lanes, w, x);
+            if (count == kBlock) gather_runs<false, kBlock>(N, D.k1, d0, count, first_lane, w, x);
+            else gather_runs<false, 0>(N, D.k1, d0, count, first_lane, w, x);
             break;
         case Direction::General: gather_general(D, N, d0, count, w, x); break;
     }
@@ -268,39 +264,73 @@ void gather_block(const Direction &D, int N, int d0, int count, int first_lane, 
 LPI_SIMD_CLONES
 void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
                    double *w) {
-    const int slope = D.layout == Direction::Row ? D.k2 : D.k1;
-    auto lanes = [&](auto &&f) { for_each_lane(N, slope, d0, first_lane, f); };
     switch (D.layout) {
         case Direction::Row:
-            if (count == kBlock) scatter_runs<true, kBlock>(N, count, lanes, x, w);
-            else scatter_runs<true, 0>(N, count, lanes, x, w);
+            if (count == kBlock) scatter_runs<true, kBlock>(N, D.k2, d0, count, first_lane, x, w);
+            else scatter_runs<true, 0>(N, D.k2, d0, count, first_lane, x, w);
             break;
         case Direction::Column:
-            if (count == kBlock) scatter_runs<false, kBlock>(N, count, lanes, x, w);
-            else scatter_runs<false, 0>(N, count, lanes, x, w);
+            if (count == kBlock) scatter_runs<false, kBlock>(N, D.k1, d0, count, first_lane, x, w);
+            else scatter_runs<false, 0>(N, D.k1, d0, count, first_lane, x, w);
             break;
         case Direction::General: scatter_general(D, N, d0, count, x, w); break;
     }
 }
 
+// ---- Row runs of the other directions ----------------------------------------
+// At each point of the walk (for_each_run_lane: element t, row r, position o
+// of line 0) the run's lines lie at positions o .. o+count-1 of row r and
+// their mirrors at the negated positions of row -r. Line i goes to row
+// s = t + shift + i shift_step of the block, or, mirrored, is read from the
+// mirror and goes to row -s (see RowRun). Calls f(i, point, mirror, row):
+// the entries of the mode its line holds there, of its conjugate, and of
+// its row in the block.
+template <class F>
+inline void for_each_run_point(int N, const RowRun &run, int k2, int first_lane, F &&f) {
+    const std::size_t lane = 2 * static_cast<std::size_t>(N);
+    for_each_run_lane(N, run, k2, first_lane, [&](int t, int r, int o) {
+        const std::size_t here = lane * r, there = lane * static_cast<std::size_t>(r == 0 ? 0 : N - r);
+        int s = t + run.shift, p = o;
+        if (s >= N) s -= N;
+        for (int i = 0; i < run.count; ++i) {
+            const std::size_t point = here + 2 * static_cast<std::size_t>(p);
+            const std::size_t mirror = there + 2 * static_cast<std::size_t>(p == 0 ? 0 : N - p);
+            const int row = s == 0 || !(run.mirrored >> i & 1u) ? s : N - s;
+            if (run.mirrored >> i & 1u) f(i, mirror, point, row);
+            else f(i, point, mirror, row);
+            if (++p == N) p = 0;
+            s += run.shift_step;
+            if (s >= N) s -= N;
+        }
+    });
+}
+
 LPI_SIMD_CLONES
 void gather_run(const RowRun &run, int k2, int N, int first_lane, const double *w, double *x) {
-    auto lanes = [&](auto &&f) { for_each_run_lane(N, run, k2, first_lane, f); };
-    auto rows = [&](auto &&f) { for_each_lane(N, k2, run.column, first_lane, f); };
-    if (run.classes == 1 && run.count == kBlock) gather_runs<true, kBlock>(N, run.count, rows, w, x);
-    else if (run.classes == 1) gather_runs<true, 0>(N, run.count, rows, w, x);
-    else if (run.count == kBlock) gather_runs<true, kBlock>(N, run.count, lanes, w, x);
-    else gather_runs<true, 0>(N, run.count, lanes, w, x);
+    if (run.shift_step != 0) {
+        const std::size_t n = run.count;
+        for_each_run_point(N, run, k2, first_lane, [&](int i, std::size_t mode, std::size_t, int row) {
+            store(x + 2 * (row * n + i), load<Complex1>(w + mode));
+        });
+        return;
+    }
+    if (run.count == kBlock) gather_runs<true, kBlock>(N, k2, run.column, run.count, first_lane, w, x);
+    else gather_runs<true, 0>(N, k2, run.column, run.count, first_lane, w, x);
 }
 
 LPI_SIMD_CLONES
 void scatter_run(const RowRun &run, int k2, int N, int first_lane, const double *x, double *w) {
-    auto lanes = [&](auto &&f) { for_each_run_lane(N, run, k2, first_lane, f); };
-    auto rows = [&](auto &&f) { for_each_lane(N, k2, run.column, first_lane, f); };
-    if (run.classes == 1 && run.count == kBlock) scatter_runs<true, kBlock>(N, run.count, rows, x, w);
-    else if (run.classes == 1) scatter_runs<true, 0>(N, run.count, rows, x, w);
-    else if (run.count == kBlock) scatter_runs<true, kBlock>(N, run.count, lanes, x, w);
-    else scatter_runs<true, 0>(N, run.count, lanes, x, w);
+    if (run.shift_step != 0) {
+        const std::size_t n = run.count;
+        for_each_run_point(N, run, k2, first_lane, [&](int i, std::size_t mode, std::size_t mirror, int row) {
+            const Complex1 sum = load<Complex1>(w + mode) + load<Complex1>(x + 2 * (row * n + i));
+            store(w + mode, sum);
+            store(w + mirror, sum * Complex1{1.0, -1.0});
+        });
+        return;
+    }
+    if (run.count == kBlock) scatter_runs<true, kBlock>(N, k2, run.column, run.count, first_lane, x, w);
+    else scatter_runs<true, 0>(N, k2, run.column, run.count, first_lane, x, w);
 }
 
 // Line i of the block (d = d0 + i) has c = sigma d, so exp(t Lambda_l) =
@@ -370,14 +400,13 @@ void apply_phase(int N, int d0, int count, const double *tables, double sign, do
     else phase_rows<0>(N, d0, count, arrays, sign, x);
 }
 
-// Line by line, four rows l at a time: line i (d = offsets[i] = -c) reads
+// Line by line, four rows l at a time: line i (d = offsets[i]) reads
 // P_{l+d} at entry l + d and (Q, q)_{l-d} at entry N + l - d of tables
 // written in order of l (write_phase with mirrored = false), both running
-// forwards along the line, so that no two lines need neighbouring c. The
-// arithmetic is phase_product's, with sign +1: exp(t Lambda_l) =
-// u_{l-c} conj(u_{l+c}) = u_{l+d} conj(u_{l-d}).
+// forwards along the line, so that no two lines need neighbouring d. The
+// values and the arithmetic are phase_rows' for the same d and sign.
 LPI_SIMD_CLONES
-void apply_phase_lines(int N, const int *offsets, int count, const double *tables, double *x) {
+void apply_phase_lines(int N, const int *offsets, int count, const double *tables, double sign, double *x) {
     const std::size_t array = 2 * static_cast<std::size_t>(N);
     const double *const arrays[kPhaseArrays] = {tables,             tables + array,     tables + 2 * array,
                                                 tables + 3 * array, tables + 4 * array, tables + 5 * array};
@@ -389,14 +418,14 @@ void apply_phase_lines(int N, const int *offsets, int count, const double *table
             double *z0 = z + l * row;
             const Complex2 z02 = load_pair(z0, z0 + 2 * row), z13 = load_pair(z0 + row, z0 + 3 * row);
             Complex2 zr = even_parts(z02, z13), zi = odd_parts(z02, z13);
-            phase_product(arrays, l + d, rows + l - d, 1.0, zr, zi);
+            phase_product(arrays, l + d, rows + l - d, sign, zr, zi);
             store_pair(z0, z0 + 2 * row, even_parts(zr, zi));
             store_pair(z0 + row, z0 + 3 * row, odd_parts(zr, zi));
         }
         for (std::size_t l = fours; l < rows; ++l) {
             double *zl = z + l * row;
             double zr = zl[0], zi = zl[1];
-            phase_product(arrays, l + d, rows + l - d, 1.0, zr, zi);
+            phase_product(arrays, l + d, rows + l - d, sign, zr, zi);
             zl[0] = zr;
             zl[1] = zi;
         }

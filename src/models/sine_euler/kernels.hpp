@@ -39,9 +39,9 @@ inline std::size_t phase_table_doubles(int N) { return 2 * static_cast<std::size
 // d0+count-1) by the line flows' increments (exp(t Lambda_l) - 1) / N read
 // from the phase tables (see the definition).
 void apply_phase(int N, int d0, int count, const double *tables, double sign, double *x);
-// The same for lines of any c: line i has d = offsets[i] = -c mod N, and the
-// tables are written with mirrored = false.
-void apply_phase_lines(int N, const int *offsets, int count, const double *tables, double *x);
+// The same for lines d = offsets[i] in any order, on tables written with
+// mirrored = false: line i as apply_phase treats line d, to the bit.
+void apply_phase_lines(int N, const int *offsets, int count, const double *tables, double sign, double *x);
 
 // v_l = u_l - 1 = exp(i phi_l) - 1 = (-2 sin^2(phi_l / 2), sin phi_l), phi_l =
 // factor B_l (B: the transformed line spectrum, factor = t / (2 eps)), as

@@ -215,9 +215,9 @@ void SineEuler::move_block(const Direction &D, int block, double *x, double *w) 
     scatter_block(D, N_, d0, count, first_lane, x, w);
 }
 
-// The same for block `block` of D's row runs. Row directions (k1 = 1) have
-// c = -d for d = column + i, consecutive: apply_phase. The others have
-// c = c0 - i k1: apply_phase_lines, on tables in order of l.
+// The same for block `block` of D's row runs. Row directions (k1 = 1) move
+// lines d = column + i, consecutive: apply_phase. The others move the lines
+// run_line gives: apply_phase_lines, on tables in order of l.
 void SineEuler::move_run(const Direction &D, const std::vector<RowRun> &runs, int block, double *x,
                          double *w) {
     const RowRun &run = runs[static_cast<std::size_t>(block)];
@@ -228,11 +228,9 @@ void SineEuler::move_run(const Direction &D, const std::vector<RowRun> &runs, in
     if (D.k1 == 1) {
         apply_phase(N_, run.column, run.count, transforms_->phase(), 1.0, x);
     } else {
-        int offsets[kBlock];
-        const std::int64_t c0 =
-            static_cast<std::int64_t>(run.row) * D.k2 - static_cast<std::int64_t>(run.column) * D.k1;
-        for (int i = 0; i < run.count; ++i) offsets[i] = modulo(static_cast<std::int64_t>(i) * D.k1 - c0, N_);
-        apply_phase_lines(N_, offsets, run.count, transforms_->phase(), x);
+        int lines[kBlock];
+        for (int i = 0; i < run.count; ++i) lines[i] = run_line(D, run, i, N_);
+        apply_phase_lines(N_, lines, run.count, transforms_->phase(), -D.sigma, x);
     }
     transforms_->backward(run.count, x);
     scatter_run(run, D.k2, N_, first_lane, x, w);

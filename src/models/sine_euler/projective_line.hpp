@@ -80,17 +80,32 @@ struct LineBlocks {
 };
 
 // A block of parallel lines of a direction k laid so that it streams: line
-// i (0 <= i < count) is {(row, column + i) + t k}, and its element t lies at
+// i (0 <= i < count) is {(row, column + i) + t k}, and the point at t lies at
 // row row + t k1, column column + i + t k2 (mod N). At every t the block's
-// elements are one run of consecutive columns of one row, whatever k is;
-// line i has c = c0 - i k1, c0 = row k2 - column k1.
+// points are one run of consecutive columns of one row, whatever k is; line
+// i has c = c0 - i k1, c0 = row k2 - column k1.
 struct RowRun {
     int row, column, count;
     // g = gcd(k1, N), L = N / g and v = (k1 / g)^-1 mod L: row row + q g
-    // holds elements s = q v (mod L) of every line (the kernels walk the
+    // holds the points t = q v (mod L) of every line (the kernels walk the
     // rows in order).
     int classes, cycle, step;
+    // Where the transforms take each value, so that every line meets the
+    // same arithmetic, and gives the same bits, as in the Column and General
+    // blocks (and on MPI): D's own lines d j + s k, d = 1 .. M. Line i of the
+    // run is line d = c of them (sigma = 1), its point at t element s = t +
+    // shift + i shift_step (mod N) (shift = j x (row, column), shift_step =
+    // j1); or, bit i of `mirrored` set, where c > M, the conjugate of line
+    // d = N - c, whose element -s lies at the mirror of that point, where it
+    // is read and written. All 0 for Row directions (their runs are their
+    // blocks).
+    int shift, shift_step;
+    unsigned mirrored;
 };
+
+// The line d (1 .. M) of D's own parametrization that line i of the run
+// moves: d = sigma c, or, mirrored, N - sigma c (see RowRun).
+int run_line(const Direction &D, const RowRun &run, int i, int N);
 
 // Runs shorter than this go by the Column or General layout instead.
 constexpr int kMinRun = 8;
