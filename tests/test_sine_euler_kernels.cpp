@@ -11,7 +11,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <numeric>
 #include <vector>
 
 #include "lpi_config.h"
@@ -53,35 +52,6 @@ std::vector<double> hermitian_field(int N, Random &random) {
 
 const int kGatherSizes[] = {15, 25, 35, 49, 75};
 
-// A block gathered into x (count lines), and what scattering increments
-// into it must give.
-struct Moves {
-    std::vector<double> increment, expected;
-    std::vector<char> moved;  // each mode once
-    Moves(const std::vector<double> &w, const std::vector<double> &x, int N)
-        : increment(x.size()), expected(w), moved(static_cast<std::size_t>(N) * N, 0) {}
-    // Checks that x[s * count + i] holds element s of line d of D (the mode
-    // at d j + s k) for every s, draws its increments, and records the sums
-    // there and their conjugates at the mirror modes.
-    void line(const Direction &D, int N, int d, int i, int count, const std::vector<double> &w,
-              const std::vector<double> &x, Random &random) {
-        for (int s = 0; s < N; ++s) {
-            const std::size_t e = static_cast<std::size_t>(s) * count + i;
-            const std::size_t m = mode_at(d * D.j1 + s * D.k1, d * D.j2 + s * D.k2, N);
-            const std::size_t mirror = mode_at(-(d * D.j1 + s * D.k1), -(d * D.j2 + s * D.k2), N);
-            assert_memory_equal(&x[2 * e], &w[2 * m], 2 * sizeof(double));
-            increment[2 * e] = random.next();
-            increment[2 * e + 1] = random.next();
-            expected[2 * m] = w[2 * m] + increment[2 * e];
-            expected[2 * m + 1] = w[2 * m + 1] + increment[2 * e + 1];
-            expected[2 * mirror] = expected[2 * m];
-            expected[2 * mirror + 1] = -expected[2 * m + 1];
-            assert_int_equal(moved[m] + moved[mirror], 0);
-            moved[m] = moved[mirror] = 1;
-        }
-    }
-};
-
 void test_gather_scatter_follow_the_lines(void **) {
     Random random{42};
     for (int N : kGatherSizes) {
@@ -94,11 +64,27 @@ void test_gather_scatter_follow_the_lines(void **) {
                 const std::vector<double> w = hermitian_field(N, random);
                 std::vector<double> x(2 * static_cast<std::size_t>(N) * count);
                 gather_block(D, N, d0, count, blocks.first_lane(b), w.data(), x.data());
-                Moves moves(w, x, N);
-                for (int i = 0; i < count; ++i) moves.line(D, N, d0 + i, i, count, w, x, random);
+                std::vector<double> increment(x.size()), expected = w;
+                std::vector<char> moved(static_cast<std::size_t>(N) * N, 0);
+                for (int s = 0; s < N; ++s)
+                    for (int i = 0; i < count; ++i) {
+                        const int d = d0 + i;
+                        const std::size_t e = static_cast<std::size_t>(s) * count + i;
+                        const std::size_t m = mode_at(d * D.j1 + s * D.k1, d * D.j2 + s * D.k2, N);
+                        const std::size_t mirror = mode_at(-(d * D.j1 + s * D.k1), -(d * D.j2 + s * D.k2), N);
+                        assert_memory_equal(&x[2 * e], &w[2 * m], 2 * sizeof(double));
+                        increment[2 * e] = random.next();
+                        increment[2 * e + 1] = random.next();
+                        expected[2 * m] = w[2 * m] + increment[2 * e];
+                        expected[2 * m + 1] = w[2 * m + 1] + increment[2 * e + 1];
+                        expected[2 * mirror] = expected[2 * m];
+                        expected[2 * mirror + 1] = -expected[2 * m + 1];
+                        assert_int_equal(moved[m] + moved[mirror], 0);  // each mode once
+                        moved[m] = moved[mirror] = 1;
+                    }
                 std::vector<double> scattered = w;
-                scatter_block(D, N, d0, count, blocks.first_lane(b), moves.increment.data(), scattered.data());
-                assert_memory_equal(scattered.data(), moves.expected.data(), sizeof(double) * w.size());
+                scatter_block(D, N, d0, count, blocks.first_lane(b), increment.data(), scattered.data());
+                assert_memory_equal(scattered.data(), expected.data(), sizeof(double) * w.size());
             }
         }
         std::printf("N = %2d: %3d Row, %3d Column, %3d General directions, %d blocks each\n", N,
@@ -148,10 +134,8 @@ void test_phase_is_the_complex_arithmetic(void **) {
                         // exp(t Lambda_l) = u_{l+d} conj(u_{l-d}), conjugated for sign = -1.
                         std::complex<double> exact = u[(l + d) % N] * std::conj(u[((l - d) % N + N) % N]);
                         if (sign < 0) exact = std::conj(exact);
-                        const std::complex<double> reference =
-                            (exact - 1.0) / n * std::complex<double>(zr, zi);
-                        worst = std::max(
-                            worst, std::abs(reference - std::complex<double>(expected[e], expected[e + 1])));
+                        const std::complex<double> reference = (exact - 1.0) / n * std::complex<double>(zr, zi);
+                        worst = std::max(worst, std::abs(reference - std::complex<double>(expected[e], expected[e + 1])));
                     }
                 apply_phase(N, d0, count, tables.data(), sign, x.data());
                 assert_memory_equal(x.data(), expected.data(), sizeof(double) * x.size());
@@ -161,135 +145,12 @@ void test_phase_is_the_complex_arithmetic(void **) {
     }
 }
 
-// Row runs: a direction's runs move each line d = 1 .. M once (run_line),
-// the Row directions' runs are the LineBlocks, and the other directions have
-// runs where their cycles of lines are long enough (L = N / gcd(k1, N) >=
-// kMinRun). gather_run puts element s of line d = run_line(i) (the mode at
-// d j + s k) at x[s * count + i], as gather_block does, so every line meets
-// the transforms with the same values wherever it was read from, and
-// scatter_run adds the increments there and writes the conjugates at the
-// mirror modes, touching nothing else. Sizes with cycles L of 25 and 15
-// (75), 35, 21 and 15 (105: General directions), 25 (125), and 15 and 5
-// (135: Column blocks remain).
-const int kRunSizes[] = {75, 105, 125, 135};
-
-void test_row_runs_follow_the_lines(void **) {
-    Random random{11};
-    for (int N : kRunSizes) {
-        const LineBlocks blocks(N);
-        int streamed = 0, kept = 0;
-        for (const Direction &D : projective_line(N)) {
-            const std::vector<RowRun> runs = row_runs(D, N);
-            if (runs.empty()) {
-                ++kept;
-                assert_true(N / std::gcd(D.k1, N) < kMinRun);
-                continue;
-            }
-            if (D.k1 == 1) {
-                assert_int_equal(runs.size(), blocks.count());
-                for (int b = 0; b < blocks.count(); ++b) {
-                    assert_int_equal(runs[b].row, 0);
-                    assert_int_equal(runs[b].column, blocks.first_line(b));
-                    assert_int_equal(runs[b].count, blocks.lines(b));
-                }
-            } else {
-                ++streamed;
-            }
-            std::vector<char> line_seen(N, 0);
-            const std::vector<double> w = hermitian_field(N, random);
-            for (std::size_t r = 0; r < runs.size(); ++r) {
-                const RowRun &run = runs[r];
-                assert_true(run.count >= 1 && run.count <= kBlock);
-                const int first_lane = static_cast<int>(r * N / runs.size());
-                std::vector<double> x(2 * static_cast<std::size_t>(N) * run.count);
-                gather_run(run, D.k2, N, first_lane, w.data(), x.data());
-                Moves moves(w, x, N);
-                for (int i = 0; i < run.count; ++i) {
-                    const int d = run_line(D, run, i, N);
-                    assert_true(d >= 1 && d <= blocks.M);
-                    assert_int_equal(line_seen[d], 0);
-                    line_seen[d] = 1;
-                    moves.line(D, N, d, i, run.count, w, x, random);
-                }
-                std::vector<double> scattered = w;
-                scatter_run(run, D.k2, N, first_lane, moves.increment.data(), scattered.data());
-                assert_memory_equal(scattered.data(), moves.expected.data(), sizeof(double) * w.size());
-            }
-            int lines = 0;
-            for (char seen : line_seen) lines += seen;
-            assert_int_equal(lines, blocks.M);
-        }
-        std::printf("N = %3d: %3d directions in row runs besides the Row ones, %2d in Column or General "
-                    "blocks\n",
-                    N, streamed, kept);
-        assert_true(streamed > 0);
-    }
-}
-
-// apply_phase_lines gives line i what apply_phase gives line d = lines[i],
-// for lines in any order: the same bits, from tables written in order of l.
-void test_phase_lines_as_phase_rows(void **) {
-    Random random{5};
-    for (int N : kPhaseSizes) {
-        const LineBlocks blocks(N);
-        std::vector<double> spectrum(2 * static_cast<std::size_t>(N));
-        for (double &b : spectrum) b = random.next();
-        const double factor = 0.9;
-        std::vector<double> mirrored(phase_table_doubles(N)), in_order(phase_table_doubles(N));
-        for (int l = 0; l < N; ++l) {
-            write_phase(N, l, factor, spectrum.data(), mirrored.data());
-            write_phase(N, l, factor, spectrum.data(), in_order.data(), false);
-        }
-        for (double sign : {-1.0, 1.0})
-            for (int b = 0; b < blocks.count(); ++b) {
-                const int d0 = blocks.first_line(b), count = blocks.lines(b);
-                std::vector<double> x(2 * static_cast<std::size_t>(N) * count);
-                for (double &z : x) z = random.next();
-                std::vector<double> expected = x;
-                apply_phase(N, d0, count, mirrored.data(), sign, expected.data());
-                // The block's lines taken one at a time, in reverse order.
-                for (int i = 0; i < count; ++i) {
-                    const int k = count - 1 - i, line = d0 + k;
-                    std::vector<double> column(2 * static_cast<std::size_t>(N));
-                    for (int l = 0; l < N; ++l) {
-                        column[2 * l] = x[2 * (static_cast<std::size_t>(l) * count + k)];
-                        column[2 * l + 1] = x[2 * (static_cast<std::size_t>(l) * count + k) + 1];
-                    }
-                    apply_phase_lines(N, &line, 1, in_order.data(), sign, column.data());
-                    for (int l = 0; l < N; ++l) {
-                        const std::size_t e = 2 * (static_cast<std::size_t>(l) * count + k);
-                        assert_memory_equal(&column[2 * l], &expected[e], 2 * sizeof(double));
-                    }
-                }
-                std::vector<int> reversed(count);
-                std::vector<double> y(x.size());
-                for (int i = 0; i < count; ++i) {
-                    reversed[i] = d0 + count - 1 - i;
-                    for (int l = 0; l < N; ++l)
-                        for (int part = 0; part < 2; ++part)
-                            y[2 * (static_cast<std::size_t>(l) * count + i) + part] =
-                                x[2 * (static_cast<std::size_t>(l) * count + count - 1 - i) + part];
-                }
-                apply_phase_lines(N, reversed.data(), count, in_order.data(), sign, y.data());
-                for (int i = 0; i < count; ++i)
-                    for (int l = 0; l < N; ++l) {
-                        const std::size_t row = static_cast<std::size_t>(l) * count;
-                        assert_memory_equal(&y[2 * (row + i)], &expected[2 * (row + count - 1 - i)],
-                                            2 * sizeof(double));
-                    }
-            }
-        std::printf("N = %3d: line by line, in any order, the bits of apply_phase\n", N);
-    }
-}
-
 }  // namespace
 
 int main() {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gather_scatter_follow_the_lines),
         cmocka_unit_test(test_phase_is_the_complex_arithmetic),
-        cmocka_unit_test(test_row_runs_follow_the_lines),
-        cmocka_unit_test(test_phase_lines_as_phase_rows),
     };
     return lpi_run_tests(tests);
 }

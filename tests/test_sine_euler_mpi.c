@@ -58,8 +58,8 @@ static void make_pair(int N, const char *method, lpi_system **spread, lpi_system
 static void test_matches_one_process(void **state) {
     (void)state;
     /* 5: M = 2 lines, fewer than the processes at P = 3 and 4 (some hold none).
-     * 27: one process lays the directions (3a, 1) in row runs (cycles of 9
-     * lines), which the spread system does not: the same bits all the same. */
+     * 27 = 3^3: nine of its 36 directions are Column directions, whose lines a
+     * process gathers down the columns of the mode array. */
     static const int orders[] = {5, 13, 15, 25, 27, 31};
     for (size_t k = 0; k < sizeof orders / sizeof orders[0]; ++k) {
         const int N = orders[k];

@@ -348,14 +348,14 @@ void SineEulerMpi::flow(std::size_t piece, double t, double *state) {
     if (!line_spectrum(state + mpi::line0_entry())) return;
     const double factor = t / (2.0 * eps_);
     double *slab = state + mpi::slab_entry(N_);
-    run_line_flows(*transforms_, N_, blocks_of(mine_), threads_, factor, true,
+    run_line_flows(*transforms_, N_, mine_, threads_, factor,
                    [&](int block, double *x) { move_block(D, block, x, slab); });
 }
 
 // The transforms of this process's lines alone; the slowest process's time.
 TransformTiming SineEulerMpi::time_transforms(std::size_t flows_per_step, std::int64_t steps) {
     const std::size_t flows = flow_count(flows_per_step, steps);
-    const double seconds = time_line_transforms(transforms(), N_, {block_counts(mine_)}, threads_, flows);
+    const double seconds = time_line_transforms(transforms(), N_, mine_, threads_, flows);
     const double per_step = static_cast<double>(steps);
     return {comm_->max(seconds) / per_step, static_cast<double>(flows) * (1.0 + 2.0 * lines_.M) / per_step};
 }

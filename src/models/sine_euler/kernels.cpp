@@ -89,41 +89,6 @@ inline void for_each_lane(int N, int slope, int d0, int first_lane, F &&f) {
     }
 }
 
-// A RowRun's element s lies in row run.row + s k1, at position run.column +
-// s k2 of it. Calls f(s, row, o) for the N elements row by row, rows in
-// increasing order (cyclically, from row run.row + (first_lane / g) g on):
-// row run.row + q g holds the g elements s = q v + j L (mod N), j = 0 ..
-// g-1 (run.classes = g, run.cycle = L, run.step = v), called one after
-// another, so that consecutive rows are g rows apart, a stride the hardware
-// prefetchers follow (s in order would jump k1 rows at a time). For Row
-// directions (g = 1, v = 1) this is for_each_lane, which is called instead.
-template <class F>
-inline void for_each_run_lane(int N, const RowRun &run, int k2, int first_lane, F &&f) {
-    const int g = run.classes, L = run.cycle;
-    const int q0 = first_lane / g;
-    int s = static_cast<int>(static_cast<std::int64_t>(q0) * run.step % L);
-    int o = modulo(run.column + static_cast<std::int64_t>(s) * k2, N);
-    const int row_slope = modulo(static_cast<std::int64_t>(run.step) * k2, N);  // o per row
-    const int wrap_slope = modulo(static_cast<std::int64_t>(L) * k2, N);        // o per L in s
-    for (int k = 0, q = q0; k < L; ++k, q = q + 1 < L ? q + 1 : 0) {
-        const int row = run.row + q * g;
-        for (int j = 0, sj = s, oj = o; j < g; ++j) {
-            f(sj, row, oj);
-            sj += L;
-            oj += wrap_slope;
-            if (oj >= N) oj -= N;
-        }
-        s += run.step;
-        o += row_slope;
-        if (o >= N) o -= N;
-        if (s >= L) {
-            s -= L;
-            o -= wrap_slope;
-            if (o < 0) o += N;
-        }
-    }
-}
-
 // Count > 0: the block size, known at compile time (full blocks); 0: count.
 template <bool Rows, int Count>
 inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
@@ -277,62 +242,6 @@ void scatter_block(const Direction &D, int N, int d0, int count, int first_lane,
     }
 }
 
-// ---- Row runs of the other directions ----------------------------------------
-// At each point of the walk (for_each_run_lane: element t, row r, position o
-// of line 0) the run's lines lie at positions o .. o+count-1 of row r and
-// their mirrors at the negated positions of row -r. Line i goes to row
-// s = t + shift + i shift_step of the block, or, mirrored, is read from the
-// mirror and goes to row -s (see RowRun). Calls f(i, point, mirror, row):
-// the entries of the mode its line holds there, of its conjugate, and of
-// its row in the block.
-template <class F>
-inline void for_each_run_point(int N, const RowRun &run, int k2, int first_lane, F &&f) {
-    const std::size_t lane = 2 * static_cast<std::size_t>(N);
-    for_each_run_lane(N, run, k2, first_lane, [&](int t, int r, int o) {
-        const std::size_t here = lane * r, there = lane * static_cast<std::size_t>(r == 0 ? 0 : N - r);
-        int s = t + run.shift, p = o;
-        if (s >= N) s -= N;
-        for (int i = 0; i < run.count; ++i) {
-            const std::size_t point = here + 2 * static_cast<std::size_t>(p);
-            const std::size_t mirror = there + 2 * static_cast<std::size_t>(p == 0 ? 0 : N - p);
-            const int row = s == 0 || !(run.mirrored >> i & 1u) ? s : N - s;
-            if (run.mirrored >> i & 1u) f(i, mirror, point, row);
-            else f(i, point, mirror, row);
-            if (++p == N) p = 0;
-            s += run.shift_step;
-            if (s >= N) s -= N;
-        }
-    });
-}
-
-LPI_SIMD_CLONES
-void gather_run(const RowRun &run, int k2, int N, int first_lane, const double *w, double *x) {
-    if (run.shift_step != 0) {
-        const std::size_t n = run.count;
-        for_each_run_point(N, run, k2, first_lane, [&](int i, std::size_t mode, std::size_t, int row) {
-            store(x + 2 * (row * n + i), load<Complex1>(w + mode));
-        });
-        return;
-    }
-    if (run.count == kBlock) gather_runs<true, kBlock>(N, k2, run.column, run.count, first_lane, w, x);
-    else gather_runs<true, 0>(N, k2, run.column, run.count, first_lane, w, x);
-}
-
-LPI_SIMD_CLONES
-void scatter_run(const RowRun &run, int k2, int N, int first_lane, const double *x, double *w) {
-    if (run.shift_step != 0) {
-        const std::size_t n = run.count;
-        for_each_run_point(N, run, k2, first_lane, [&](int i, std::size_t mode, std::size_t mirror, int row) {
-            const Complex1 sum = load<Complex1>(w + mode) + load<Complex1>(x + 2 * (row * n + i));
-            store(w + mode, sum);
-            store(w + mirror, sum * Complex1{1.0, -1.0});
-        });
-        return;
-    }
-    if (run.count == kBlock) scatter_runs<true, kBlock>(N, k2, run.column, run.count, first_lane, x, w);
-    else scatter_runs<true, 0>(N, k2, run.column, run.count, first_lane, x, w);
-}
-
 // Line i of the block (d = d0 + i) has c = sigma d, so exp(t Lambda_l) =
 // u_{l-c} conj(u_{l+c}) is e = u_{l+d} conj(u_{l-d}) for sigma = -1 and
 // conj(e) for sigma = +1: `sign` = -sigma multiplies Im e, an exact negation.
@@ -398,38 +307,6 @@ void apply_phase(int N, int d0, int count, const double *tables, double sign, do
                                                 tables + 3 * array, tables + 4 * array, tables + 5 * array};
     if (count == kBlock) phase_rows<kBlock>(N, d0, count, arrays, sign, x);
     else phase_rows<0>(N, d0, count, arrays, sign, x);
-}
-
-// Line by line, four rows l at a time: line i (d = offsets[i]) reads
-// P_{l+d} at entry l + d and (Q, q)_{l-d} at entry N + l - d of tables
-// written in order of l (write_phase with mirrored = false), both running
-// forwards along the line, so that no two lines need neighbouring d. The
-// values and the arithmetic are phase_rows' for the same d and sign.
-LPI_SIMD_CLONES
-void apply_phase_lines(int N, const int *offsets, int count, const double *tables, double sign, double *x) {
-    const std::size_t array = 2 * static_cast<std::size_t>(N);
-    const double *const arrays[kPhaseArrays] = {tables,             tables + array,     tables + 2 * array,
-                                                tables + 3 * array, tables + 4 * array, tables + 5 * array};
-    const std::size_t n = count, rows = N, fours = rows / 4 * 4, row = 2 * n;
-    for (std::size_t i = 0; i < n; ++i) {
-        const std::size_t d = static_cast<std::size_t>(offsets[i]);
-        double *z = x + 2 * i;
-        for (std::size_t l = 0; l < fours; l += 4) {
-            double *z0 = z + l * row;
-            const Complex2 z02 = load_pair(z0, z0 + 2 * row), z13 = load_pair(z0 + row, z0 + 3 * row);
-            Complex2 zr = even_parts(z02, z13), zi = odd_parts(z02, z13);
-            phase_product(arrays, l + d, rows + l - d, sign, zr, zi);
-            store_pair(z0, z0 + 2 * row, even_parts(zr, zi));
-            store_pair(z0 + row, z0 + 3 * row, odd_parts(zr, zi));
-        }
-        for (std::size_t l = fours; l < rows; ++l) {
-            double *zl = z + l * row;
-            double zr = zl[0], zi = zl[1];
-            phase_product(arrays, l + d, rows + l - d, sign, zr, zi);
-            zl[0] = zr;
-            zl[1] = zi;
-        }
-    }
 }
 
 }  // namespace sine_euler

@@ -23,13 +23,6 @@ void gather_block(const Direction &D, int N, int d0, int count, int first_lane, 
 // gathers), so every mode is written once.
 void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
                    double *w);
-// The same for a RowRun of direction (k1, k2): element s of line i at row
-// run.row + s k1, column run.column + i + s k2 goes to x[s * count + i], and
-// back with its mirror (every mode of the run's lines and their conjugates
-// written once).
-void gather_run(const RowRun &run, int k2, int N, int first_lane, const double *w, double *x);
-void scatter_run(const RowRun &run, int k2, int N, int first_lane, const double *x, double *w);
-
 // The phase tables of one flow: kPhaseArrays arrays of 2N doubles, array a
 // at tables + 2 N a, written by write_phase and read by apply_phase.
 constexpr int kPhaseArrays = 6;
@@ -39,30 +32,25 @@ inline std::size_t phase_table_doubles(int N) { return 2 * static_cast<std::size
 // d0+count-1) by the line flows' increments (exp(t Lambda_l) - 1) / N read
 // from the phase tables (see the definition).
 void apply_phase(int N, int d0, int count, const double *tables, double sign, double *x);
-// The same for lines d = offsets[i] in any order, on tables written with
-// mirrored = false: line i as apply_phase treats line d, to the bit.
-void apply_phase_lines(int N, const int *offsets, int count, const double *tables, double sign, double *x);
 
 // v_l = u_l - 1 = exp(i phi_l) - 1 = (-2 sin^2(phi_l / 2), sin phi_l), phi_l =
 // factor B_l (B: the transformed line spectrum, factor = t / (2 eps)), as
 // real and imaginary parts in arrays of their own, so that apply_phase
 // multiplies four lines at a time without shuffling the tables: P = v_l / N
 // at entry l (Re P, Im P: arrays 0, 1), and at entry -l (the table read
-// backwards) Q = v_l / N and q = v_l (Re Q, Im Q, Re q, Im q: arrays 2 .. 5);
-// with mirrored = false, Q and q at entry l as well (apply_phase_lines).
+// backwards) Q = v_l / N and q = v_l (Re Q, Im Q, Re q, Im q: arrays 2 .. 5).
 // Each array holds its N entries twice over, so that l + d and N + d - l need
 // no reduction mod N and run forwards along the lines of a block (see
 // apply_phase). Each l writes its own entries only, so threads may share the
 // loop over l.
-inline void write_phase(int n, int l, double factor, const double *spectrum, double *tables,
-                        bool mirrored = true) {
+inline void write_phase(int n, int l, double factor, const double *spectrum, double *tables) {
     const std::size_t N = n, array = 2 * N;
     const double angle = factor * spectrum[2 * l];
     const double half = std::sin(0.5 * angle);
     const double re = -2.0 * half * half, im = std::sin(angle);
     const double n_real = n;
     const double scaled_re = re / n_real, scaled_im = im / n_real;
-    const std::size_t minus = l == 0 || !mirrored ? l : N - l;
+    const std::size_t minus = l == 0 ? 0 : N - l;
     const double entries[kPhaseArrays] = {scaled_re, scaled_im, scaled_re, scaled_im, re, im};
     for (std::size_t copy = 0; copy < 2; ++copy)
         for (std::size_t a = 0; a < kPhaseArrays; ++a)

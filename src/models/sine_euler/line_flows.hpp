@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
-#include <vector>
 
 #include "../../core/error.hpp"
 #include "kernels.hpp"
@@ -34,23 +33,16 @@ inline int this_thread() {
 // Block b of `lines` lines (kBlock each, the last one the remainder).
 inline int blocks_of(int lines) { return (lines + kBlock - 1) / kBlock; }
 inline int lines_in_block(int lines, int b) { return lines - b * kBlock < kBlock ? lines - b * kBlock : kBlock; }
-// The line counts of those blocks.
-inline std::vector<int> block_counts(int lines) {
-    std::vector<int> counts(static_cast<std::size_t>(blocks_of(lines)));
-    for (std::size_t b = 0; b < counts.size(); ++b) counts[b] = lines_in_block(lines, static_cast<int>(b));
-    return counts;
-}
 
-// Writes the phase tables of the transformed line spectrum (write_phase,
-// `mirrored` as the phase kernel reads them), then calls move_block(b, x)
-// for the blocks b = 0 .. blocks-1 with the
+// Writes the phase tables of the transformed line spectrum (write_phase),
+// then calls move_block(b, x) for every block b of `lines` lines with the
 // block buffer x of its thread. The implicit barrier between the two loops
 // orders them; blocks are the same whichever thread runs them, so the
 // results are the same for every thread count.
 template <class MoveBlock>
-void run_line_flows(LineTransforms &T, int N, int blocks, int threads, double factor, bool mirrored,
-                    MoveBlock &&move_block) {
-    auto phase = [&](int l) { write_phase(N, l, factor, T.spectrum(), T.phase(), mirrored); };
+void run_line_flows(LineTransforms &T, int N, int lines, int threads, double factor, MoveBlock &&move_block) {
+    const int blocks = blocks_of(lines);
+    auto phase = [&](int l) { write_phase(N, l, factor, T.spectrum(), T.phase()); };
 #if LPI_HAVE_OPENMP
     if (threads > 1 && blocks > 1) {
 #pragma omp parallel num_threads(threads)
@@ -83,25 +75,22 @@ inline std::size_t flow_count(std::size_t flows_per_step, std::int64_t steps) {
 
 // Seconds that `flows` flows' transforms alone take (the line spectrum's and
 // a forward and backward transform of every block), on T's plans, buffers
-// and threads, on zeros. Flow f has blocks of the line counts
-// pieces[f mod pieces.size()].
-inline double time_line_transforms(LineTransforms &T, int N, const std::vector<std::vector<int>> &pieces,
-                                   int threads, std::size_t flows) {
+// and threads, on zeros.
+inline double time_line_transforms(LineTransforms &T, int N, int lines, int threads, std::size_t flows) {
+    const int blocks = blocks_of(lines);
     std::memset(T.spectrum(), 0, sizeof(double) * 2 * N);
     for (int i = 0; i < threads; ++i)
         std::memset(T.block(static_cast<std::size_t>(i)), 0, sizeof(double) * 2 * N * kBlock);
     const auto start = std::chrono::steady_clock::now();
     for (std::size_t f = 0; f < flows; ++f) {
-        const std::vector<int> &counts = pieces[f % pieces.size()];
-        const int blocks = static_cast<int>(counts.size());
         T.transform_spectrum();
 #if LPI_HAVE_OPENMP
 #pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && blocks > 1)
 #endif
         for (int b = 0; b < blocks; ++b) {
             double *x = T.block(static_cast<std::size_t>(this_thread()));
-            T.forward(counts[static_cast<std::size_t>(b)], x);
-            T.backward(counts[static_cast<std::size_t>(b)], x);
+            T.forward(lines_in_block(lines, b), x);
+            T.backward(lines_in_block(lines, b), x);
         }
     }
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -75,18 +75,7 @@ class SineEuler final : public SineEulerModel {
 public:
     explicit SineEuler(int N)
         : N_(N), blocks_(N), eps_(2.0 * std::acos(-1.0) / N), dirs_(projective_line(N)),
-          hamiltonian_(N) {
-        for (const Direction &D : dirs_) {
-            runs_.push_back(row_runs(D, N));
-            std::vector<int> counts;
-            for (const RowRun &run : runs_.back()) counts.push_back(run.count);
-            if (counts.empty()) counts = block_counts(blocks_.M);
-            run_counts_.insert(run_counts_.end(), counts.begin(), counts.end());
-            piece_blocks_.push_back(std::move(counts));
-        }
-        std::sort(run_counts_.begin(), run_counts_.end());
-        run_counts_.erase(std::unique(run_counts_.begin(), run_counts_.end()), run_counts_.end());
-    }
+          hamiltonian_(N) {}
 
     const char *kind() const override { return "sine-euler"; }
     int truncation() const override { return N_; }
@@ -157,7 +146,7 @@ public:
     TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) override;
 
     void set_planning(FftPlanning planning) override {
-        auto planned = std::make_unique<LineTransforms>(N_, blocks_.M, planning, run_counts_);
+        auto planned = std::make_unique<LineTransforms>(N_, blocks_.M, planning);
         planned->reserve_threads(static_cast<std::size_t>(threads_));
         transforms_ = std::move(planned);
         planning_ = planning;
@@ -168,18 +157,11 @@ private:
     LineTransforms &transforms();
     bool line_spectrum(const Direction &D, const double *w);
     void move_block(const Direction &D, int block, double *x, double *w);
-    void move_run(const Direction &D, const std::vector<RowRun> &runs, int block, double *x, double *w);
 
     int N_;
     LineBlocks blocks_;
     double eps_;
     std::vector<Direction> dirs_;
-    // Each direction's lines as row runs (row_runs), or none: then the
-    // Column or General blocks of blocks_. The line counts of every piece's
-    // blocks, and the counts the transforms are planned for.
-    std::vector<std::vector<RowRun>> runs_;
-    std::vector<std::vector<int>> piece_blocks_;
-    std::vector<int> run_counts_;
     Hamiltonian hamiltonian_;
     SplitChoice split_{{"directions"}};
     int threads_ = 1;
@@ -188,7 +170,7 @@ private:
 };
 
 LineTransforms &SineEuler::transforms() {
-    if (!transforms_) transforms_ = std::make_unique<LineTransforms>(N_, blocks_.M, planning_, run_counts_);
+    if (!transforms_) transforms_ = std::make_unique<LineTransforms>(N_, blocks_.M, planning_);
     transforms_->reserve_threads(static_cast<std::size_t>(threads_));
     return *transforms_;
 }
@@ -215,49 +197,21 @@ void SineEuler::move_block(const Direction &D, int block, double *x, double *w) 
     scatter_block(D, N_, d0, count, first_lane, x, w);
 }
 
-// The same for block `block` of D's row runs. Row directions (k1 = 1) move
-// lines d = column + i, consecutive: apply_phase. The others move the lines
-// run_line gives: apply_phase_lines, on tables in order of l.
-void SineEuler::move_run(const Direction &D, const std::vector<RowRun> &runs, int block, double *x,
-                         double *w) {
-    const RowRun &run = runs[static_cast<std::size_t>(block)];
-    const long long blocks = static_cast<long long>(runs.size());
-    const int first_lane = static_cast<int>(block * static_cast<long long>(N_) / blocks);
-    gather_run(run, D.k2, N_, first_lane, w, x);
-    transforms_->forward(run.count, x);
-    if (D.k1 == 1) {
-        apply_phase(N_, run.column, run.count, transforms_->phase(), 1.0, x);
-    } else {
-        int lines[kBlock];
-        for (int i = 0; i < run.count; ++i) lines[i] = run_line(D, run, i, N_);
-        apply_phase_lines(N_, lines, run.count, transforms_->phase(), -D.sigma, x);
-    }
-    transforms_->backward(run.count, x);
-    scatter_run(run, D.k2, N_, first_lane, x, w);
-}
-
 void SineEuler::flow(std::size_t piece, double t, double *state) {
     transforms();
     const Direction &D = dirs_[piece];
     // A piece whose stream function is zero on its line moves nothing: its flow is the identity
     // (taken exactly, not through a round trip of FFTs).
     if (!line_spectrum(D, state)) return;
-    const double factor = t / (2.0 * eps_);
-    const std::vector<RowRun> &runs = runs_[piece];
-    if (runs.empty()) {
-        run_line_flows(*transforms_, N_, blocks_.count(), threads_, factor, true,
-                       [&](int block, double *x) { move_block(D, block, x, state); });
-        return;
-    }
-    run_line_flows(*transforms_, N_, static_cast<int>(runs.size()), threads_, factor, D.k1 == 1,
-                   [&](int block, double *x) { move_run(D, runs, block, x, state); });
+    run_line_flows(*transforms_, N_, blocks_.M, threads_, t / (2.0 * eps_),
+                   [&](int block, double *x) { move_block(D, block, x, state); });
 }
 
 // The transforms of `flows_per_step * steps` flows alone, on the model's own
 // plans, buffers and threads, on zeros: what the splitting costs in FFTW.
 TransformTiming SineEuler::time_transforms(std::size_t flows_per_step, std::int64_t steps) {
     const std::size_t flows = flow_count(flows_per_step, steps);
-    const double seconds = time_line_transforms(transforms(), N_, piece_blocks_, threads_, flows);
+    const double seconds = time_line_transforms(transforms(), N_, blocks_.M, threads_, flows);
     const double per_step = static_cast<double>(steps);
     return {seconds / per_step, static_cast<double>(flows) * (1.0 + 2.0 * blocks_.M) / per_step};
 }

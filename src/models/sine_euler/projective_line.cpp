@@ -135,47 +135,6 @@ std::vector<Direction> projective_line(int N) {
     return dirs;
 }
 
-std::vector<RowRun> row_runs(const Direction &D, int N) {
-    std::vector<RowRun> runs;
-    if (D.k1 == 1) {
-        const LineBlocks blocks(N);
-        for (int b = 0; b < blocks.count(); ++b)
-            runs.push_back({0, blocks.first_line(b), blocks.lines(b), 1, N, 1, 0, 0, 0u});
-        return runs;
-    }
-    const int g = std::gcd(D.k1, N), L = N / g;  // k1 = 0: g = N
-    if (L < kMinRun) return runs;
-    const int step = inverse_mod(D.k1 / g, L);
-    auto cut = [&](int row, int first, int lines) {
-        const int pieces = (lines + kBlock - 1) / kBlock;
-        for (int p = 0, column = first; p < pieces; ++p) {
-            const int count = lines / pieces + (p < lines % pieces ? 1 : 0);
-            const int shift =
-                modulo(static_cast<std::int64_t>(D.j1) * column - static_cast<std::int64_t>(D.j2) * row, N);
-            RowRun run{row, column, count, g, L, step, shift, D.j1, 0u};
-            for (int i = 0; i < count; ++i) {
-                const int c = modulo(static_cast<std::int64_t>(row) * D.k2 -
-                                         static_cast<std::int64_t>(column + i) * D.k1, N);
-                if (c > (N - 1) / 2) run.mirrored |= 1u << i;
-            }
-            runs.push_back(run);
-            column += count;
-        }
-    };
-    cut(0, 1, (L - 1) / 2);
-    const int inverse = inverse_mod(modulo(D.k2, g), g);  // k is primitive: k2 is a unit mod g
-    for (int delta = 1; delta <= (g - 1) / 2; ++delta)
-        cut(modulo(static_cast<std::int64_t>(delta) * inverse, g), 0, L);
-    return runs;
-}
-
-int run_line(const Direction &D, const RowRun &run, int i, int N) {
-    const std::int64_t c =
-        static_cast<std::int64_t>(run.row) * D.k2 - static_cast<std::int64_t>(run.column + i) * D.k1;
-    const int d = modulo(D.sigma * c, N);
-    return run.mirrored >> i & 1u ? N - d : d;
-}
-
 double piece_energy(const Direction &D, const Hamiltonian &H, const double *modes) {
     const int N = H.truncation();
     double sum = 0.0;

@@ -79,48 +79,5 @@ struct LineBlocks {
     }
 };
 
-// A block of parallel lines of a direction k laid so that it streams: line
-// i (0 <= i < count) is {(row, column + i) + t k}, and the point at t lies at
-// row row + t k1, column column + i + t k2 (mod N). At every t the block's
-// points are one run of consecutive columns of one row, whatever k is; line
-// i has c = c0 - i k1, c0 = row k2 - column k1.
-struct RowRun {
-    int row, column, count;
-    // g = gcd(k1, N), L = N / g and v = (k1 / g)^-1 mod L: row row + q g
-    // holds the points t = q v (mod L) of every line (the kernels walk the
-    // rows in order).
-    int classes, cycle, step;
-    // Where the transforms take each value, so that every line meets the
-    // same arithmetic, and gives the same bits, as in the Column and General
-    // blocks (and on MPI): D's own lines d j + s k, d = 1 .. M. Line i of the
-    // run is line d = c of them (sigma = 1), its point at t element s = t +
-    // shift + i shift_step (mod N) (shift = j x (row, column), shift_step =
-    // j1); or, bit i of `mirrored` set, where c > M, the conjugate of line
-    // d = N - c, whose element -s lies at the mirror of that point, where it
-    // is read and written. All 0 for Row directions (their runs are their
-    // blocks).
-    int shift, shift_step;
-    unsigned mirrored;
-};
-
-// The line d (1 .. M) of D's own parametrization that line i of the run
-// moves: d = sigma c, or, mirrored, N - sigma c (see RowRun).
-int run_line(const Direction &D, const RowRun &run, int i, int N);
-
-// Runs shorter than this go by the Column or General layout instead.
-constexpr int kMinRun = 8;
-
-// The lines of D as row runs, one of each conjugate pair (M in all), or none
-// where they would be short. Columns next to each other in a row differ in c
-// by k1, so a row holds the lines of one class of c mod g = gcd(k1, N), in
-// cycles of L = N / g: class 0 (with the line through the origin, c = 0, and
-// c = -i k1 conjugate to c = -(L - i) k1) gives lines i = 1 .. (L - 1) / 2 of
-// row 0; classes +-delta, delta = 1 .. (g - 1) / 2, conjugate to one another,
-// a whole cycle of row delta / k2 mod g. Each is cut into blocks of at most
-// kBlock lines, of nearly equal counts. For Row directions (k1 = 1, g = 1)
-// these are the LineBlocks, at (0, first_line). Empty when L < kMinRun:
-// (0, 1), and directions whose k1 shares most of N's factors.
-std::vector<RowRun> row_runs(const Direction &D, int N);
-
 }  // namespace sine_euler
 }  // namespace lpi

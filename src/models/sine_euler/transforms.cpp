@@ -56,19 +56,12 @@ unsigned planner_flags(FftPlanning planning) {
 
 struct LineTransforms::Plans {
     fftw_plan spectrum = nullptr;
-    fftw_plan forward[kBlock + 1] = {};  // by the block's line count
-    fftw_plan backward[kBlock + 1] = {};
+    fftw_plan forward[2] = {nullptr, nullptr};  // [0]: full block, [1]: remainder
+    fftw_plan backward[2] = {nullptr, nullptr};
 };
 
-LineTransforms::LineTransforms(int N, int lines, FftPlanning planning, const std::vector<int> &more_counts)
+LineTransforms::LineTransforms(int N, int lines, FftPlanning planning)
     : N_(N), lines_(lines), plans_(new Plans) {
-    bool wanted[kBlock + 1] = {};
-    if (lines >= kBlock) wanted[kBlock] = true;
-    wanted[lines % kBlock] = true;
-    for (int count : more_counts)
-        if (count >= 1 && count <= kBlock) wanted[count] = true;
-    wanted[0] = false;
-    bool planned = true;
     try {
         spectrum_ = reinterpret_cast<double *>(fftw_alloc_complex(N));
         phase_ = static_cast<double *>(fftw_malloc(sizeof(double) * phase_table_doubles(N)));
@@ -80,21 +73,24 @@ LineTransforms::LineTransforms(int N, int lines, FftPlanning planning, const std
         // The spectrum is one FFT per flow: planned by the heuristic always,
         // so that processes sharing a field compute the same phases.
         plans_->spectrum = fftw_plan_dft_1d(N, b, b, FFTW_FORWARD, FFTW_ESTIMATE);
-        for (int howmany = 1; howmany <= kBlock && planned; ++howmany) {
-            if (!wanted[howmany]) continue;
+        const int sizes[2] = {lines_ >= kBlock ? kBlock : 0, lines_ % kBlock};
+        for (int i = 0; i < 2; ++i) {
+            const int howmany = sizes[i];
+            if (howmany == 0) continue;
             // Transform along s (stride howmany); the lines of a block are
             // adjacent, as gathered from a row.
-            plans_->forward[howmany] = fftw_plan_many_dft(1, &N, howmany, x, nullptr, howmany, 1, x, nullptr,
-                                                          howmany, 1, FFTW_FORWARD, flags);
-            plans_->backward[howmany] = fftw_plan_many_dft(1, &N, howmany, x, nullptr, howmany, 1, x,
-                                                           nullptr, howmany, 1, FFTW_BACKWARD, flags);
-            planned = plans_->forward[howmany] && plans_->backward[howmany];
+            plans_->forward[i] = fftw_plan_many_dft(1, &N, howmany, x, nullptr, howmany, 1, x, nullptr,
+                                                    howmany, 1, FFTW_FORWARD, flags);
+            plans_->backward[i] = fftw_plan_many_dft(1, &N, howmany, x, nullptr, howmany, 1, x,
+                                                     nullptr, howmany, 1, FFTW_BACKWARD, flags);
+            if (!plans_->forward[i] || !plans_->backward[i]) break;
         }
     } catch (...) {
         release();
         throw;
     }
-    if (!plans_->spectrum || !planned) {
+    if (!plans_->spectrum || (lines_ >= kBlock && !plans_->forward[0]) ||
+        (lines_ % kBlock && !plans_->forward[1])) {
         release();
         fail(LPI_ERR_INTERNAL, "FFTW could not create a plan for N = " + std::to_string(N));
     }
@@ -105,10 +101,9 @@ LineTransforms::~LineTransforms() { release(); }
 void LineTransforms::release() {
     std::lock_guard<std::mutex> lock(fftw_planner_mutex());
     if (plans_)
-        for (int count = 0; count <= kBlock; ++count)
-            for (fftw_plan p : {plans_->forward[count], plans_->backward[count]})
-                if (p) fftw_destroy_plan(p);
-    if (plans_ && plans_->spectrum) fftw_destroy_plan(plans_->spectrum);
+        for (fftw_plan p : {plans_->spectrum, plans_->forward[0], plans_->forward[1],
+                            plans_->backward[0], plans_->backward[1]})
+            if (p) fftw_destroy_plan(p);
     plans_.reset();
     fftw_free(spectrum_);
     fftw_free(phase_);
@@ -130,11 +125,11 @@ void LineTransforms::transform_spectrum() {
 }
 
 void LineTransforms::forward(int lines, double *block) {
-    fftw_execute_dft(plans_->forward[lines], complex_of(block), complex_of(block));
+    fftw_execute_dft(plans_->forward[lines == kBlock ? 0 : 1], complex_of(block), complex_of(block));
 }
 
 void LineTransforms::backward(int lines, double *block) {
-    fftw_execute_dft(plans_->backward[lines], complex_of(block), complex_of(block));
+    fftw_execute_dft(plans_->backward[lines == kBlock ? 0 : 1], complex_of(block), complex_of(block));
 }
 
 namespace {

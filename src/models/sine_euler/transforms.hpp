@@ -2,7 +2,7 @@
 // that another backend (MPI, GPU) can replace them and keep the geometry and
 // the kernels: FFTW plans and aligned buffers, created once per system, for
 // the spectrum of one direction's line through the origin (length N) and for
-// a block of lines (kBlock, the remainder, or other counts asked for: transforms of length N along s,
+// a block of lines (kBlock, or the remainder, transforms of length N along s,
 // stride the block's line count). Plan creation, destruction and wisdom hold
 // fftw_planner_mutex(). Everything here needs FFTW3 except the wisdom
 // functions, which refuse with LPI_ERR_UNSUPPORTED in a build without it.
@@ -22,9 +22,8 @@ class LineTransforms {
 public:
     // Plans at the given rigor and buffers for `lines` lines of length N (the
     // (N - 1) / 2 integrated lines of a direction, or one process's share of
-    // them: blocks of kBlock and the remainder), and for blocks of the
-    // `more_counts` line counts (at most kBlock each), with one block buffer.
-    LineTransforms(int N, int lines, FftPlanning planning, const std::vector<int> &more_counts = {});
+    // them), with one block buffer.
+    LineTransforms(int N, int lines, FftPlanning planning);
     ~LineTransforms();
     LineTransforms(const LineTransforms &) = delete;
     LineTransforms &operator=(const LineTransforms &) = delete;
@@ -37,7 +36,7 @@ public:
     // The phase tables (phase_table_doubles(N); see write_phase).
     double *phase() { return phase_; }
     // Block buffer of a thread, and its forward / backward transform in place
-    // for a block of `lines` lines (a count it was planned for).
+    // for a block of `lines` lines (kBlock, or the remainder M mod kBlock).
     double *block(std::size_t thread) { return blocks_[thread]; }
     void forward(int lines, double *block);
     void backward(int lines, double *block);
