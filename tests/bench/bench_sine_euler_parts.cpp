@@ -8,7 +8,10 @@
 // Row, Column and General layouts weigh as they do in a step; per part the
 // least of three passes. Prints ns per mode moved, the parts beside the FFTs
 // ("rest / FFTs" is about what the step's ratio to the FFT floor of
-// bench_sine_euler exceeds 1 by) and the serial part's share of the flow.
+// bench_sine_euler exceeds 1 by), the serial part's share of the flow, and
+// the gather and scatter of each layout's directions by themselves, per mode
+// those directions move (Column blocks read one mode from each of 16 rows a
+// lane, General blocks one mode at a time: composite N pay for them).
 // Prints figures; asserts nothing.
 #include <algorithm>
 #include <chrono>
@@ -56,12 +59,13 @@ void measure(int N) {
     const Hamiltonian H(N);  // Euler's
     std::vector<double> w = field(N);
     const double factor = 1e-3 / (2.0 * (2.0 * std::acos(-1.0) / N));  // t = 1e-3
-    double best[kParts];
+    double best[kParts], best_moves[3];
     std::fill(best, best + kParts, INFINITY);
+    std::fill(best_moves, best_moves + 3, INFINITY);
     int layouts[3] = {0, 0, 0};
     for (const Direction &D : directions) ++layouts[D.layout];
     for (int pass = 0; pass < 3; ++pass) {
-        double sum[kParts] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+        double sum[kParts] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}, moves[3] = {0.0, 0.0, 0.0};
         for (const Direction &D : directions) {
             Clock::time_point clock = Clock::now();
             line_stream(D, H, w.data(), T.spectrum());
@@ -74,7 +78,9 @@ void measure(int N) {
                 double *x = T.block(0);
                 clock = Clock::now();
                 gather_block(D, N, d0, count, blocks.first_lane(block), w.data(), x);
-                sum[Gather] += seconds_since(clock);
+                const double gather = seconds_since(clock);
+                sum[Gather] += gather;
+                moves[D.layout] += gather;
                 T.forward(count, x);
                 sum[Transforms] += seconds_since(clock);
                 apply_phase(N, d0, count, T.phase(), -D.sigma, x);
@@ -82,18 +88,27 @@ void measure(int N) {
                 T.backward(count, x);
                 sum[Transforms] += seconds_since(clock);
                 scatter_block(D, N, d0, count, blocks.first_lane(block), x, w.data());
-                sum[Scatter] += seconds_since(clock);
+                const double scatter = seconds_since(clock);
+                sum[Scatter] += scatter;
+                moves[D.layout] += scatter;
             }
         }
         for (int p = 0; p < kParts; ++p) best[p] = std::min(best[p], sum[p]);
+        for (int l = 0; l < 3; ++l) best_moves[l] = std::min(best_moves[l], moves[l]);
     }
     const double modes = static_cast<double>(directions.size()) * N * blocks.M, ns = 1e9 / modes;
     const double rest = best[Spectrum] + best[Tables] + best[Gather] + best[Phase] + best[Scatter];
-    std::printf("%5d %5d %5d %5d %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %7.2f %7.2f %6.1f%%\n", N,
+    std::printf("%5d %5d %5d %5d %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %7.2f %7.2f %6.1f%%", N,
                 layouts[0], layouts[1], layouts[2], ns * best[Transforms], ns * best[Spectrum],
                 ns * best[Tables], ns * best[Gather], ns * best[Phase], ns * best[Scatter], ns * rest,
                 rest / best[Transforms], (best[Gather] + best[Scatter]) / best[Transforms],
                 100.0 * best[Spectrum] / (rest + best[Transforms]));
+    for (int l = 0; l < 3; ++l) {  // per mode moved by that layout's directions
+        const double layout_modes = static_cast<double>(layouts[l]) * N * blocks.M;
+        if (layouts[l] > 0) std::printf(" %6.2f", 1e9 * best_moves[l] / layout_modes);
+        else std::printf(" %6s", "-");
+    }
+    std::printf("\n");
     std::fflush(stdout);
 }
 
@@ -101,10 +116,11 @@ void measure(int N) {
 
 int main() {
     std::printf("sine-Euler, one thread: a flow's parts in ns per mode moved, summed over every direction\n");
-    std::printf("%5s %5s %5s %5s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s\n", "N", "rows", "cols", "other",
-                "FFTs", "spectrum", "sines", "gather", "phase", "scatter", "rest", "rest/", "moves/", "serial");
-    std::printf("%5s %5s %5s %5s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s\n", "", "", "", "", "", "", "", "", "",
-                "", "", "FFTs", "FFTs", "");
+    std::printf("%5s %5s %5s %5s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s %20s\n", "N", "rows", "cols", "other",
+                "FFTs", "spectrum", "sines", "gather", "phase", "scatter", "rest", "rest/", "moves/", "serial",
+                "moves by layout");
+    std::printf("%5s %5s %5s %5s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s %6s %6s %6s\n", "", "", "", "", "", "", "",
+                "", "", "", "", "FFTs", "FFTs", "", "row", "column", "other");
     const int Ns[] = {61, 125, 127, 243, 251, 375, 509, 625};
     for (int N : Ns) measure(N);
     return 0;
