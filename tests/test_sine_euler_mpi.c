@@ -1,9 +1,9 @@
 /* Sine-Euler spread over MPI processes (liepoisson_mpi.h), run by ctest under
  * mpirun with 1 to 4 processes: the distributed handle follows the library's
  * one-process model to the bit (a 4th-order method, 40 steps, N prime and
- * composite: the state, modes, grid and traces, as lpi_sine_euler_create_mpi(3)
- * says; energy and enstrophy to round-off), its outputs are the same on every
- * process, checkpoints are one
+ * composite: the state, modes, grid, traces, stream function and shell
+ * spectrum, as lpi_sine_euler_create_mpi(3) says; energy and enstrophy to
+ * round-off), its outputs are the same on every process, checkpoints are one
  * file that both load, and bad input gets the same status on every process
  * with the state unchanged. */
 #include <liepoisson_mpi.h>
