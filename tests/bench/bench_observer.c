@@ -28,7 +28,7 @@ static const char *const kNames[kConfigs] = {"none", "never fires", "every 1000"
 static const int64_t kEvery[kConfigs] = {0, INT64_MAX, 1000, 100, 10};
 
 int main(int argc, char **argv) {
-    const int64_t steps = argc > 1 ? atoll(argv[1]) : 200000;
+    const int64_t steps = argc > 1 ? atoll(argv[1]) : bench_quick() ? 2000 : 200000;
     const char *methods[] = {"leapfrog", "yoshida-6", "rk4"};
     const double m0[3] = {1.0, 0.5, -0.3};
     printf("Observer cost, rigid body I = (1, 2, 3), %lld steps per lpi_step call, dt = 1e-3,\n"

@@ -53,6 +53,8 @@ typedef struct {
     int band; /* Bands: which half of each row */
 } Work;
 static volatile double work_sink; /* the results, kept so that the work is done */
+/* Repeats of each kind of work: a hundredth in the quick mode. */
+static long work_repeats(long full) { return bench_quick() ? full / 100 : full; }
 
 static void *run_work(void *argument) {
     const Work *work = argument;
@@ -61,18 +63,18 @@ static void *run_work(void *argument) {
     if (work->kind == Dependent) {
         double a[kChains];
         for (int i = 0; i < kChains; ++i) a[i] = 1.0 + b[i];
-        for (long k = 0; k < 4000000; ++k)
+        for (long k = 0, n = work_repeats(4000000); k < n; ++k)
             for (int i = 0; i < kChains; ++i) a[i] = a[i] * factor + term;
         for (int i = 0; i < kChains; ++i) sum += a[i];
     } else if (work->kind == Throughput) {
         Pair a[kPairChains];
         const Pair f = {factor, factor}, t = {term, term};
         for (int i = 0; i < kPairChains; ++i) a[i] = (Pair){1.0 + b[i], 1.0 + b[i + 1]};
-        for (long k = 0; k < 2000000; ++k)
+        for (long k = 0, n = work_repeats(2000000); k < n; ++k)
             for (int i = 0; i < kPairChains; ++i) a[i] = a[i] * f + t;
         for (int i = 0; i < kPairChains; ++i) sum += a[i][0] + a[i][1];
     } else if (work->kind == Bands) {
-        for (int pass = 0; pass < 400; ++pass)
+        for (long pass = 0, n = work_repeats(400); pass < n; ++pass)
             for (int row = 0; row < kBufferDoubles; row += kRowDoubles) {
                 double *x = work->buffer + row + work->band * (kRowDoubles / 2);
                 for (int i = 0; i < kRowDoubles / 2; ++i) x[i] = x[i] * factor + term;
@@ -80,7 +82,7 @@ static void *run_work(void *argument) {
         sum = work->buffer[work->band * (kRowDoubles / 2)];
     } else {
         double a[4] = {0.0, 0.0, 0.0, 0.0};
-        for (int pass = 0; pass < 400; ++pass)
+        for (long pass = 0, n = work_repeats(400); pass < n; ++pass)
             for (int i = 0; i < kBufferDoubles; i += 4)
                 for (int j = 0; j < 4; ++j) a[j] += b[i + j];
         sum = a[0] + a[1] + a[2] + a[3];
@@ -175,7 +177,9 @@ int main(void) {
         return 0;
     }
     lpi_destroy(probe);
-    const double budget = getenv("LPI_BENCH_SECONDS") ? atof(getenv("LPI_BENCH_SECONDS")) : 0.4;
+    const double budget = getenv("LPI_BENCH_SECONDS") ? atof(getenv("LPI_BENCH_SECONDS"))
+                          : bench_quick()               ? 0.001
+                                                        : 0.4;
     double load[3] = {NAN, NAN, NAN};
     getloadavg(load, 3);
     printf("sine-Euler, leapfrog (time per step; floor = FFTW alone, same plans and transforms;"
@@ -195,7 +199,8 @@ int main(void) {
            "bands");
     /* Prime and composite N: FFTW is 2-3x faster at 125, 243, 375, 625. */
     const int Ns[] = {31, 61, 125, 127, 243, 251, 375, 509, 625};
-    for (size_t i = 0; i < sizeof Ns / sizeof Ns[0]; ++i) {
+    const size_t count = bench_quick() ? 2 : sizeof Ns / sizeof Ns[0];
+    for (size_t i = 0; i < count; ++i) {
         const int N = Ns[i];
         lpi_system *sys = make(N);
         double transforms = 0;
@@ -216,8 +221,12 @@ int main(void) {
         lpi_destroy(sys);
     }
     /* Peak memory at N = 1021 in a child process, so that nothing else counts. */
-    const int N = 1021;
+    const int N = bench_quick() ? 61 : 1021;
     const pid_t child = fork();
+    if (child < 0) {
+        perror("bench_sine_euler: fork");
+        return 1;
+    }
     if (child == 0) {
         lpi_system *sys = make(N);
         check(lpi_set_method(sys, "lie-trotter"), sys, "method");
@@ -226,7 +235,10 @@ int main(void) {
         _exit(0);
     }
     int status = 0;
-    waitpid(child, &status, 0);
+    if (waitpid(child, &status, 0) != child || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        fprintf(stderr, "bench_sine_euler: the N = %d child failed\n", N);
+        return 1;
+    }
     struct rusage usage;
     getrusage(RUSAGE_CHILDREN, &usage);
     printf("N = %d: peak RSS %.1f MiB after one Lie-Trotter step (the modes alone: %.1f MiB)\n", N,

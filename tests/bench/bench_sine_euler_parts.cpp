@@ -24,6 +24,7 @@
 #include "models/sine_euler/kernels.hpp"
 #include "models/sine_euler/projective_line.hpp"
 #include "models/sine_euler/transforms.hpp"
+#include "bench_common.h"
 
 namespace {
 
@@ -121,7 +122,8 @@ int main() {
                 "moves by layout");
     std::printf("%5s %5s %5s %5s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s %6s %6s %6s\n", "", "", "", "", "", "", "",
                 "", "", "", "", "FFTs", "FFTs", "", "row", "column", "other");
-    const int Ns[] = {61, 125, 127, 243, 251, 375, 509, 625};
+    const std::vector<int> Ns = bench_quick() ? std::vector<int>{15, 27, 61}  // General, Column, Row
+                                              : std::vector<int>{61, 125, 127, 243, 251, 375, 509, 625};
     for (int N : Ns) measure(N);
     return 0;
 }
