@@ -64,11 +64,14 @@ static inline int lpi_test_have_sine_euler(void) {
     return have;
 }
 
-/* State and time of a handle, to compare bit for bit. */
+/* What a handle shows, to compare bit for bit: state, time, method, split and
+ * flows per step (which the implicit methods measure in each call). */
 typedef struct {
     double x[4096];
     size_t n;
     double time;
+    char method[64], split[64];
+    size_t flows;
 } lpi_snapshot;
 
 static inline void lpi_take_snapshot(const lpi_system *sys, lpi_snapshot *s) {
@@ -76,6 +79,9 @@ static inline void lpi_take_snapshot(const lpi_system *sys, lpi_snapshot *s) {
     assert_true(s->n <= sizeof s->x / sizeof s->x[0]);
     assert_int_equal(lpi_get_state(sys, s->x, s->n), LPI_OK);
     s->time = lpi_time(sys);
+    snprintf(s->method, sizeof s->method, "%s", lpi_get_method(sys));
+    snprintf(s->split, sizeof s->split, "%s", lpi_get_split(sys));
+    assert_int_equal(lpi_flows_per_step(sys, &s->flows), LPI_OK);
 }
 
 static inline void lpi_assert_unchanged(const lpi_system *sys, const lpi_snapshot *before) {
@@ -84,6 +90,9 @@ static inline void lpi_assert_unchanged(const lpi_system *sys, const lpi_snapsho
     assert_int_equal(after.n, before->n);
     assert_memory_equal(after.x, before->x, before->n * sizeof(double));
     assert_memory_equal(&after.time, &before->time, sizeof(double));
+    assert_string_equal(after.method, before->method);
+    assert_string_equal(after.split, before->split);
+    assert_int_equal(after.flows, before->flows);
 }
 
 /* Asserts that `call` returns `expected`, that the handle's (or the thread's)

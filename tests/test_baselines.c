@@ -55,6 +55,19 @@ static void test_midpoint_non_convergence_rolls_back(void **state) {
     assert_int_equal(lpi_set_method(sys, "implicit-midpoint"), LPI_OK);
     assert_int_equal(lpi_step(sys, 0.1, 10), LPI_OK);
     lpi_destroy(sys);
+    /* A step whose result overflows is rolled back with what the last call
+     * measured: flows per step as before (the snapshot compares them; the
+     * non-finite path kept the failed call's average, 2 where it was 13). */
+    sys = rigid_body();
+    assert_int_equal(lpi_set_method(sys, "implicit-midpoint"), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.3, 10), LPI_OK);
+    size_t flows = 0;
+    assert_int_equal(lpi_flows_per_step(sys, &flows), LPI_OK);
+    assert_true(flows > 5);
+    const double huge[3] = {1.2e308, 0.0, 0.0};
+    assert_int_equal(lpi_set_state(sys, huge, 3), LPI_OK);
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.3, 1), LPI_ERR_NONFINITE, "lpi_step");
+    lpi_destroy(sys);
 }
 
 /* The implicit midpoint rule conserves every quadratic invariant in exact

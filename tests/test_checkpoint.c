@@ -525,6 +525,12 @@ static void test_impossible_payloads(void **state) {
     assert_crafted_refused(&c, LPI_ERR_FORMAT, "unknown method");
     c = rigid_crafted(), c.n_gammas = 0, c.gammas = NULL;
     assert_crafted_refused(&c, LPI_ERR_FORMAT, "other weights");
+    /* A method no system of this kind can run: no save writes it, so the
+     * file is bad (FORMAT), not one for another build (UNSUPPORTED). */
+    c = rigid_crafted(), c.n_gammas = 0, c.gammas = NULL, c.method = "isomp";
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "sine-Euler systems only");
+    c = rigid_crafted(), c.n_gammas = 0, c.gammas = NULL, c.method = "direct-eq5";
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "sine-Euler systems only");
     const double lopsided[3] = {0.5, 0.25, 0.25};
     c = rigid_crafted(), c.method = "custom", c.n_gammas = 3, c.gammas = lopsided;
     assert_crafted_refused(&c, LPI_ERR_FORMAT, "symmetric");
@@ -668,6 +674,17 @@ static void test_sine_euler_payloads(void **state) {
     params[1 + 1] = 2.0;
     for (int k = 1; k < 10; ++k) params[k] *= 0.5; /* Euler's own: stored as N alone */
     assert_crafted_refused(&c, LPI_ERR_FORMAT, "not in the form this library writes");
+
+    /* direct-eq5 refuses N > 31: a checkpoint with it at N = 33 is bad. */
+    const double large = 33.0;
+    static double still[2 * 33 * 33];
+    c = (crafted){"sine-euler", 1, &large, "directions", "direct-eq5", 0, NULL, 1e-13, 100, 0.0,
+                  2 * 33 * 33, 2 * 33 * 33, still};
+    assert_crafted_refused(&c, LPI_ERR_FORMAT, "accepts N <= 31");
+    c.method = "leapfrog", c.n_gammas = 1, c.gammas = gammas;
+    buf = craft(&c, &size);
+    lpi_destroy(load(buf, size)); /* the same file with leapfrog loads */
+    free(buf);
 }
 
 /* A legitimate run is never refused: the carry frozen by a non-splitting

@@ -484,8 +484,46 @@ static void test_product_piece_overflow(void **state) {
     lpi_destroy(sys);
 }
 
+/* H(u) recording whether it was ever handed a non-finite u. */
+static int watching_h(double u, double *out, void *user) {
+    if (!isfinite(u)) *(int *)user = 1;
+    *out = u;
+    return 0;
+}
+static int watching_dh(double u, double *out, void *user) {
+    if (!isfinite(u)) *(int *)user = 1;
+    *out = 1.0;
+    return 0;
+}
+
+/* x1 x3 = 1e400 overflows: the energy, an rk4 step (the vector field) and a
+ * splitting step (the flow) all refuse it alike, and no callback is handed
+ * u = inf (the energy called H(inf) and returned LPI_OK). */
+static void test_product_piece_product_overflows(void **state) {
+    (void)state;
+    lpi_system *sys = NULL;
+    int saw_nonfinite = 0;
+    assert_int_equal(lpi_moments_create(&sys), LPI_OK);
+    assert_int_equal(lpi_moments_add_product_piece(sys, watching_h, watching_dh, &saw_nonfinite), LPI_OK);
+    const double x[8] = {1e200, 0.1, 1e200, 3.0, 0.2, 1.0, 0.1, 3.0};
+    assert_int_equal(lpi_set_state(sys, x, 8), LPI_OK);
+    double energy = 0.0;
+    LPI_ASSERT_FAILS(sys, lpi_energy(sys, &energy), LPI_ERR_OVERFLOW, "lpi_energy");
+    assert_non_null(strstr(lpi_last_error(sys), "x1 x3 = 9.9999999999999997e+199 * 9.9999999999999997e+199 overflows in piece 0"));
+    assert_true(energy == 0.0);
+    const char *methods[2] = {"rk4", "leapfrog"};
+    for (int m = 0; m < 2; ++m) {
+        assert_int_equal(lpi_set_method(sys, methods[m]), LPI_OK);
+        LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.1, 1), LPI_ERR_OVERFLOW, "lpi_step");
+        assert_non_null(strstr(lpi_last_error(sys), "overflows in piece 0 (product H(x1 x3))"));
+    }
+    assert_false(saw_nonfinite);
+    lpi_destroy(sys);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_product_piece_product_overflows),
         cmocka_unit_test(test_built_in_casimirs_and_rank),
         cmocka_unit_test(test_casimirs_over_1e5_steps),
         cmocka_unit_test(test_orders_against_rk4),

@@ -41,6 +41,8 @@ public:
     std::size_t evaluations_per_step() const override {
         return static_cast<std::size_t>(std::ceil(1.0 + std::max(1.0, average_iterations_)));
     }
+    double average_iterations() const override { return average_iterations_; }
+    void restore_average_iterations(double average) override { average_iterations_ = average; }
 
 private:
     // One step; returns the iterations it took.

@@ -238,6 +238,8 @@ public:
     std::size_t evaluations_per_step() const override {
         return static_cast<std::size_t>(std::ceil(std::max(1.0, average_iterations_)));
     }
+    double average_iterations() const override { return average_iterations_; }
+    void restore_average_iterations(double average) override { average_iterations_ = average; }
 
 private:
     void begin_run() override { iterations_ = 0; }
@@ -306,9 +308,8 @@ namespace {
 int sine_euler_order(const Method &method, const Model &model) {
     const auto *sine_euler = dynamic_cast<const SineEulerModel *>(&model);
     if (!sine_euler)
-        fail(LPI_ERR_UNSUPPORTED, "method '" + method.name + "' integrates the matrix form of "
-                                  "sine-Euler and applies to sine-Euler systems only (this "
-                                  "system is " + model.kind() + ")");
+        refuse_system("method '" + method.name + "' integrates the matrix form of sine-Euler and "
+                      "applies to sine-Euler systems only (this system is " + model.kind() + ")");
     return sine_euler->truncation();
 }
 
@@ -316,11 +317,10 @@ std::unique_ptr<Integrator> make_direct_eq5(const Method &method, const Model &m
                                             const ImplicitSettings &) {
     const int N = sine_euler_order(method, model);
     if (N > kDirectEq5MaxN)
-        fail(LPI_ERR_UNSUPPORTED,
-             "method 'direct-eq5' sums eq. 5 term by term (O(N^4) per evaluation) as a "
-             "correctness check and accepts N <= " + std::to_string(kDirectEq5MaxN) +
-                 " only, this system has N = " + std::to_string(N) +
-                 " (use rk4, rk4-matrix or a splitting method)");
+        refuse_system("method 'direct-eq5' sums eq. 5 term by term (O(N^4) per evaluation) as a "
+                      "correctness check and accepts N <= " + std::to_string(kDirectEq5MaxN) +
+                      " only, this system has N = " + std::to_string(N) +
+                      " (use rk4, rk4-matrix or a splitting method)");
     return std::make_unique<DirectEq5>(N);
 }
 

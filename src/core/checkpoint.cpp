@@ -300,8 +300,11 @@ void restore_checkpoint(System &system, const Checkpoint &cp) {
             system.set_method(cp.method);
         }
         system.restore_working_state(cp.state, cp.time);
+    } catch (const MethodNotApplicable &e) {
+        // A method that can never run on this system: no save writes that.
+        fail(LPI_ERR_FORMAT, e.what());
     } catch (const Error &e) {
-        // Not a bad file: a method this build or this system cannot run (a
+        // Not a bad file: a method this build or this layout cannot run (a
         // baseline on a system spread over processes, a matrix baseline
         // without LAPACK), or no memory.
         if (e.status() == LPI_ERR_NO_MEMORY || e.status() == LPI_ERR_UNSUPPORTED) throw;

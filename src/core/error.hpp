@@ -23,6 +23,15 @@ private:
     throw Error(status, message);
 }
 
+// LPI_ERR_UNSUPPORTED because a method can never apply to the system (not
+// because this build or a spread system lacks what it needs): a checkpoint
+// naming such a method is not one the library writes, so loading it is
+// LPI_ERR_FORMAT.
+class MethodNotApplicable : public Error {
+public:
+    explicit MethodNotApplicable(const std::string &message) : Error(LPI_ERR_UNSUPPORTED, message) {}
+};
+
 // Calls a user callback. A C++ exception thrown from it (a callback written
 // in C++) is the user's failure: LPI_ERR_CALLBACK naming the callback
 // (name() is formed only then), not an internal error of the library.

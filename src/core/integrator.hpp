@@ -56,6 +56,11 @@ public:
     virtual std::size_t evaluations_per_step() const = 0;
     // The largest |multiple of dt| that one flow or stage of a step takes.
     virtual double largest_step_fraction() const { return 1.0; }
+    // What a run measures besides the state: the average iterations behind
+    // evaluations_per_step of the implicit methods. System puts it back when
+    // a call fails, so that a failed call leaves the handle as it was.
+    virtual double average_iterations() const { return 0.0; }
+    virtual void restore_average_iterations(double) {}
 
 protected:
     // advance() for an integrator that overrides run(): its steps counted

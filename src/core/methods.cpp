@@ -205,6 +205,8 @@ const std::vector<Method> &method_table() {
 
 bool is_splitting(const Method &method) { return method.kind != MethodKind::Baseline; }
 
+void refuse_system(const std::string &message) { throw MethodNotApplicable(message); }
+
 Method baseline_method(std::string name, int order, std::string source, IntegratorFactory make) {
     Method m;
     m.name = std::move(name);

@@ -19,7 +19,8 @@ struct ImplicitSettings;
 struct Method;
 
 // Builds the integrator of `method` for `model`. A method defined for some
-// kinds of system only refuses the others with LPI_ERR_UNSUPPORTED.
+// kinds of system only refuses the others with LPI_ERR_UNSUPPORTED, thrown
+// as MethodNotApplicable (refuse_system).
 using IntegratorFactory = std::unique_ptr<Integrator> (*)(const Method &method,
                                                           const Model &model,
                                                           const ImplicitSettings &implicit);
@@ -41,6 +42,10 @@ struct Method {
     std::vector<double> gammas;  // SymmetricComposition only
     IntegratorFactory make_integrator = nullptr;
 };
+
+// Refuses a system the method can never apply to: LPI_ERR_UNSUPPORTED,
+// thrown as MethodNotApplicable (error.hpp).
+[[noreturn]] void refuse_system(const std::string &message);
 
 // True for the methods that compose exact piece flows.
 bool is_splitting(const Method &method);

@@ -172,23 +172,26 @@ bool System::step(double dt, std::int64_t nsteps) {
         };
     }
     saved_ = state_;
+    const double average_iterations = integrator_->average_iterations();
+    const auto roll_back = [&] {
+        state_.swap(saved_);
+        time_ = start;
+        integrator_->restore_average_iterations(average_iterations);
+    };
     StepsInProgress progress;
     RunOutcome outcome;
     try {
         outcome = integrator_->run(*model_, state_.data(), dt, nsteps, watch, progress);
     } catch (const Error &e) {
-        state_.swap(saved_);
-        time_ = start;
+        roll_back();
         fail(e.status(), std::string(e.what()) + ", " + steps_text(progress, start, dt) +
                              "; state rolled back");
     } catch (...) {
-        state_.swap(saved_);
-        time_ = start;
+        roll_back();
         throw;
     }
     if (outcome.end == RunOutcome::NonFinite) {
-        state_.swap(saved_);
-        time_ = start;
+        roll_back();
         fail(LPI_ERR_NONFINITE,
              "method '" + method_.name + "' produced a non-finite state with dt = " +
                  number_text(dt, 6) + ", found after step " + std::to_string(outcome.steps) +

@@ -176,14 +176,15 @@ public:
 
     double energy(const double *x) const override {
         double value = 0.0;
-        const int rc = call_user([&] { return h_(x[0] * x[2], &value, user_); },
+        const double u = product(x);
+        const int rc = call_user([&] { return h_(u, &value, user_); },
                                  [&] { return "the H callback of " + label(); });
         check(rc, value, "H");
         return value;
     }
 
     void add_vector_field(const double *x, double *rate) const override {
-        const double mu = derivative(x[0] * x[2]);
+        const double mu = derivative(product(x));
         const std::uint32_t sigma[2] = {0, 2};
         const double g[2] = {mu * x[2], mu * x[0]};
         add_poisson_times(constants_, sigma, 2, g, x, rate);
@@ -192,10 +193,7 @@ public:
 private:
     void advance(double t, double *x) const {
         const double b = x[0], a = x[2];
-        if (!std::isfinite(a * b))
-            fail(LPI_ERR_OVERFLOW, "x1 x3 = " + number_text(b) + " * " + number_text(a) +
-                                       " overflows in " + label());
-        const double mu = derivative(a * b);
+        const double mu = derivative(product(x));
         const double lambda = 4.0 * x[1] * mu;
         const double delta = 4.0 * mu * mu * (x[1] * x[1] - a * b);
         if (std::fabs(lambda * t) > kFarFromIdentity ||
@@ -283,6 +281,17 @@ private:
         apply_fourth_power_of_map(F, x + 3);
         x[0] = b * std::exp(lambda * t);
         x[2] = a * std::exp(-lambda * t);
+    }
+
+    // u = x1 x3, the callbacks' argument: LPI_ERR_OVERFLOW where it
+    // overflows (the energy, the vector field and the flow alike), so that no
+    // callback is handed an infinite u.
+    double product(const double *x) const {
+        const double u = x[0] * x[2];
+        if (!std::isfinite(u))
+            fail(LPI_ERR_OVERFLOW, "x1 x3 = " + number_text(x[0]) + " * " + number_text(x[2]) +
+                                       " overflows in " + label());
+        return u;
     }
 
     double derivative(double u) const {
