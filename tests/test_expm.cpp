@@ -479,7 +479,8 @@ void test_diagonal_series(void **) {
 }
 
 // Depth 1 (a shear: every moved index reads fixed ones only) is the sum
-// x_v + sum_j t (c_j g_pj) x_j, rounded as written; with two terms at one
+// x_v + sum_j (c_j s_pj) x_j, rounded as written, with s_p = t g_p shortened
+// so that every c_j s_p is exact (see shortening_bits); with two terms at one
 // position (the general sweep) it agrees to round-off.
 void test_shear(void **) {
     const std::vector<lpi::SparseTerm> terms = {
@@ -491,9 +492,17 @@ void test_shear(void **) {
     std::vector<double> x = {1.1, -0.4, 2.2, 0.9, -3.3}, y = x;
     shear.apply(g, t, y.data());
     std::vector<double> expected = x;
-    expected[1] = x[1] + (t * (0.75 * g[0]) * x[0] + t * (-1.25 * g[1]) * x[3]);
-    expected[2] = x[2] + t * (2.5 * g[1]) * x[0];
-    expected[4] = x[4] + (t * (0.3 * g[1]) * x[0] + t * (-0.5 * g[0]) * x[3]);
+    // Parameter 0: 0.75 (binary 0.11) and -0.5, two bits; parameter 1: -1.25
+    // and 2.5 (binary 101), three (0.3 has too many to be made exact).
+    assert_int_equal(lpi::shortening_bits(0.75), 2);
+    assert_int_equal(lpi::shortening_bits(-0.5), 0);
+    assert_int_equal(lpi::shortening_bits(2.5), 3);
+    assert_int_equal(lpi::shortening_bits(0.3), -1);
+    const double s0 = lpi::shortened(t * g[0], 2), s1 = lpi::shortened(t * g[1], 3);
+    assert_true(s0 != t * g[0] || s1 != t * g[1]);  // the shortening is exercised
+    expected[1] = x[1] + ((0.75 * s0) * x[0] + (-1.25 * s1) * x[3]);
+    expected[2] = x[2] + (2.5 * s1) * x[0];
+    expected[4] = x[4] + ((0.3 * s1) * x[0] + (-0.5 * s0) * x[3]);
     for (std::size_t i = 0; i < x.size(); ++i) assert_true(y[i] == expected[i]);
 
     std::vector<lpi::SparseTerm> summed = terms;
@@ -502,7 +511,7 @@ void test_shear(void **) {
     assert_int_equal(general.depth(), 1);
     std::vector<double> z = x;
     general.apply(g, t, z.data());
-    const double exact2 = x[2] + t * (2.5L * g[1] + 1.5L * g[0]) * x[0];
+    const double exact2 = x[2] + (2.5L * s1 + 1.5L * s0) * x[0];  // the flow for times s_p
     assert_true(std::fabs(z[2] - exact2) <= 4 * 2.2e-16 * std::fabs(exact2));
     assert_true(z[1] == y[1] && z[4] == y[4]);
 }

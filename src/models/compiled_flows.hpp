@@ -93,6 +93,8 @@ struct Plan {
     Scaling scaling[kMaxDim] = {};
     int groups = 0;
     Group group[kMaxDim] = {};
+    int parameters = 0;
+    int shortening[kMaxDim] = {};  // per parameter, as SparseExponential's
 };
 
 constexpr double absolute(double v) { return v < 0 ? -v : v; }
@@ -117,6 +119,11 @@ constexpr Plan plan(unsigned mask) {
         ++parameter;
     }
     if (count == 0) return P;
+    P.parameters = parameter;
+    for (int e = 0; e < count; ++e) {
+        const int bits = shortening_bits(raw[e].coefficient);
+        if (bits > P.shortening[raw[e].parameter]) P.shortening[raw[e].parameter] = bits;
+    }
     for (int e = 0; e < count; ++e)
         for (int f = e + 1; f < count; ++f)
             if (raw[e].row == raw[f].row && raw[e].col == raw[f].col) return P;
@@ -234,6 +241,8 @@ struct Piece {
     // scaled_by_exponential for each scaling. Both give the general plan's
     // bits.
     static long flow(const double *g, double t, double *x) {
+        double s[P.parameters];
+        unroll<0, P.parameters>([&](auto p) { s[p] = shortened(t * g[p], P.shortening[p]); });
         bool far = false;
         unroll<0, P.groups>([&](auto q) {
             constexpr Group G = P.group[q];
@@ -241,13 +250,13 @@ struct Piece {
         });
         unroll<0, P.scalings>([&](auto d) {
             constexpr Scaling S = P.scaling[d];
-            if constexpr (S.group < 0) far |= may_contract_by_half(t * (S.coefficient * g[S.parameter]));
+            if constexpr (S.group < 0) far |= may_contract_by_half(S.coefficient * s[S.parameter]);
         });
-        return far ? flow_in<true>(g, t, x) : flow_in<false>(g, t, x);
+        return far ? flow_in<true>(g, t, s, x) : flow_in<false>(g, t, s, x);
     }
 
     template <bool Far>
-    static long flow_in(const double *g, double t, double *x) {
+    static long flow_in(const double *g, double t, const double *s, double *x) {
         constexpr int depth = P.depth;
         // For exp(tD): E_k = exp(k s) - 1 of each group by powers of
         // expm1(+-s) (expm1_powers, shared with SparseExponential); first,
@@ -268,12 +277,13 @@ struct Piece {
             unroll<P.first[n], P.first[n + 1]>([&](auto e) {
                 constexpr Entry E = P.entry[e];
                 constexpr int lanes = P.level[E.col] + 1 < level ? P.level[E.col] + 1 : level;
-                const double a = t * (E.coefficient * g[E.parameter]);
+                const double a = E.coefficient * s[E.parameter];
                 unroll<0, lanes>([&](auto k) { acc[k] += a * c[E.col][k]; });
             });
             double total = 0.0;
             unroll<0, level>([&](auto k) {
-                const double term = acc[k] * (1.0 / static_cast<double>(k + 1));
+                constexpr Reciprocal inverse = reciprocal(k + 1);
+                const double term = divided(acc[k], inverse);
                 total += term;
                 c[v][k + 1] = term;
             });
@@ -292,7 +302,7 @@ struct Piece {
             constexpr Scaling S = P.scaling[d];
             double growth, exponent;
             if constexpr (S.group < 0) {
-                exponent = t * (S.coefficient * g[S.parameter]);
+                exponent = S.coefficient * s[S.parameter];
                 growth = std::expm1(exponent);
             } else {
                 constexpr Group G = P.group[S.group];

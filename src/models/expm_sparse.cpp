@@ -322,7 +322,7 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
         powers_.assign(power_groups_.size() * (2 * kMaxMultiple + 1), 0.0);
         scaled_values_.resize(scalings_.size());
         lanes_ = depth_ <= 1 ? 1 : depth_ <= 2 ? 2 : depth_ <= 4 ? 4 : depth_ <= 8 ? 8 : depth_;
-        for (std::size_t k = 0; k < lanes_; ++k) inverse_.push_back(1.0 / static_cast<double>(k + 1));
+        for (std::size_t k = 0; k < lanes_; ++k) inverse_.push_back(reciprocal(static_cast<int>(k + 1)));
         coefficients_.resize(nodes_.size() * lanes_);
         accumulator_.resize(lanes_);
         positions = series;
@@ -333,6 +333,13 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
         for (std::size_t q = positions[j].first + 1; q < positions[j].end; ++q)
             further_terms_.push_back({j, terms[q].parameter, terms[q].coefficient});
     }
+    // Per parameter, the widest of its coefficients that a shortened s_p
+    // still multiplies exactly.
+    for (const SparseTerm &term : terms) {
+        if (shortening_.size() <= term.parameter) shortening_.resize(term.parameter + 1, 0);
+        shortening_[term.parameter] = std::max(shortening_[term.parameter], shortening_bits(term.coefficient));
+    }
+    times_.resize(shortening_.size());
     scaled_.resize(positions.size());
     increment_.resize(moved_.size());
     shear_ = path_ == ExpmPath::Nilpotent && depth_ == 1 && further_terms_.empty();
@@ -381,19 +388,18 @@ void SparseExponential::check_norm(double norm, double t) const {
     }
 }
 
-void SparseExponential::scale_entries(const double *g, double t) {
+void SparseExponential::shorten_times(const double *g, double t) {
+    for (std::size_t p = 0; p < times_.size(); ++p) times_[p] = shortened(t * g[p], shortening_[p]);
+}
+
+// Exact products c s_p where one term makes a position (the usual case); the
+// sum of several rounds.
+void SparseExponential::scale_entries() {
     const SparseTerm *first = first_terms_.data();
+    const double *s = times_.data();
     double *scaled = scaled_.data();
-    const std::size_t count = first_terms_.size();
-    if (further_terms_.empty()) {  // the usual case: one term a position
-        for (std::size_t j = 0; j < count; ++j)
-            scaled[j] = t * (first[j].coefficient * g[first[j].parameter]);
-        return;
-    }
-    for (std::size_t j = 0; j < count; ++j)
-        scaled[j] = first[j].coefficient * g[first[j].parameter];
-    for (const Term &q : further_terms_) scaled[q.position] += q.coefficient * g[q.parameter];
-    for (std::size_t j = 0; j < count; ++j) scaled[j] *= t;
+    for (std::size_t j = 0; j < first_terms_.size(); ++j) scaled[j] = first[j].coefficient * s[first[j].parameter];
+    for (const Term &q : further_terms_) scaled[q.position] += q.coefficient * s[q.parameter];
 }
 
 // One pass over the nodes in topological order, each node's Taylor
@@ -409,7 +415,7 @@ bool SparseExponential::sweep(double *x) {
     double *acc = Lanes ? fixed_width : accumulator_.data();
     const double *a = scaled_.data();
     const std::uint32_t *column = columns_.data();
-    const double *inverse = inverse_.data();
+    const Reciprocal *inverse = inverse_.data();
     double *coefficients = coefficients_.data();
     bool finite = true;
     for (std::size_t v = 0; v < nodes_.size(); ++v) {
@@ -426,7 +432,7 @@ bool SparseExponential::sweep(double *x) {
         own[0] = x[node.global];
         double total = 0.0;
         for (std::size_t k = 0; k < lanes; ++k) {
-            const double term = acc[k] * inverse[k];
+            const double term = divided(acc[k], inverse[k]);
             total += term;
             if (k + 1 < lanes) own[k + 1] = term;
         }
@@ -444,14 +450,15 @@ bool SparseExponential::sweep(double *x) {
 // Depth 1 (every moved index reads fixed ones only: a shear, as the kick of
 // a pendulum): x_v += sum_j (t A)_vj x_j, the entries formed as read, one
 // term a position. The same sums, in the same order, as sweep<1>.
-inline bool SparseExponential::shear(const double *g, double t, double *x) {
+inline bool SparseExponential::shear(double *x) {
     const SparseTerm *term = first_terms_.data();
     const std::uint32_t *column = columns_.data();
+    const double *s = times_.data();
     bool finite = true;
     for (std::size_t v = 0; v < nodes_.size(); ++v) {
         double sum = 0.0;
         for (std::uint32_t i = 0; i < nodes_[v].fixed_columns; ++i, ++term, ++column)
-            sum += t * (term->coefficient * g[term->parameter]) * x[*column];
+            sum += (term->coefficient * s[term->parameter]) * x[*column];
         increment_[v] = x[nodes_[v].global] + sum;  // the new value, written once all are finite
         finite &= std::isfinite(increment_[v]);
     }
@@ -461,11 +468,12 @@ inline bool SparseExponential::shear(const double *g, double t, double *x) {
 }
 
 void SparseExponential::apply(const double *g, double t, double *x) {
+    shorten_times(g, t);
     if (shear_) {
-        if (!shear(g, t, x)) fail_nonfinite();
+        if (!shear(x)) fail_nonfinite();
         return;
     }
-    scale_entries(g, t);
+    scale_entries();
     switch (path_) {
         case ExpmPath::Plane: apply_plane(t, x); return;
         case ExpmPath::Pade: apply_pade(t, x); return;
