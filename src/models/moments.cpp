@@ -31,10 +31,12 @@ namespace {
 
 // I and K are evaluated in long double: with x87 extended precision its
 // exponent range (1e4932) holds the products of entries up to 1e308, so a
-// finite state never gives a NaN from inf - inf, and a Casimir whose value
-// is representable is returned even when its terms are not (entries near
-// 1e150: K ~ 1e450 terms); one that is not representable becomes +-inf,
-// which lpi_casimirs reports as LPI_ERR_OVERFLOW naming the Casimir.
+// finite state never gives a NaN from inf - inf, and a Casimir is returned
+// even when its terms overflow a double (entries near 1e150: K ~ 1e450
+// terms), with an error of 2^-64 of its largest term. Where that error
+// itself passes DBL_MAX (terms beyond about 3e327), a small value can come
+// out +-inf, as one that is not representable does: lpi_casimirs reports
+// LPI_ERR_OVERFLOW naming the Casimir (lpi_moments_create(3) says so).
 // Where long double is double, the same code is the plain double formula.
 template <class Real>
 Real invariant_I(const Real *x) {
