@@ -283,7 +283,7 @@ struct Piece {
             double total = 0.0;
             unroll<0, level>([&](auto k) {
                 constexpr Reciprocal inverse = reciprocal(k + 1);
-                const double term = divided(acc[k], inverse);
+                const double term = divided(acc[k], k + 1, inverse);
                 total += term;
                 c[v][k + 1] = term;
             });

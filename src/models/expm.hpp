@@ -141,17 +141,30 @@ constexpr int shortening_bits(double c) {
     return bits <= kMaxShorteningBits ? bits : -1;
 }
 
-// s rounded to its leading 53 - bits bits (ties away from zero), on its bit
-// pattern: exact for subnormals too, +-inf for a double that rounds up past
-// the largest.
+// s cut to its leading 53 - bits bits (towards zero): a time shorter by
+// less than 2^(bits-53) of itself, so the flow is still one of the algebra.
+// On the bit pattern, which vector types keep in a floating-point register
+// (a round trip through an integer register lengthened every flow's chain).
 inline double shortened(double s, int bits) {
     if (bits <= 0) return s;
+    const std::uint64_t mask = ~((std::uint64_t{1} << bits) - 1);
+#if defined(__GNUC__)
+    typedef double Double2 __attribute__((vector_size(16)));
+    typedef std::uint64_t Bits2 __attribute__((vector_size(16)));
+    const Double2 value = {s, s};
+    Bits2 pattern;
+    std::memcpy(&pattern, &value, sizeof value);
+    pattern &= Bits2{mask, mask};
+    Double2 cut;
+    std::memcpy(&cut, &pattern, sizeof cut);
+    return cut[0];
+#else
     std::uint64_t pattern = 0;
     std::memcpy(&pattern, &s, sizeof s);
-    const std::uint64_t unit = std::uint64_t{1} << bits;
-    pattern = (pattern + unit / 2) & ~(unit - 1);
+    pattern &= mask;
     std::memcpy(&s, &pattern, sizeof s);
     return s;
+#endif
 }
 
 // 1/k as hi + lo: hi the double nearest 1/k, lo the rest (0 for a power of
@@ -163,9 +176,10 @@ constexpr Reciprocal reciprocal(int k) {
     const double hi = 1.0 / k;
     return {hi, static_cast<double>((1.0L - static_cast<long double>(k) * hi) / k)};
 }
-// acc / k without 1/k's own rounding.
-inline double divided(double acc, const Reciprocal &r) {
-    return r.lo == 0.0 ? acc * r.hi : acc * r.hi + acc * r.lo;
+// acc / k without 1/k's own rounding, r = reciprocal(k). Asked of k, not of
+// r.lo, so that unrolled lanes know the answer when they are compiled.
+inline double divided(double acc, std::size_t k, const Reciprocal &r) {
+    return (k & (k - 1)) == 0 ? acc * r.hi : acc * r.hi + acc * r.lo;
 }
 
 // LPI_ERR_NONFINITE: the exact flow's increment of `component` is not finite.

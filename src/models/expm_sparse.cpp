@@ -432,7 +432,7 @@ bool SparseExponential::sweep(double *x) {
         own[0] = x[node.global];
         double total = 0.0;
         for (std::size_t k = 0; k < lanes; ++k) {
-            const double term = divided(acc[k], inverse[k]);
+            const double term = divided(acc[k], k + 1, inverse[k]);
             total += term;
             if (k + 1 < lanes) own[k + 1] = term;
         }
