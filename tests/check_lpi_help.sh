@@ -83,6 +83,23 @@ if [ -w /dev/full ]; then
 else
     echo "not checked: output to /dev/full (none here)"
 fi
+# The exit statuses lpi --help gives are those of man1 and lpi run --help.
+for status in 130 143; do
+    grep -q "$status" "$out/help" || { echo "lpi --help does not give exit status $status"; exit 1; }
+done
+# man1 as it renders: an alternating-font macro (.BR, .IR, ...) joins its
+# arguments without spaces, so an argument ending in prose punctuation
+# before another ran words together (".BR \-\-T ): leapfrog, mclachlan-4,").
+awk '/^\.(BR|RB|BI|IB|IR|RI) / {
+        line = substr($0, 5); n = 0
+        while (match(line, /^ *("[^"]*"|[^ ]+)/)) {
+            arg[++n] = substr(line, RSTART, RLENGTH); line = substr(line, RLENGTH + 1)
+        }
+        for (i = 1; i < n; ++i)
+            if (arg[i] ~ /[,;:]$/) { print FILENAME ":" FNR ": words run together: " $0; bad = 1; break }
+    } END { exit bad }' "$man1" || exit 1
+grep -q "Steps are 64-bit integers, everything else" "$man1" &&
+    { echo "man1: the integer datasets are more than the steps (/casimir, /component)"; exit 1; }
 for command in --version --help; do
     rc=0; "$lpi" $command --bogus >/dev/null 2>"$out/extra.err" || rc=$?
     [ "$rc" -eq 2 ] && grep -q -e "--bogus" "$out/extra.err" ||

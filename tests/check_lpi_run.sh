@@ -52,6 +52,13 @@ refused --out report --out
 refused no-such-scene report no-such-scene
 refused --bogus report --bogus
 refused FILTER stress a b
+# An option may be given once, a flag too; an operand is never empty; an
+# argument after a command's --help is refused, not ignored.
+refused --quick stress --quick --quick "pendulum near"
+refused "empty argument" stress "" "pendulum near"
+refused "empty argument" run "" rigid-body --steps 2 --out "$out/bad"
+refused "empty argument" report "" --out "$out/bad"
+for command in run report stress methods; do refused --bogus $command --help --bogus; done
 refused no-such-case stress no-such-case
 refused --bogus stress --bogus
 refused argument methods extra

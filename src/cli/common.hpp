@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdarg>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -22,6 +23,21 @@
 namespace lpi_cli {
 
 constexpr double kPi = 3.14159265358979323846;
+
+// printf into a std::string.
+inline std::string format(const char *pattern, ...) __attribute__((format(printf, 1, 2)));
+inline std::string format(const char *pattern, ...) {
+    va_list args, again;
+    va_start(args, pattern);
+    va_copy(again, args);
+    const int n = std::vsnprintf(nullptr, 0, pattern, args);
+    va_end(args);
+    std::string text(static_cast<std::size_t>(std::max(n, 0)) + 1, '\0');
+    std::vsnprintf(&text[0], text.size(), pattern, again);
+    va_end(again);
+    text.resize(static_cast<std::size_t>(std::max(n, 0)));
+    return text;
+}
 
 inline double cpu_seconds() {
     timespec ts;
@@ -44,9 +60,10 @@ inline bool close_written(FILE *f) {
     return std::fclose(f) == 0 && written;
 }
 
-// Says on standard error that `path` was not written (errno: why); false.
-inline bool cannot_write(const std::string &path) {
-    std::fprintf(stderr, "lpi: cannot write %s: %s\n", path.c_str(), std::strerror(errno));
+// Says on standard error why an output was not written (`why` names the
+// file and the reason: output.hpp); false.
+inline bool cannot_write(const std::string &why) {
+    std::fprintf(stderr, "lpi: %s\n", why.c_str());
     return false;
 }
 
@@ -79,6 +96,28 @@ public:
 
     // Whether `arg` asks for the command's usage.
     static bool is_help(const std::string &arg) { return arg == "--help" || arg == "-h"; }
+
+    // Whether `arg` (just read by next()) asks for the command's usage, which
+    // then is all it does: an argument after it would be ignored, so it is
+    // refused.
+    bool help(const std::string &arg) {
+        if (!is_help(arg)) return false;
+        if (!done()) fail("takes no argument after " + arg + " ('" + argv_[next_] + "')");
+        return true;
+    }
+
+    // A flag (an option without a value), given once like every option.
+    void flag(const std::string &option) {
+        if (!seen_.insert(option).second) fail(option + " is given twice");
+    }
+
+    // `arg`, which matched none of the command's options, as an operand (a
+    // scene, a filter): neither an option nor empty.
+    std::string operand(const std::string &arg, const std::string &what) {
+        refuse_unknown_option(arg);
+        if (arg.empty()) fail("an empty argument is not a " + what);
+        return arg;
+    }
 
     // Stops the command when `arg`, which matched none of its options, looks
     // like an option ("-x"): it is then no operand either.

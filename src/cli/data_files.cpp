@@ -8,6 +8,8 @@
 #include <cstring>
 #include <memory>
 
+#include "output.hpp"
+
 #if LPI_CLI_HAVE_HDF5
 #include <hdf5.h>
 #include <hdf5_hl.h>
@@ -29,41 +31,6 @@ std::size_t element_count(const std::vector<std::size_t> &shape, bool *too_many)
         count = *too_many ? 0 : count * n;
     }
     return count;
-}
-
-// A temporary file beside `path` (same directory, so rename is atomic).
-struct TemporaryFile {
-    std::string name;
-    int fd = -1;
-    explicit TemporaryFile(const std::string &path) : name(path + ".tmp-XXXXXX") {
-        fd = mkstemp(&name[0]);
-    }
-    ~TemporaryFile() {
-        if (fd >= 0) close(fd);
-        if (!name.empty()) unlink(name.c_str());
-    }
-    // fsync, close and rename onto `path`; "" or the reason.
-    std::string commit(const std::string &path) {
-        std::string why;
-        if (fsync(fd) != 0) why = std::strerror(errno);
-        if (close(fd) != 0 && why.empty()) why = std::strerror(errno);
-        fd = -1;
-        if (why.empty() && std::rename(name.c_str(), path.c_str()) != 0) why = std::strerror(errno);
-        if (why.empty()) name.clear();  // renamed: nothing left to remove
-        return why;
-    }
-};
-
-bool write_all(int fd, const void *data, std::size_t size) {
-    const char *p = static_cast<const char *>(data);
-    while (size > 0) {
-        const ssize_t n = write(fd, p, size);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) return false;
-        p += n;
-        size -= static_cast<std::size_t>(n);
-    }
-    return true;
 }
 
 // Little-endian bytes, whatever the host's order.
@@ -138,11 +105,10 @@ std::string npy_header(const Array &a) {
     return header + dict;
 }
 
-std::string write_npy(const std::string &path, const Array &a) {
-    TemporaryFile tmp(path);
-    if (tmp.fd < 0) return std::string("cannot create a file beside it: ") + std::strerror(errno);
-    const std::string header = npy_header(a);
-    std::vector<unsigned char> data(8 * a.values.size());
+std::string npy_file(const Array &a) {
+    std::string file = npy_header(a);
+    const std::size_t at = file.size();
+    file.resize(at + 8 * a.values.size());
     for (std::size_t i = 0; i < a.values.size(); ++i) {
         std::uint64_t bits;
         if (a.integer) {
@@ -150,32 +116,31 @@ std::string write_npy(const std::string &path, const Array &a) {
         } else {
             std::memcpy(&bits, &a.values[i], 8);
         }
-        put_le(bits, &data[8 * i]);
+        put_le(bits, reinterpret_cast<unsigned char *>(&file[at + 8 * i]));
     }
-    if (!write_all(tmp.fd, header.data(), header.size()) || !write_all(tmp.fd, data.data(), data.size()))
-        return std::strerror(errno);
-    return tmp.commit(path);
+    return file;
 }
 
-std::string read_npy(const std::string &path, Array &a) {
-    std::unique_ptr<FILE, int (*)(FILE *)> f(std::fopen(path.c_str(), "rb"), std::fclose);
-    if (!f) return std::strerror(errno);
+namespace {
+
+// read_npy of an opened file.
+std::string parse_npy(RegularFileReader &f, Array &a) {
     unsigned char start[12];
-    if (std::fread(start, 1, 10, f.get()) != 10 || std::memcmp(start, "\x93NUMPY", 6) != 0)
+    if (f.read(start, 10) != 10 || std::memcmp(start, "\x93NUMPY", 6) != 0)
         return "not a NumPy .npy file (no \\x93NUMPY magic)";
     const int major = start[6];
     std::size_t length = 0;
     if (major == 1) {
         length = get_le(start + 8, 2);
     } else if (major == 2 || major == 3) {
-        if (std::fread(start + 10, 1, 2, f.get()) != 2) return "truncated header";
+        if (f.read(start + 10, 2) != 2) return "truncated header";
         length = get_le(start + 8, 4);
     } else {
         return "NumPy format version " + std::to_string(major) + " is not known here (1, 2 or 3)";
     }
     if (length > 1 << 20) return "header length " + std::to_string(length) + " is absurd";
     std::string header(length, '\0');
-    if (std::fread(&header[0], 1, length, f.get()) != length) return "truncated header";
+    if (f.read(reinterpret_cast<unsigned char *>(&header[0]), length) != length) return "truncated header";
     const std::string descr = header_value(header, "descr");
     const std::string order = header_value(header, "fortran_order");
     int item = 0;
@@ -194,9 +159,10 @@ std::string read_npy(const std::string &path, Array &a) {
     const std::size_t count = element_count(out.shape, &too_many);
     if (too_many) return "more than 2^28 values";
     std::vector<unsigned char> bytes(count * item);
-    if (std::fread(bytes.data(), 1, bytes.size(), f.get()) != bytes.size())
+    if (f.read(bytes.data(), bytes.size()) != bytes.size())
         return "truncated: the data is shorter than its shape says";
-    if (std::fgetc(f.get()) != EOF) return "bytes after the data its shape says";
+    unsigned char extra;
+    if (f.read(&extra, 1) != 0) return "bytes after the data its shape says";
     out.values.resize(count);
     for (std::size_t i = 0; i < count; ++i) {
         const std::uint64_t bits = get_le(&bytes[i * item], item);
@@ -228,15 +194,29 @@ std::string read_npy(const std::string &path, Array &a) {
     return "";
 }
 
+}  // namespace
+
+std::string read_npy(const std::string &path, Array &a) {
+    std::string why;
+    const std::string unreadable = failure_of([&] {
+        RegularFileReader f(path);
+        why = parse_npy(f, a);
+    });
+    return unreadable.empty() ? why : unreadable;
+}
+
 bool is_hdf5_file(const std::string &path) {
     // The signature is at offset 0 or, after a user block, 512, 1024, ...
-    std::unique_ptr<FILE, int (*)(FILE *)> f(std::fopen(path.c_str(), "rb"), std::fclose);
-    if (!f) return false;
-    for (long offset = 0; offset <= (1L << 20); offset = offset ? 2 * offset : 512) {
-        unsigned char signature[8];
-        if (std::fseek(f.get(), offset, SEEK_SET) != 0 || std::fread(signature, 1, 8, f.get()) != 8) return false;
-        if (std::memcmp(signature, "\x89HDF\r\n\x1a\n", 8) == 0) return true;
-    }
+    // A file that is not regular (a FIFO) is none: its reader says so.
+    std::vector<unsigned char> start;
+    const std::string unreadable = failure_of([&] {
+        RegularFileReader f(path);
+        start.resize(std::min<std::size_t>(f.size(), (std::size_t(1) << 20) + 8));
+        start.resize(f.read(start.data(), start.size()));
+    });
+    if (!unreadable.empty()) return false;
+    for (std::size_t offset = 0; offset + 8 <= start.size(); offset = offset ? 2 * offset : 512)
+        if (std::memcmp(&start[offset], "\x89HDF\r\n\x1a\n", 8) == 0) return true;
     return false;
 }
 
@@ -295,12 +275,16 @@ bool have_hdf5() { return true; }
 std::string write_hdf5(const std::string &path, const std::vector<Dataset> &datasets,
                        const std::vector<Attribute> &attributes, std::vector<std::uint64_t> *offsets) {
     quiet_hdf5();
-    TemporaryFile tmp(path);
-    if (tmp.fd < 0) return std::string("cannot create a file beside it: ") + std::strerror(errno);
-    std::string why;
+    // HDF5 writes the temporary file by its name.
+    std::unique_ptr<FileReplacement> tmp;
+    std::string why = failure_of([&] {
+        tmp = std::make_unique<FileReplacement>(path);
+        tmp->close_descriptor();
+    });
+    if (!why.empty()) return why;
     {
-        Id file(H5Fcreate(tmp.name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
-        if (!file.ok()) return "HDF5 cannot create " + tmp.name;
+        Id file(H5Fcreate(tmp->temporary().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+        if (!file.ok()) return "HDF5 cannot create " + tmp->temporary();
         // No modification times in the objects: the same run gives the same bytes.
         Id creation(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
         H5Pset_obj_track_times(creation.get(), false);
@@ -343,9 +327,9 @@ std::string write_hdf5(const std::string &path, const std::vector<Dataset> &data
             if (!why.empty()) return "HDF5 cannot write " + why;
         }
         ids.clear();
-        if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0) return "HDF5 cannot flush " + tmp.name;
+        if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0) return "HDF5 cannot flush " + tmp->temporary();
     }
-    return tmp.commit(path);
+    return failure_of([&] { tmp->commit(); });
 }
 
 std::string read_hdf5(const std::string &path, const std::string &name, Array &a, bool *found) {

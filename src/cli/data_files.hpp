@@ -21,9 +21,8 @@ struct Array {
 // ('<f8' or '<i8', C order), padded with spaces to a multiple of 64 bytes.
 std::string npy_header(const Array &a);
 
-// Writes `a` as .npy atomically (a temporary file beside it, then rename).
-// Returns "" or the reason it failed.
-std::string write_npy(const std::string &path, const Array &a);
+// The bytes of `a` as a .npy file: its header, then the values.
+std::string npy_file(const Array &a);
 
 // Reads a .npy file (format 1.0, 2.0 or 3.0) of little-endian float64,
 // float32, int64 or int32, in C or Fortran order, into C order. Returns "" or
@@ -55,7 +54,7 @@ bool have_hdf5();
 
 // Writes the datasets (contiguous, so that other programs, gnuplot among
 // them, can read the raw data at a byte offset) and the attributes to one
-// HDF5 file, atomically. `offsets` receives, per dataset, the byte offset of
+// HDF5 file, atomically (output.hpp). `offsets` receives, per dataset, the byte offset of
 // its raw data in the file. Returns "" or the reason it failed.
 std::string write_hdf5(const std::string &path, const std::vector<Dataset> &datasets,
                        const std::vector<Attribute> &attributes, std::vector<std::uint64_t> *offsets);

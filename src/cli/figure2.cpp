@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "output.hpp"
 #include "plots.hpp"
 #include "scenes.hpp"
 #include "systems.hpp"
@@ -28,9 +29,7 @@ bool run_figure2(const std::string &out_dir) {
                 static_cast<long long>(steps));
     std::printf("   field: |w| = 1 over one mode of each pair +-m (w_0 = 0), H(0) = %.15g\n", H0);
     const std::string csv = out_dir + "/figure2.csv";
-    FILE *f = std::fopen(csv.c_str(), "w");
-    if (!f) return cannot_write(csv);
-    std::fprintf(f, "time,energy_error,c2_drift,spectrum_drift\n");
+    std::string text = "time,energy_error,c2_drift,spectrum_drift\n";
     double worst_first = 0.0, worst_second = 0.0, c2_drift = 0.0, spectrum_change = 0.0;
     const double t0 = cpu_seconds();
     for (int64_t done = 0; done < steps; done += every) {
@@ -44,10 +43,11 @@ bool run_figure2(const std::string &out_dir) {
         }
         (done < steps / 2 ? worst_first : worst_second) =
             std::max(done < steps / 2 ? worst_first : worst_second, std::fabs(rel));
-        std::fprintf(f, "%.6g,%.6e,%.6e,%.6e\n", lpi_time(h.get()), rel, c2_drift, spectrum_change);
+        text += format("%.6g,%.6e,%.6e,%.6e\n", lpi_time(h.get()), rel, c2_drift, spectrum_change);
     }
     const double cpu = cpu_seconds() - t0;
-    if (!close_written(f)) return cannot_write(csv);
+    std::string why = write_output(csv, text);
+    if (!why.empty()) return cannot_write(why);
     std::printf("   max |H - H0|/H0: %.3e over t in [0, 2500], %.3e over [2500, 5000]: %s\n",
                 worst_first, worst_second,
                 worst_second <= 1.5 * worst_first ? "bounded, no secular growth" : "GROWING");
@@ -61,32 +61,27 @@ bool run_figure2(const std::string &out_dir) {
         std::printf("   gnuplot not found: no PNG\n");
         return true;
     }
-    const std::string script = out_dir + "/figure2.gp";
-    FILE *g = std::fopen(script.c_str(), "w");
-    if (!g) return cannot_write(script);
+    PlotScript script(out_dir, "figure2.gp");
     // The drift starts at round-off: its axis spans the decades from there.
     Range drift;
     drift.add(1e-16);
     drift.add(std::max(c2_drift, spectrum_change));
-    std::fprintf(g, "set datafile separator ','\nset grid\nset tics out nomirror\nset border 3\n"
-                    "set xlabel 'time'\nset key top left\n");
+    script += "set datafile separator ','\nset grid\nset tics out nomirror\nset border 3\n"
+              "set xlabel 'time'\nset key top left\n";
     const std::string commands =
         "set multiplot layout 2,1\nunset logscale y\nset autoscale y\nset ytics autofreq\nset mytics default\n"
         "set format y '%g'\nset title 'McLachlan 1993, Figure 2: sine-Euler N = 7, leapfrog, dt = 0.05' noenhanced\n"
-        "set ylabel '(H(t) - H(0)) / H(0)  [10^{-5}]'\n" +
-        format("plot '%s' using 1:($2 * 1e5) every ::1 with lines lc rgb '#0072b2' notitle\n", csv.c_str()) +
+        "set ylabel '(H(t) - H(0)) / H(0)  [10^{-5}]'\n"
+        "plot 'figure2.csv' using 1:($2 * 1e5) every ::1 with lines lc rgb '#0072b2' notitle\n"
         "set title 'Casimir drift'\nset ylabel 'relative drift'\n" + decade_axis("y", drift.lo, drift.hi) +
-        format("plot '%s' using 1:($3 > 0 ? $3 : 1/0) every ::1 with lines lc rgb '#d55e00' lw 1.5 "
-               "title 'C_2 = {/Symbol S} |w|^2', '%s' using 1:($4 > 0 ? $4 : 1/0) every ::1 with lines "
-               "lc rgb '#009e73' dt 2 lw 1.5 title 'spectrum of W'\nunset multiplot\n",
-               csv.c_str(), csv.c_str());
-    emit_figure(g, out_dir + "/figure2", 1000, 700, commands);
-    switch (finish_plot(g, script)) {
-    case Plot::drawn: std::printf("   wrote %s/figure2.png and .svg\n", out_dir.c_str()); return true;
-    case Plot::gnuplot_failed: std::printf("   gnuplot failed: see %s\n", script.c_str()); return true;
-    case Plot::not_written: return false;
-    }
-    return false;
+        "plot 'figure2.csv' using 1:($3 > 0 ? $3 : 1/0) every ::1 with lines lc rgb '#d55e00' lw 1.5 "
+        "title 'C_2 = {/Symbol S} |w|^2', 'figure2.csv' using 1:($4 > 0 ? $4 : 1/0) every ::1 with lines "
+        "lc rgb '#009e73' dt 2 lw 1.5 title 'spectrum of W'\nunset multiplot\n";
+    script.add_figure("figure2", 1000, 700, commands);
+    why = script.draw();
+    if (!why.empty()) return cannot_write(why);
+    std::printf("   wrote %s/figure2.png and .svg\n", out_dir.c_str());
+    return true;
 }
 
 }  // namespace lpi_cli

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "output.hpp"
 #include "plots.hpp"
 #include "report.hpp"
 
@@ -74,41 +75,34 @@ std::string format_steps(const std::vector<double> &steps) {
     return text;
 }
 
-// False, having said so, when a file was not written.
-bool write_long_csv(const std::string &base, const LongRunScene &scene, const std::vector<LongRow> &rows) {
-    const std::string csv = base + ".csv", history = base + "_history.csv";
-    FILE *f = std::fopen(csv.c_str(), "w");
-    if (!f) return cannot_write(csv);
-    FILE *g = std::fopen(history.c_str(), "w");
-    if (!g) {
-        cannot_write(history);
-        std::fclose(f);
-        return false;
-    }
-    std::fprintf(f, "scene,run,method,order,poisson,dt,steps,cpu_seconds,max_energy_error,"
-                    "max_casimir_drift,final_casimir_drift,reached_time,status\n");
-    std::fprintf(g, "run,method,dt,time,energy_error,casimir_drift\n");
+// Writes BASE.csv and BASE_history.csv: "" or why not.
+std::string write_long_csv(const std::string &base, const LongRunScene &scene, const std::vector<LongRow> &rows) {
+    std::string csv = "scene,run,method,order,poisson,dt,steps,cpu_seconds,max_energy_error,"
+                      "max_casimir_drift,final_casimir_drift,reached_time,status\n";
+    std::string history = "run,method,dt,time,energy_error,casimir_drift\n";
     for (const LongRow &r : rows) {
         const int i = method_index(r.method);
-        std::fprintf(f, "%s,%d,%s,%d,%d,%.17g,%lld,%.6e,%.6e,%.6e,%.6e,%.10g,%s\n", scene.name.c_str(),
-                     r.run, r.method.c_str(), lpi_method_order(i), lpi_method_is_poisson(i), r.dt,
-                     static_cast<long long>(r.steps), r.cpu, r.energy_error, r.casimir_drift,
-                     r.final_casimir_drift, r.reached, lpi_status_name(r.status));
+        csv += format("%s,%d,%s,%d,%d,%.17g,%lld,%.6e,%.6e,%.6e,%.6e,%.10g,%s\n", scene.name.c_str(), r.run,
+                      r.method.c_str(), lpi_method_order(i), lpi_method_is_poisson(i), r.dt,
+                      static_cast<long long>(r.steps), r.cpu, r.energy_error, r.casimir_drift,
+                      r.final_casimir_drift, r.reached, lpi_status_name(r.status));
         for (const Sample &s : r.history)
-            std::fprintf(g, "%d,%s,%.17g,%.10g,%.6e,%.6e\n", r.run, r.method.c_str(), r.dt, s.time,
-                         s.energy_error, s.casimir_drift);
+            history += format("%d,%s,%.17g,%.10g,%.6e,%.6e\n", r.run, r.method.c_str(), r.dt, s.time,
+                              s.energy_error, s.casimir_drift);
     }
-    const bool csv_written = close_written(f) || cannot_write(csv);
-    return (close_written(g) || cannot_write(history)) && csv_written;
+    const std::string why = write_output(base + ".csv", csv);
+    return why.empty() ? write_output(base + "_history.csv", history) : why;
 }
 
 // Max energy error and max Casimir drift against CPU time (one curve per
 // method through its step sizes), and both against time for the run of each
 // method whose CPU time is nearest `history_cpu`.
-Plot plot_long(const std::string &base, const LongRunScene &scene, const std::vector<LongRow> &rows,
-               const std::vector<std::string> &methods, double history_cpu) {
-    FILE *f = open_plot_script(base + ".gp");
-    if (!f) return Plot::not_written;
+// "" or why not.
+std::string plot_long(const std::string &dir, const LongRunScene &scene, const std::vector<LongRow> &rows,
+                      const std::vector<std::string> &methods, double history_cpu) {
+    const std::string &base = scene.name;  // in dir
+    PlotScript script(dir, base + ".gp");
+    script += csv_plot_preamble();
     const char *energy_label = "|H(t) - H(0)| / |H(0)|";
     const char *casimir_label = "max_i |{/Symbol l}_i(t) - {/Symbol l}_i(0)| / max_i |{/Symbol l}_i(0)|";
     struct Panel {
@@ -145,7 +139,7 @@ Plot plot_long(const std::string &base, const LongRunScene &scene, const std::ve
                                plot_style(i, methods[i]).c_str(), method_label(methods[i]).c_str(),
                                format_steps(steps).c_str());
         }
-        emit_figure(f, base + "_" + p.file, 1000, 820, commands + "\n");
+        script.add_figure(base + "_" + p.file, 1000, 820, commands + "\n");
     }
     // Against time: one panel per measure, the key once, on the right; each
     // method's run nearest the given CPU time.
@@ -188,8 +182,8 @@ Plot plot_long(const std::string &base, const LongRunScene &scene, const std::ve
         }
         commands += "\nunset key\n";
     }
-    emit_figure(f, base + "_history", 1000, 900, commands + "unset multiplot\n");
-    return finish_plot(f, base + ".gp");
+    script.add_figure(base + "_history", 1000, 900, commands + "unset multiplot\n");
+    return script.draw();
 }
 
 }  // namespace
@@ -269,7 +263,8 @@ bool run_long_scene(const LongRunScene &scene, const std::string &out_dir) {
     }
 
     const std::string base = out_dir + "/" + scene.name;
-    if (!write_long_csv(base, scene, rows)) return false;
+    std::string why = write_long_csv(base, scene, rows);
+    if (!why.empty()) return cannot_write(why);
     std::printf("   wrote %s.csv and %s_history.csv (every sample of every run)\n", base.c_str(), base.c_str());
     // The history plot compares the methods at about equal cost: the
     // geometric mean of all successful runs' CPU times.
@@ -285,15 +280,11 @@ bool run_long_scene(const LongRunScene &scene, const std::string &out_dir) {
         std::printf("   no run succeeded: no plots\n");
         return true;
     }
-    switch (plot_long(base, scene, rows, methods, std::exp(log_sum / count))) {
-    case Plot::drawn:
-        std::printf("   wrote %s_energy.png, %s_casimirs.png and %s_history.png\n", base.c_str(), base.c_str(),
-                    base.c_str());
-        return true;
-    case Plot::gnuplot_failed: std::printf("   gnuplot failed: see %s.gp\n", base.c_str()); return true;
-    case Plot::not_written: return false;
-    }
-    return false;
+    why = plot_long(out_dir, scene, rows, methods, std::exp(log_sum / count));
+    if (!why.empty()) return cannot_write(why);
+    std::printf("   wrote %s_energy.png, %s_casimirs.png and %s_history.png\n", base.c_str(), base.c_str(),
+                base.c_str());
+    return true;
 }
 
 }  // namespace lpi_cli

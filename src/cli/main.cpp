@@ -46,7 +46,8 @@ void print_usage(FILE *to) {
                  "           energy error, Casimir drift and status per case, step and method\n"
                  "       lpi methods   the integration methods: name, order, stages, reference\n"
                  "       lpi --version | --help\n"
-                 "exit status: 0 success, 1 a failure, 2 a bad option, 130 interrupted (lpi run)\n");
+                 "exit status: 0 success, 1 a failure, 2 a bad option, 130 (143) interrupted by\n"
+                 "SIGINT (SIGTERM) (lpi run)\n");
     print_scenes(to);
 }
 
@@ -78,12 +79,11 @@ int report_command(int argc, char **argv) {
             if (scene_options.sine_euler_n % 2 == 0) args.fail("--N must be odd");
         } else if (arg == "--T") {
             scene_options.long_run_time = args.positive(arg);
-        } else if (Arguments::is_help(arg)) {
+        } else if (args.help(arg)) {
             print_report_usage(stdout);
             return 0;
         } else {
-            args.refuse_unknown_option(arg);
-            names.push_back(arg);
+            names.push_back(args.operand(arg, "SCENE"));
         }
     }
     const std::vector<Scene> all = builtin_scenes(scene_options);
@@ -123,7 +123,7 @@ int methods_command(int argc, char **argv) {
     Arguments args("lpi methods", argc, argv);
     while (!args.done()) {
         const std::string arg = args.next();
-        if (Arguments::is_help(arg)) {
+        if (args.help(arg)) {
             std::printf("usage: lpi methods\n  the integration methods (lpi run --method NAME): name, order,\n"
                         "  stages (leapfrog-equivalent cost), Poisson (keeps Casimirs to round-off),\n"
                         "  reference\n");

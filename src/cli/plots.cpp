@@ -1,8 +1,19 @@
 #include "plots.hpp"
 
-#include <cstdlib>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
-#include "common.hpp"
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+
+#include "output.hpp"
+
+extern char **environ;
 
 namespace lpi_cli {
 
@@ -15,11 +26,85 @@ int method_index(const std::string &method) {
 
 bool is_poisson(const std::string &method) { return lpi_method_is_poisson(method_index(method)) == 1; }
 
-bool have_gnuplot() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
-
-bool run_gnuplot(const std::string &script) {
-    return std::system(("gnuplot '" + script + "' 2>/dev/null").c_str()) == 0;
+// The PATH lookup execvp makes, without a shell.
+bool have_gnuplot() {
+    const char *path = std::getenv("PATH");
+    const std::string dirs = path ? path : "/usr/bin:/bin";
+    for (std::size_t from = 0;;) {
+        const std::size_t colon = dirs.find(':', from);
+        const std::string dir = dirs.substr(from, colon - from);
+        const std::string file = (dir.empty() ? "." : dir) + "/gnuplot";
+        struct stat st;
+        if (stat(file.c_str(), &st) == 0 && S_ISREG(st.st_mode) && access(file.c_str(), X_OK) == 0) return true;
+        if (colon == std::string::npos) return false;
+        from = colon + 1;
+    }
 }
+
+namespace {
+
+// Runs `gnuplot SCRIPT` in `dir`: no shell, so no name is ever parsed as a
+// command; its output discarded, what it says on standard error kept for the
+// message of a failure. "" when it succeeded, else why not.
+std::string run_gnuplot(const std::string &dir, const std::string &script) {
+    int pipe_fds[2];
+    if (pipe2(pipe_fds, O_CLOEXEC) != 0) return std::string("cannot run gnuplot: ") + std::strerror(errno);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], 2);
+    posix_spawn_file_actions_addchdir_np(&actions, dir.c_str());
+    std::string program = "gnuplot", argument = script;
+    char *argv[] = {&program[0], &argument[0], nullptr};
+    pid_t pid = 0;
+    const int spawned = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
+    posix_spawn_file_actions_destroy(&actions);
+    close(pipe_fds[1]);
+    std::string said;
+    if (spawned == 0) {
+        char chunk[4096];
+        for (;;) {
+            const ssize_t n = read(pipe_fds[0], chunk, sizeof chunk);
+            if (n < 0 && errno == EINTR) continue;  // a signal lpi run notes
+            if (n <= 0) break;
+            said.append(chunk, static_cast<std::size_t>(n));
+        }
+    }
+    close(pipe_fds[0]);
+    if (spawned != 0) return std::string("cannot run gnuplot: ") + std::strerror(spawned);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "";
+    while (!said.empty() && (said.back() == '\n' || said.back() == ' ')) said.pop_back();
+    while (!said.empty() && said.front() == '\n') said.erase(0, 1);
+    if (WIFSIGNALED(status)) return "gnuplot was killed by signal " + std::to_string(WTERMSIG(status));
+    return said.empty() ? "gnuplot exited with status " + std::to_string(WEXITSTATUS(status)) : said;
+}
+
+// Replaces every `from` in `text` by `to`.
+void replace_all(std::string &text, const std::string &from, const std::string &to) {
+    for (std::size_t at = 0; (at = text.find(from, at)) != std::string::npos; at += to.size())
+        text.replace(at, from.size(), to);
+}
+
+// A name as a gnuplot string ('' inside single quotes is one quote); a
+// control character (a line break would end the command) is refused.
+bool gnuplot_string(const std::string &name, std::string &quoted) {
+    quoted = "'";
+    for (char c : name) {
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return false;
+        quoted += c == '\'' ? std::string("''") : std::string(1, c);
+    }
+    quoted += "'";
+    return true;
+}
+
+// An image's mark in a script's text until draw() names it.
+std::string mark(std::size_t i) { return "\x01" + std::to_string(i) + "\x01"; }
+
+}  // namespace
 
 // The i-th method's colour in a plot: twenty that read apart on white
 // (Okabe and Ito's, then Kelly's colours of maximum contrast).
@@ -54,22 +139,77 @@ std::string method_label(const std::string &method) {
            (stages == 1 ? " stage)" : " stages)");
 }
 
-// Starts a gnuplot script: CSV input, a grid, the key outside.
-FILE *open_plot_script(const std::string &path) {
-    FILE *f = std::fopen(path.c_str(), "w");
-    if (!f) cannot_write(path);
-    else
-        std::fprintf(f, "set datafile separator ','\nset grid xtics ytics mxtics mytics lw 0.5, lw 0.2\n"
-                        "set key below center horizontal maxcols 3 samplen 3\nset xlabel offset 0,0.5\nset bmargin 12\nset tics out nomirror\nset border 3\n");
-    return f;
+std::string csv_plot_preamble() {
+    return "set datafile separator ','\nset grid xtics ytics mxtics mytics lw 0.5, lw 0.2\n"
+           "set key below center horizontal maxcols 3 samplen 3\nset xlabel offset 0,0.5\nset bmargin 12\n"
+           "set tics out nomirror\nset border 3\n";
 }
 
-Plot finish_plot(FILE *f, const std::string &path) {
-    if (!close_written(f)) {
-        cannot_write(path);
-        return Plot::not_written;
+std::string PlotScript::output(const std::string &image) {
+    images_.push_back(image);
+    return "set output " + mark(images_.size() - 1) + "\n";
+}
+
+void PlotScript::add_figure(const std::string &base, int width, int height, const std::string &commands) {
+    text_ += format("set terminal pngcairo size %d,%d enhanced font ',11'\n", width, height) +
+             output(base + ".png") + commands;
+    text_ += format("set terminal svg size %d,%d enhanced font 'Helvetica,11' background '#ffffff'\n", width,
+                    height) +
+             output(base + ".svg") + commands + "set output\n";
+}
+
+std::string PlotScript::with_names(const std::vector<std::string> &names) const {
+    std::string text = text_;
+    for (std::size_t i = names.size(); i-- > 0;) replace_all(text, mark(i), names[i]);
+    return text;
+}
+
+std::string PlotScript::draw() const {
+    const std::string script = dir_ + "/" + name_;
+    std::vector<std::string> quoted(images_.size());
+    for (std::size_t i = 0; i < images_.size(); ++i)
+        if (!gnuplot_string(images_[i], quoted[i])) return "cannot draw " + dir_ + "/" + images_[i];
+    std::string why = write_output(script, with_names(quoted));
+    if (!why.empty()) return why;
+    // gnuplot runs a copy of the script that draws each image into its
+    // temporary file: a temporary beside the script, removed afterwards.
+    std::vector<std::unique_ptr<FileReplacement>> drawn;
+    std::unique_ptr<FileReplacement> run;
+    std::vector<std::string> temporaries;
+    why = failure_of([&] {
+        for (const std::string &image : images_) {
+            drawn.push_back(std::make_unique<FileReplacement>(dir_ + "/" + image));
+            drawn.back()->close_descriptor();
+            temporaries.push_back(drawn.back()->temporary());
+        }
+        run = std::make_unique<FileReplacement>(script);
+    });
+    if (!why.empty()) return why;
+    // A temporary is in the directory, or beside the file a symbolic link
+    // there names: as gnuplot sees it from the directory, its name or its path.
+    auto seen_from_dir = [&](const std::string &path) {
+        return path.compare(0, dir_.size() + 1, dir_ + "/") == 0 ? path.substr(dir_.size() + 1) : path;
+    };
+    for (std::size_t i = 0; i < temporaries.size(); ++i) {
+        temporaries[i] = seen_from_dir(temporaries[i]);
+        if (!gnuplot_string(temporaries[i], quoted[i])) return "cannot draw " + dir_ + "/" + images_[i];
     }
-    return run_gnuplot(path) ? Plot::drawn : Plot::gnuplot_failed;
+    const std::string text = with_names(quoted);
+    why = failure_of([&] {
+        run->write(reinterpret_cast<const unsigned char *>(text.data()), text.size());
+        run->close_descriptor();
+    });
+    if (!why.empty()) return why;
+    std::string said = run_gnuplot(dir_, seen_from_dir(run->temporary()));
+    if (!said.empty()) {
+        // Its messages name the files lpi names.
+        replace_all(said, seen_from_dir(run->temporary()), name_);
+        for (std::size_t i = 0; i < temporaries.size(); ++i) replace_all(said, temporaries[i], images_[i]);
+        return "gnuplot failed on " + script + ": " + said;
+    }
+    return failure_of([&] {
+        for (auto &image : drawn) image->commit();
+    });
 }
 
 }  // namespace lpi_cli

@@ -7,6 +7,9 @@
 #include <cstdarg>
 #include <cstdio>
 #include <string>
+#include <vector>
+
+#include "common.hpp"
 
 namespace lpi_cli {
 
@@ -37,37 +40,13 @@ struct Range {
     }
 };
 
-// Writes a figure's commands twice: BASE.png, then BASE.svg beside it.
-inline void emit_figure(FILE *f, const std::string &base, int width, int height, const std::string &commands) {
-    std::fprintf(f, "set terminal pngcairo size %d,%d enhanced font ',11'\nset output '%s.png'\n%s",
-                 width, height, base.c_str(), commands.c_str());
-    std::fprintf(f, "set terminal svg size %d,%d enhanced font 'Helvetica,11' background '#ffffff'\n"
-                    "set output '%s.svg'\n%sset output\n",
-                 width, height, base.c_str(), commands.c_str());
-}
-
-inline std::string format(const char *pattern, ...) __attribute__((format(printf, 1, 2)));
-inline std::string format(const char *pattern, ...) {
-    va_list args, again;
-    va_start(args, pattern);
-    va_copy(again, args);
-    const int n = std::vsnprintf(nullptr, 0, pattern, args);
-    va_end(args);
-    std::string text(static_cast<std::size_t>(std::max(n, 0)) + 1, '\0');
-    std::vsnprintf(&text[0], text.size(), pattern, again);
-    va_end(again);
-    text.resize(static_cast<std::size_t>(std::max(n, 0)));
-    return text;
-}
-
 // Index of a registered method, -1 if none has that name.
 int method_index(const std::string &method);
 // Whether the registered method of that name is a Poisson map.
 bool is_poisson(const std::string &method);
-// Whether gnuplot is on the PATH: without it the figures are left out.
+// Whether gnuplot is on the PATH: without it the figures are left out, and
+// the commands say so (lpi(1)).
 bool have_gnuplot();
-// Runs a gnuplot script (its messages silenced); whether it succeeded.
-bool run_gnuplot(const std::string &script);
 
 // The i-th method's colour in a plot: twenty that read apart on white
 // (Okabe and Ito's, then Kelly's colours of maximum contrast).
@@ -85,15 +64,37 @@ std::string plot_style(std::size_t i, const std::string &method);
 // steps), which is what tells the curves apart.
 std::string method_label(const std::string &method);
 
-// What became of a figure: drawn; gnuplot failed (a note: its script and
-// data are there to rerun); or its script was not written (a failed file).
-enum class Plot { drawn, gnuplot_failed, not_written };
+// A gnuplot script and the images it draws, in one output directory.
+// gnuplot runs there, without a shell, so every file a script names is a
+// name inside that directory, lpi's own (the directory the user gave never
+// enters a script). The images are drawn into temporary files beside them
+// and put in place (output.hpp) only when gnuplot succeeded: a failure keeps
+// the old images and the command fails, naming the file. The script itself
+// is saved as DIR/NAME, naming the images, to be rerun there by hand.
+class PlotScript {
+public:
+    PlotScript(std::string dir, std::string name) : dir_(std::move(dir)), name_(std::move(name)) {}
+    // Appends commands.
+    PlotScript &operator+=(const std::string &commands) {
+        text_ += commands;
+        return *this;
+    }
+    // "set output '...'" for `image`, a name in the directory.
+    std::string output(const std::string &image);
+    // Commands drawn twice, as BASE.png, then BASE.svg beside it.
+    void add_figure(const std::string &base, int width, int height, const std::string &commands);
+    // Saves the script, runs gnuplot and puts the images in place: "" or why
+    // not (naming the file).
+    std::string draw() const;
 
-// Starts a gnuplot script: CSV input, a grid, the key outside. Null, having
-// said so, when it cannot be created.
-FILE *open_plot_script(const std::string &path);
+private:
+    // The text with each image's mark replaced by names[i].
+    std::string with_names(const std::vector<std::string> &names) const;
+    std::string dir_, name_, text_;
+    std::vector<std::string> images_;
+};
 
-// Closes the script `f` written to `path` and runs it.
-Plot finish_plot(FILE *f, const std::string &path);
+// The start of a script that plots lpi's CSV files: a grid, the key outside.
+std::string csv_plot_preamble();
 
 }  // namespace lpi_cli

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "output.hpp"
 #include "plots.hpp"
 
 // OpenBLAS's own call, when an OpenBLAS is loaded where the program sees it
@@ -157,37 +158,32 @@ double cpu_at_error(const std::vector<Row> &rows, const std::string &method, dou
     return kNaN;
 }
 
-// Each writer returns false, having said so, when its file was not written.
-bool write_csv(const std::string &path, const std::vector<Row> &rows, const Scene &scene) {
-    FILE *f = std::fopen(path.c_str(), "w");
-    if (!f) return cannot_write(path);
-    std::fprintf(f, "scene,method,order,dt,steps,cpu_seconds,error,max_energy_error,max_casimir_drift,status\n");
+// The CSV files' text.
+std::string csv_text(const std::vector<Row> &rows, const Scene &scene) {
+    std::string text = "scene,method,order,dt,steps,cpu_seconds,error,max_energy_error,max_casimir_drift,status\n";
     for (const Row &r : rows)
-        std::fprintf(f, "%s,%s,%d,%.17g,%lld,%.6e,%.6e,%.6e,%.6e,%s\n", scene.name.c_str(),
-                     r.method.c_str(), r.order, r.dt, static_cast<long long>(r.steps), r.cpu,
-                     r.error, r.energy_error, r.casimir_drift, lpi_status_name(r.status));
-    return close_written(f) || cannot_write(path);
+        text += format("%s,%s,%d,%.17g,%lld,%.6e,%.6e,%.6e,%.6e,%s\n", scene.name.c_str(), r.method.c_str(),
+                       r.order, r.dt, static_cast<long long>(r.steps), r.cpu, r.error, r.energy_error,
+                       r.casimir_drift, lpi_status_name(r.status));
+    return text;
 }
 
-bool write_history(const std::string &path, const std::map<std::string, History> &histories) {
-    FILE *f = std::fopen(path.c_str(), "w");
-    if (!f) return cannot_write(path);
-    std::fprintf(f, "method,dt,time,energy_error,casimir_drift\n");
+std::string history_text(const std::map<std::string, History> &histories) {
+    std::string text = "method,dt,time,energy_error,casimir_drift\n";
     for (const auto &[method, history] : histories)
         for (const Sample &s : history.samples)
-            std::fprintf(f, "%s,%.17g,%.10g,%.6e,%.6e\n", method.c_str(), history.dt, s.time,
-                         s.energy_error, s.casimir_drift);
-    return close_written(f) || cannot_write(path);
+            text += format("%s,%.17g,%.10g,%.6e,%.6e\n", method.c_str(), history.dt, s.time, s.energy_error,
+                           s.casimir_drift);
+    return text;
 }
 
-
 // Draws the work-precision and energy plots with gnuplot from the CSV files.
-Plot plot(const std::string &dir, const Scene &scene, const std::vector<std::string> &methods,
-          const std::vector<Row> &rows, const std::map<std::string, History> &histories) {
-    const std::string script = dir + "/" + scene.name + ".gp";
-    FILE *f = open_plot_script(script);
-    if (!f) return Plot::not_written;
-    const std::string base = dir + "/" + scene.name;
+// "" or why not.
+std::string plot(const std::string &dir, const Scene &scene, const std::vector<std::string> &methods,
+                 const std::vector<Row> &rows, const std::map<std::string, History> &histories) {
+    PlotScript script(dir, scene.name + ".gp");
+    script += csv_plot_preamble();
+    const std::string &base = scene.name;  // in dir
     Range cpu, error, energy;
     for (const Row &r : rows)
         if (r.status == LPI_OK) cpu.add(r.cpu), error.add(r.error);
@@ -202,7 +198,7 @@ Plot plot(const std::string &dir, const Scene &scene, const std::vector<std::str
                            "with linespoints %s lw 1.5 ps 1.2 title '%s' noenhanced",
                            i ? ", " : "", base.c_str(), methods[i].c_str(), plot_style(i, methods[i]).c_str(),
                            method_label(methods[i]).c_str());
-    emit_figure(f, base + "_work_precision", 1000, 820, commands + "\n");
+    script.add_figure(base + "_work_precision", 1000, 820, commands + "\n");
 
     const double history_dt = histories.empty() ? 0.0 : histories.begin()->second.dt;
     commands = format("set title '%s: relative energy error against time, every method at dt = %g' noenhanced\n"
@@ -224,8 +220,8 @@ Plot plot(const std::string &dir, const Scene &scene, const std::vector<std::str
                            is_poisson(methods[i]) ? 1 : 2, plot_style(i, methods[i]).c_str(),
                            method_label(methods[i]).c_str());
     }
-    emit_figure(f, base + "_energy", 1000, 820, commands + "\n");
-    return finish_plot(f, script);
+    script.add_figure(base + "_energy", 1000, 820, commands + "\n");
+    return script.draw();
 }
 
 }  // namespace
@@ -340,21 +336,19 @@ bool run_report(const Scene &scene, const ReportOptions &options) {
     }
 
     const std::string base = options.out_dir + "/" + scene.name;
-    if (!write_csv(base + ".csv", rows, scene) || !write_history(base + "_energy.csv", histories)) return false;
+    std::string why = write_output(base + ".csv", csv_text(rows, scene));
+    if (why.empty()) why = write_output(base + "_energy.csv", history_text(histories));
+    if (!why.empty()) return cannot_write(why);
     std::printf("   wrote %s.csv and %s_energy.csv (energy history of every method at dt = %g)\n", base.c_str(),
                 base.c_str(), scene.final_time / static_cast<double>(history_steps));
     if (!have_gnuplot()) {
         std::printf("   gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n");
         return true;
     }
-    switch (plot(options.out_dir, scene, methods, rows, histories)) {
-    case Plot::drawn:
-        std::printf("   wrote %s_work_precision.png and %s_energy.png, each with .svg\n", base.c_str(), base.c_str());
-        return true;
-    case Plot::gnuplot_failed: std::printf("   gnuplot failed: see %s.gp\n", base.c_str()); return true;
-    case Plot::not_written: return false;
-    }
-    return false;
+    why = plot(options.out_dir, scene, methods, rows, histories);
+    if (!why.empty()) return cannot_write(why);
+    std::printf("   wrote %s_work_precision.png and %s_energy.png, each with .svg\n", base.c_str(), base.c_str());
+    return true;
 }
 
 }  // namespace lpi_cli

@@ -9,7 +9,9 @@
 #include <vector>
 
 #include "fields.hpp"
+#include "output.hpp"
 #include "plots.hpp"
+#include "run_watch.hpp"
 #include "scenes.hpp"
 #include "systems.hpp"
 
@@ -39,12 +41,6 @@ double high_fraction(const std::vector<double> &enstrophy) {
         if (k >= first) high += enstrophy[k];
     }
     return all > 0.0 ? high / all : 0.0;
-}
-
-// Exit status 1, having said that `path` was not written.
-int not_written(const std::string &path) {
-    cannot_write(path);
-    return 1;
 }
 
 }  // namespace
@@ -78,43 +74,77 @@ int run_rollup(const OwnRun &run) {
         return 1;
     }
     const std::string base = run.out_dir + "/rollup", csv = base + ".csv", spectra = base + "_spectra.csv";
-    FILE *f = std::fopen(csv.c_str(), "w");
-    if (!f) return not_written(csv);
-    std::fprintf(f, "time,energy_error,enstrophy_error,high_third_fraction\n");
-    std::fprintf(f, "0,0,0,%.6e\n", high_fraction(s0.enstrophy));
+    for (const std::string &path : {csv, spectra}) {
+        const std::string why = output_problem(path);
+        if (!why.empty()) return cannot_write(why), 1;
+    }
+    std::string rows_text = "time,energy_error,enstrophy_error,high_third_fraction\n";
+    rows_text += format("0,0,0,%.6e\n", high_fraction(s0.enstrophy));
     std::vector<Spectra> kept = {s0};
     std::vector<double> kept_times = {0.0};
+    // Both files, as far as the run got (also when it is interrupted or a step
+    // fails): "" or why not.
+    auto write_files = [&] {
+        std::string text = "k";
+        for (double t : kept_times) text += format(",enstrophy_t%g", t);
+        text += "\n";
+        for (std::size_t k = 0; k < K; ++k) {
+            text += std::to_string(k + 1);
+            for (const Spectra &s : kept) text += format(",%.6e", s.enstrophy[k]);
+            text += "\n";
+        }
+        const std::string why = write_output(csv, rows_text);
+        return why.empty() ? write_output(spectra, text) : why;
+    };
     double first_fraction = high_fraction(s0.enstrophy), late_sum = 0.0, peak = first_fraction;
     int64_t late_rows = 0;
+    // Ctrl-C and SIGTERM stop the run as they stop lpi run (lpi(1)): within a
+    // few steps, through the observer, with a row at the step reached.
+    catch_interrupts();
+    std::printf("   stepping (Ctrl-C stops it, writing the rows so far)\n");
+    std::fflush(stdout);
+    Progress progress(0, steps);
+    Watch watch;
+    watch.progress = &progress;
+    check(lpi_set_observer(sys, observation_interval(sys), watch_steps, &watch), sys, "set observer");
     const double t0 = cpu_seconds();
-    for (int64_t r = 1; r <= rows; ++r) {
-        check(lpi_step(sys, dt, row_end(r) - row_end(r - 1)), sys, "step");
+    int64_t done = 0;
+    int status = LPI_OK;
+    for (int64_t r = 1; r <= rows && !interrupted_by; ++r) {
+        watch.call_start = done;
+        status = lpi_step(sys, dt, row_end(r) - done);
+        if (status != LPI_OK && status != LPI_STOPPED) break;
+        done = status == LPI_STOPPED ? watch.stopped_at : row_end(r);
         const Spectra s = spectra_of(sys);
         double Z = 0.0;
         check(lpi_sine_euler_enstrophy(sys, &Z), sys, "enstrophy");
         const double fraction = high_fraction(s.enstrophy);
         peak = std::max(peak, fraction);
         if (2 * r > rows) late_sum += fraction, ++late_rows;
-        std::fprintf(f, "%.6g,%.6e,%.6e,%.6e\n", lpi_time(sys), (energy_of(sys) - H0) / H0, (Z - Z0) / Z0,
-                     fraction);
+        rows_text += format("%.6g,%.6e,%.6e,%.6e\n", lpi_time(sys), (energy_of(sys) - H0) / H0, (Z - Z0) / Z0,
+                            fraction);
+        if (status == LPI_STOPPED) break;
+        progress.update(done);
         if (std::find(spectrum_rows.begin(), spectrum_rows.end(), r) != spectrum_rows.end()) {
             kept.push_back(s);
             kept_times.push_back(lpi_time(sys));
         }
     }
+    progress.finish();
     const double cpu = cpu_seconds() - t0;
-    if (!close_written(f)) return not_written(csv);
-    FILE *g = std::fopen(spectra.c_str(), "w");
-    if (!g) return not_written(spectra);
-    std::fprintf(g, "k");
-    for (double t : kept_times) std::fprintf(g, ",enstrophy_t%g", t);
-    std::fprintf(g, "\n");
-    for (std::size_t k = 0; k < K; ++k) {
-        std::fprintf(g, "%zu", k + 1);
-        for (const Spectra &s : kept) std::fprintf(g, ",%.6e", s.enstrophy[k]);
-        std::fprintf(g, "\n");
+    const std::string why = write_files();
+    if (status != LPI_OK && status != LPI_STOPPED) {
+        std::fprintf(stderr, "lpi run: rollup: step %lld failed: %s (%s); %s ends there\n",
+                     static_cast<long long>(done), lpi_last_error(sys), lpi_status_name(status), csv.c_str());
+        if (!why.empty()) cannot_write(why);
+        return 1;
     }
-    if (!close_written(g)) return not_written(spectra);
+    if (!why.empty()) return cannot_write(why), 1;
+    if (interrupted_by) {
+        std::printf("interrupted at step %lld (t = %.17g); wrote %s and %s\n", static_cast<long long>(done),
+                    lpi_time(sys), csv.c_str(), spectra.c_str());
+        return 128 + interrupted_by;
+    }
     // Equipartition of the enstrophy over the modes puts in each shell its
     // share of the modes: the fraction the highest third would hold then.
     std::vector<double> modes_per_shell(K, 0.0);
@@ -132,18 +162,16 @@ int run_rollup(const OwnRun &run) {
         std::printf("   gnuplot not found: no PNG\n");
         return 0;
     }
-    const std::string script = base + ".gp";
-    FILE *p = std::fopen(script.c_str(), "w");
-    if (!p) return not_written(script);
+    PlotScript script(run.out_dir, "rollup.gp");
     std::string commands = format(
         "set datafile separator ','\nset grid\nset tics out nomirror\nset border 3\n"
         "set multiplot layout 1,2\nset title 'enstrophy in the highest third of the shells' noenhanced\n"
         "set xlabel 'time'\nset ylabel 'fraction'\nset key bottom right\n"
-        "plot '%s.csv' using 1:4 every ::1 with lines lc rgb '#0072b2' title 'sine-Euler N = %d', "
+        "plot 'rollup.csv' using 1:4 every ::1 with lines lc rgb '#0072b2' title 'sine-Euler N = %d', "
         "%g with lines dt 2 lc rgb '#999999' title 'equipartition'\n"
         "set title 'enstrophy spectrum' noenhanced\nset xlabel 'shell k'\nset ylabel 'Z(k)'\n"
         "set logscale x\nset key bottom left\n",
-        base.c_str(), N, high_fraction(modes_per_shell));
+        N, high_fraction(modes_per_shell));
     // The y axis spans the spectra after the start: the smooth initial one
     // falls to 1e-90 and is drawn only where it is within that range.
     Range range;
@@ -152,17 +180,15 @@ int run_rollup(const OwnRun &run) {
     for (double z : kept[0].enstrophy) range.add(std::max(z, range.lo));
     commands += decade_axis("y", range.lo, range.hi) + "plot ";
     for (std::size_t i = 0; i < kept.size(); ++i)
-        commands += format("%s'%s_spectra.csv' using 1:($%zu > 0 ? $%zu : 1/0) with linespoints lc %s "
+        commands += format("%s'rollup_spectra.csv' using 1:($%zu > 0 ? $%zu : 1/0) with linespoints lc %s "
                            "pt 7 ps 0.5 title 't = %g'",
-                           i ? ", " : "", base.c_str(), i + 2, i + 2, plot_colour(i).c_str(), kept_times[i]);
+                           i ? ", " : "", i + 2, i + 2, plot_colour(i).c_str(), kept_times[i]);
     commands += "\nunset multiplot\n";
-    emit_figure(p, base, 1100, 450, commands);
-    switch (finish_plot(p, script)) {
-    case Plot::drawn: std::printf("   wrote %s.png and .svg\n", base.c_str()); return 0;
-    case Plot::gnuplot_failed: std::printf("   gnuplot failed: see %s\n", script.c_str()); return 0;
-    case Plot::not_written: return 1;
-    }
-    return 1;
+    script.add_figure("rollup", 1100, 450, commands);
+    const std::string not_drawn = script.draw();
+    if (!not_drawn.empty()) return cannot_write(not_drawn), 1;
+    std::printf("   wrote %s.png and .svg\n", base.c_str());
+    return 0;
 }
 
 }  // namespace lpi_cli

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "output.hpp"
 #include "plots.hpp"
 #include "processes.hpp"
 #include "run_data.hpp"
@@ -63,36 +64,85 @@ bool whole_steps(double time, double dt, int64_t &steps) {
     return std::fabs(s - static_cast<double>(steps)) <= 1e-9 * std::max(1.0, s);
 }
 
-// The CSV of an interrupted run, up to and including the row of `step`:
-// its lines, and the energy of its step-0 row (the error's reference).
-// Empty when the file is absent or has no row at `step`.
-std::vector<std::string> csv_up_to(const std::string &path, int64_t step, double &energy0) {
+// The CSV of an interrupted run, up to and including the row of `step`: its
+// lines (the header first). Empty when the file is absent or has no row at
+// `step`; `why` says why a file that is there could not be read.
+std::vector<std::string> csv_up_to(const std::string &path, int64_t step, std::string &why) {
     std::vector<std::string> lines;
-    FILE *f = std::fopen(path.c_str(), "r");
-    if (!f) return lines;
-    std::string line;
+    struct stat st;
+    if (stat(path.c_str(), &st) != 0 && errno == ENOENT) return lines;
+    std::string text;
+    why = read_input(path, text);  // a regular file only: a FIFO is refused, not waited on
     bool found = false;
-    for (int c; (c = std::fgetc(f)) != EOF;) {
-        if (c != '\n') {
-            line += static_cast<char>(c);
-            continue;
-        }
-        const bool header = lines.empty();
-        if (!header) {
+    for (std::size_t from = 0, end; (end = text.find('\n', from)) != std::string::npos; from = end + 1) {
+        const std::string line = text.substr(from, end - from);
+        if (!lines.empty()) {
             const long long row_step = std::strtoll(line.c_str(), nullptr, 10);
-            if (row_step == 0) {
-                const std::size_t a = line.find(','), b = line.find(',', a + 1);
-                energy0 = std::strtod(line.c_str() + b + 1, nullptr);
-            }
             if (row_step > step) break;
             found = row_step == step;
         }
         lines.push_back(line);
-        line.clear();
     }
-    std::fclose(f);
     if (!found) lines.clear();
     return lines;
+}
+
+// A path as the file system resolves it: the real path of the file, or of
+// the nearest directory above it that exists, and the rest of the name.
+std::string resolved(const std::string &path) {
+    if (char *real = realpath(path.c_str(), nullptr)) {
+        const std::string r = real;
+        std::free(real);
+        return r;
+    }
+    const std::size_t slash = path.find_last_of('/');
+    if (slash == std::string::npos) return resolved(".") + "/" + path;
+    if (slash == 0) return path;
+    return resolved(path.substr(0, slash)) + path.substr(slash);
+}
+
+// Whether two paths name one file: the same file when both exist (links
+// included), else the same resolved path.
+bool same_file(const std::string &a, const std::string &b) {
+    struct stat sa, sb;
+    if (stat(a.c_str(), &sa) == 0 && stat(b.c_str(), &sb) == 0)
+        return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    return resolved(a) == resolved(b);
+}
+
+// The files a run writes and the options naming them, checked before
+// anything is written: --checkpoint (and --wisdom, which measured planning
+// writes) may be none of the run's outputs nor the --init grid, for the run
+// would overwrite one with the other. A usage error: "" or the message.
+std::string colliding_paths(const RunOptions &o, const std::vector<std::string> &outputs) {
+    struct Named {
+        std::string option, path;
+    };
+    std::vector<Named> written;
+    if (!o.checkpoint.empty()) written.push_back({"--checkpoint", o.checkpoint});
+    if (!o.wisdom.empty()) written.push_back({"--wisdom", o.wisdom});
+    for (std::size_t i = 0; i < written.size(); ++i) {
+        const Named &w = written[i];
+        for (const std::string &output : outputs)
+            if (same_file(w.path, output))
+                return "lpi run: " + w.option + " " + w.path + " is " + output +
+                       ", which this run writes: give it another name";
+        // The snapshot images are named by their steps: vorticity_STEP.png and .svg.
+        const std::size_t slash = w.path.find_last_of('/');
+        const std::string name = slash == std::string::npos ? w.path : w.path.substr(slash + 1);
+        const std::string dir = slash == std::string::npos ? "." : w.path.substr(0, std::max<std::size_t>(slash, 1));
+        const std::string suffix = name.size() > 4 ? name.substr(name.size() - 4) : "";
+        const bool image = name.rfind("vorticity_", 0) == 0 && (suffix == ".png" || suffix == ".svg");
+        if (image && same_file(dir, o.out_dir))
+            return "lpi run: " + w.option + " " + w.path + " is a name of the snapshot images this run draws in " +
+                   o.out_dir + ": give it another name";
+        if (!o.init.empty() && same_file(w.path, o.init))
+            return "lpi run: " + w.option + " " + w.path + " is the --init grid, which it would overwrite";
+        for (std::size_t j = 0; j < i; ++j)
+            if (same_file(w.path, written[j].path))
+                return "lpi run: " + w.option + " and " + written[j].option + " name one file (" + w.path + ")";
+    }
+    return "";
 }
 
 }  // namespace
@@ -156,6 +206,17 @@ int run_command(int argc, char **argv) {
         }
         check_option(lpi_sine_euler_set_grid(h.get(), init_grid.data(), init_grid.size()), h.get(), "--init");
     }
+    // A system the library cannot save (moments: its pieces are callbacks)
+    // can neither write a checkpoint nor have one to resume: refused before
+    // anything runs or is written.
+    if (!o.checkpoint.empty() || !o.resume.empty()) {
+        std::size_t size = 0;
+        if (lpi_save_buffer(h.get(), nullptr, 0, &size) == LPI_ERR_UNSUPPORTED) {
+            std::fprintf(stderr, "lpi run: %s: %s cannot be checkpointed (%s)\n",
+                         o.checkpoint.empty() ? "--resume" : "--checkpoint", o.scene.c_str(), lpi_last_error(h.get()));
+            return 2;
+        }
+    }
     if (!o.resume.empty()) {
         Handle loaded;
         // Not spread (another kind), the checkpoint is read by each process.
@@ -171,6 +232,23 @@ int run_command(int argc, char **argv) {
         h = std::move(loaded);
     }
     lpi_system *sys = h.get();
+    RunData data;
+    int32_t N = 0;
+    data.vorticity = lpi_sine_euler_size(sys, &N) == LPI_OK;
+    data.snapshot_shape = data.vorticity ? std::vector<std::size_t>{static_cast<std::size_t>(N),
+                                                                    static_cast<std::size_t>(N)}
+                                         : std::vector<std::size_t>{lpi_dim(sys)};
+    data.casimir_count = lpi_casimir_count(sys);
+    const std::string csv = o.out_dir + "/" + o.scene + ".csv";
+    // What this run writes (the vorticity images besides, by their steps).
+    std::vector<std::string> outputs = data_files(o, data);
+    outputs.insert(outputs.begin(), csv);
+    outputs.push_back(o.out_dir + "/vorticity.gp");
+    const std::string collision = colliding_paths(o, outputs);
+    if (!collision.empty()) {
+        std::fprintf(stderr, "%s\n", collision.c_str());
+        return 2;
+    }
     if (!o.method.empty()) check_option(lpi_set_method(sys, o.method.c_str()), sys, "--method");
     if (o.threads != 1) check_option(lpi_set_threads(sys, o.threads), sys, "--threads");
     // Wisdom first, so that any planning (the first step's or --planning's)
@@ -229,37 +307,52 @@ int run_command(int argc, char **argv) {
     const int64_t every = o.every > 0 ? o.every : std::max<int64_t>(1, end / 100);
     // Row r is written after step min(r * every, end).
     auto row_index = [&](int64_t step) { return step / every + (step % every != 0); };
-    RunData data;
-    int32_t N = 0;
-    data.vorticity = lpi_sine_euler_size(sys, &N) == LPI_OK;
-    data.snapshot_shape = data.vorticity ? std::vector<std::size_t>{static_cast<std::size_t>(N),
-                                                                    static_cast<std::size_t>(N)}
-                                         : std::vector<std::size_t>{lpi_dim(sys)};
-    data.casimir_count = lpi_casimir_count(sys);
 
     // Every process makes it (or finds it there), each on its own disk.
-    const std::string no_dir = make_output_dir(o.out_dir);
-    if (const int agreed = agreed_failure(!no_dir.empty(), no_dir.empty() ? "" : "lpi run: --out " + no_dir))
-        return agreed;
-    const std::string csv = o.out_dir + "/" + o.scene + ".csv";
+    std::string no_output = make_output_dir(o.out_dir);
+    if (!no_output.empty()) no_output = "lpi run: --out " + no_output;
+    // The files are written at the end: those that cannot be fail now, before
+    // the work (rank 0 writes them).
+    for (std::size_t i = 0; i < outputs.size() && no_output.empty() && writes_output(); ++i) {
+        struct stat dir;  // the .npy files' folder is made when the data is written
+        const std::string parent = outputs[i].substr(0, outputs[i].find_last_of('/'));
+        if (stat(parent.c_str(), &dir) == 0 || errno != ENOENT) no_output = output_problem(outputs[i]);
+        if (!no_output.empty()) no_output = "lpi run: " + no_output;
+    }
+    if (const int agreed = agreed_failure(!no_output.empty(), no_output)) return agreed;
     std::vector<std::string> kept;
     if (!o.resume.empty()) {
-        double csv_h0 = std::nan("");
-        kept = csv_up_to(csv, start, csv_h0);
-        if (kept.empty())
-            std::printf("%s has no row at step %lld: a new file, energy error relative to step %lld\n",
-                        csv.c_str(), static_cast<long long>(start), static_cast<long long>(start));
+        std::string why;
+        kept = csv_up_to(csv, start, why);
+        int status = why.empty() ? 0 : 1;
+        if (status) why = "lpi run: --resume: " + why;
+        // The interrupted run's row at the checkpoint's step holds the
+        // checkpoint's time to the bit (both written at the end of the same
+        // call): another time there is another --dt (or --every), whose rows
+        // would be spliced to this run's.
+        const char *row_time = kept.size() > 1 ? std::strchr(kept.back().c_str(), ',') : nullptr;
+        const double time_then = row_time ? std::strtod(row_time + 1, nullptr) : lpi_time(sys);
+        if (!status && time_then != lpi_time(sys))
+            status = 2, why = format("lpi run: --resume: the checkpoint's time %.17g is step %lld of --dt %g, "
+                                     "but %s has t = %.17g at that step: resume with the options of the "
+                                     "interrupted run",
+                                     lpi_time(sys), static_cast<long long>(start), dt, csv.c_str(), time_then);
+        if (const int agreed = agreed_failure(status, why)) return agreed;
     }
     // The references of the errors and drifts: the step-0 row of the CSV
     // when resuming (to the bit: written with 17 digits), else this state.
     double H0 = energy_of(sys);
     std::vector<double> C0 = casimirs_of(sys);
     const bool spectrum = data.vorticity;
+    // The energy error is relative to |H(0)|; where H(0) = 0 (a zero field,
+    // a vanishing Hamiltonian), as lpi stress does, it is H - H(0) itself,
+    // and the CSV column and the data's attribute energy_error say so.
+    auto absolute_error = [&] { return H0 == 0.0; };
     auto add_row = [&](int64_t step, double time, double H, const std::vector<double> &c) {
         data.step.push_back(static_cast<double>(step));
         data.time.push_back(time);
         data.energy.push_back(H);
-        data.energy_error.push_back((H - H0) / std::fabs(H0));
+        data.energy_error.push_back(absolute_error() ? H - H0 : (H - H0) / std::fabs(H0));
         data.casimirs.insert(data.casimirs.end(), c.begin(), c.end());
         data.casimir_drift.push_back(casimir_drift(spectrum, c, C0));
     };
@@ -276,32 +369,40 @@ int run_command(int argc, char **argv) {
         if (fields[0] == 0.0) H0 = fields[2], C0 = c;
         add_row(static_cast<int64_t>(fields[0]), fields[1], fields[2], c);
     }
-    if (!o.resume.empty()) keep_snapshots(o, start, data);
-
-    // Every process has read what it keeps before rank 0 rewrites the file;
-    // the others write their rows nowhere.
+    if (!o.resume.empty()) {
+        const std::string why = keep_snapshots(o, start, lpi_time(sys), data);
+        if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
+        if (kept.empty())
+            std::printf("%s has no row at step %lld: a new file, energy error relative to step %lld\n",
+                        csv.c_str(), static_cast<long long>(start), static_cast<long long>(start));
+    }
+    // Every process has read what it keeps before rank 0 rewrites the files.
     synchronize();
-    FILE *f = std::fopen(writes_output() ? csv.c_str() : "/dev/null", "w");
-    const std::string no_csv = f ? "" : format("lpi run: cannot write %s: %s", csv.c_str(), std::strerror(errno));
-    if (const int agreed = agreed_failure(!f, no_csv)) {
-        if (f) std::fclose(f);
-        return agreed;
-    }
-    if (kept.empty()) {
-        std::fprintf(f, "step,time,energy,energy_error");
-        for (std::size_t i = 0; i < data.casimir_count; ++i) std::fprintf(f, ",casimir_%zu", i);
-        std::fprintf(f, "\n");
-    }
-    for (const std::string &line : kept) std::fprintf(f, "%s\n", line.c_str());
-    // Flushed row by row: a killed run leaves complete rows.
-    auto record = [&](int64_t step, double H, const std::vector<double> &c) {
-        add_row(step, lpi_time(sys), H, c);
-        std::fprintf(f, "%lld,%.17g,%.17g,%.6e", static_cast<long long>(step), lpi_time(sys), H,
-                     data.energy_error.back());
-        for (double v : c) std::fprintf(f, ",%.17g", v);
-        std::fprintf(f, "\n");
-        std::fflush(f);
+
+    // The CSV holds every row of `data` (the kept rows too, written again to
+    // the same bytes). It is replaced as a whole (output.hpp), by rank 0:
+    // with each checkpoint, so that the CSV a killed run leaves matches the
+    // checkpoint it resumes from, and at the end of the run, however it ends.
+    auto csv_text = [&] {
+        std::string text = absolute_error() ? "step,time,energy,absolute_energy_error"
+                                            : "step,time,energy,energy_error";
+        for (std::size_t i = 0; i < data.casimir_count; ++i) text += format(",casimir_%zu", i);
+        text += "\n";
+        for (std::size_t r = 0; r < data.step.size(); ++r) {
+            text += format("%lld,%.17g,%.17g,%.6e", static_cast<long long>(data.step[r]), data.time[r],
+                           data.energy[r], data.energy_error[r]);
+            for (std::size_t i = 0; i < data.casimir_count; ++i)
+                text += format(",%.17g", data.casimirs[r * data.casimir_count + i]);
+            text += "\n";
+        }
+        return text;
     };
+    auto write_csv = [&]() -> std::string {
+        if (!writes_output()) return "";
+        const std::string why = write_output(csv, csv_text());
+        return why.empty() ? "" : "lpi run: " + why;
+    };
+    auto record = [&](int64_t step, double H, const std::vector<double> &c) { add_row(step, lpi_time(sys), H, c); };
     auto row = [&](int64_t step) {
         const double H = energy_of(sys);  // collective: every process writes every row
         record(step, H, casimirs_of(sys));
@@ -319,8 +420,9 @@ int run_command(int argc, char **argv) {
     };
     // A checkpoint that cannot be written stops the run: going on would lose
     // it. `status` is lpi_save's (rank 0 alone may save one), agreed by all.
+    // The CSV follows each checkpoint saved.
     auto checkpoint_saved = [&](int status, const lpi_system *state, int64_t step) {
-        const std::string why = status == LPI_OK ? ""
+        const std::string why = status == LPI_OK ? write_csv()
                                                  : format("lpi run: checkpoint not written at step %lld: %s",
                                                           static_cast<long long>(step), lpi_last_error(state));
         if (const int agreed = agreed_failure(status != LPI_OK, why)) std::exit(agreed);
@@ -339,6 +441,7 @@ int run_command(int argc, char **argv) {
         {"N", "", static_cast<double>(N), false, true},
         {"lpi_version", lpi_version_string(), 0.0, true},
         {"description", it->description, 0.0, true},
+        {"energy_error", absolute_error() ? "absolute" : "relative", 0.0, true},
     };
     SnapshotBytes bytes;
     // Writes the data (rank 0 alone): "" or the message saying why not.
@@ -356,10 +459,10 @@ int run_command(int argc, char **argv) {
     // Caught before the first row: once it is written, a signal stops the run
     // cleanly (before the first step, if it comes that early).
     catch_interrupts();
-    save(start, true);
     // The start's row when the CSV has none, from H0 and C0 (this state's
     // then): the CSV each process read may differ, and energy_of is collective.
     if (kept.empty()) record(start, H0, C0);
+    save(start, true);
     if (o.resume.empty()) snapshot(0);
     Progress progress(start, end);
     Watch watch;
@@ -391,14 +494,13 @@ int run_command(int argc, char **argv) {
         if (status == LPI_STOPPED) status = LPI_OK;  // stopped after the call's last step: it is whole
         if (status != LPI_OK) {
             progress.finish();
-            std::fclose(f);
             std::fprintf(stderr, "lpi run: steps %lld to %lld failed: %s (%s); the state at step %lld is "
                                  "the last row of %s\n",
                          static_cast<long long>(done), static_cast<long long>(next), lpi_last_error(sys),
                          lpi_status_name(status), static_cast<long long>(done), csv.c_str());
             // lpi_step's status is the same on every process: all stop here.
-            const std::string why = keep_data();
-            if (!why.empty()) std::fprintf(stderr, "%s\n", why.c_str());
+            for (const std::string &why : {write_csv(), keep_data()})
+                if (!why.empty()) std::fprintf(stderr, "%s\n", why.c_str());
             return 1;
         }
         done = next;
@@ -421,7 +523,7 @@ int run_command(int argc, char **argv) {
         save(done, true);
     }
     // Rank 0 alone writes the CSV and the data.
-    std::string why = close_written(f) ? "" : "lpi run: writing " + csv + " failed";
+    std::string why = write_csv();
     if (why.empty()) why = keep_data();
     if (const int agreed = agreed_failure(!why.empty(), why)) return agreed;
     const double H = energy_of(sys);
@@ -436,8 +538,9 @@ int run_command(int argc, char **argv) {
         return 128 + interrupted_by;
     }
     if (!o.checkpoint.empty()) std::printf("checkpoint: %s\n", o.checkpoint.c_str());
-    std::printf("done: t = %g, %.3f CPU seconds, relative energy error %.3e; wrote %s and %s\n", lpi_time(sys),
-                cpu_seconds() - t0, (H - H0) / std::fabs(H0), csv.c_str(), data_path(o).c_str());
+    std::printf("done: t = %g, %.3f CPU seconds, %s energy error %.3e; wrote %s and %s\n", lpi_time(sys),
+                cpu_seconds() - t0, absolute_error() ? "absolute (H(0) = 0)" : "relative",
+                absolute_error() ? H - H0 : (H - H0) / std::fabs(H0), csv.c_str(), data_path(o).c_str());
 
     // Rank 0 alone draws the snapshots: main agrees on the exit status.
     if (writes_output() && data.vorticity && !data.snapshot_step.empty()) {
@@ -446,14 +549,13 @@ int run_command(int argc, char **argv) {
                         data_path(o).c_str());
             return 0;
         }
-        switch (plot_vorticity(o, data, bytes, dt, method)) {
-        case Plot::drawn:
-            std::printf("wrote %zu vorticity snapshots: %s/vorticity_*.png and .svg\n", data.snapshot_step.size(),
-                        o.out_dir.c_str());
-            break;
-        case Plot::gnuplot_failed: std::printf("gnuplot failed: see %s/vorticity.gp\n", o.out_dir.c_str()); break;
-        case Plot::not_written: return 1;
+        const std::string not_drawn = plot_vorticity(o, data, bytes, dt, method);
+        if (!not_drawn.empty()) {
+            std::fprintf(stderr, "lpi run: %s\n", not_drawn.c_str());
+            return 1;
         }
+        std::printf("wrote %zu vorticity snapshots: %s/vorticity_*.png and .svg\n", data.snapshot_step.size(),
+                    o.out_dir.c_str());
     }
     return 0;
 }

@@ -9,6 +9,9 @@
 #include <cstdlib>
 #include <cstring>
 
+#include <memory>
+
+#include "output.hpp"
 #include "plots.hpp"
 
 namespace lpi_cli {
@@ -78,23 +81,28 @@ std::string data_path(const RunOptions &o) {
 }
 
 
-// Writes the data atomically (each .npy file on its own); "" or the reason.
+std::vector<std::string> data_files(const RunOptions &o, const RunData &d) {
+    if (o.format == "h5") return {data_path(o)};
+    std::vector<std::string> files;
+    for (const Dataset &set : datasets_of(d)) files.push_back(data_path(o) + "/" + set.name + ".npy");
+    files.push_back(data_path(o) + "/attributes.json");
+    return files;
+}
+
 std::string write_data(const RunOptions &o, const RunData &d, const std::vector<Attribute> &attributes,
                        SnapshotBytes &bytes) {
     const std::vector<Dataset> sets = datasets_of(d);
     const std::string path = data_path(o);
+    // gnuplot, run in the output directory, reads the snapshots by this name.
+    const std::string in_out_dir = o.scene + (o.format == "h5" ? ".h5" : "/" + sets.back().name + ".npy");
     if (o.format == "h5") {
         std::vector<std::uint64_t> offsets;
         const std::string why = write_hdf5(path, sets, attributes, &offsets);
         if (!why.empty()) return why;
-        bytes = {path, offsets.back()};
+        bytes = {in_out_dir, offsets.back()};
         return "";
     }
     if (mkdir(path.c_str(), 0777) != 0 && errno != EEXIST) return std::strerror(errno);
-    for (const Dataset &set : sets) {
-        const std::string why = write_npy(path + "/" + set.name + ".npy", set.array);
-        if (!why.empty()) return set.name + ".npy: " + why;
-    }
     // The attributes as JSON (json.load reads them).
     auto quoted = [](const std::string &text) {
         std::string q = "\"";
@@ -108,15 +116,39 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
         if (a.integer) std::snprintf(number, sizeof number, "%lld", static_cast<long long>(a.number));
         json += (json.size() > 1 ? ", \"" : "\"") + a.name + "\": " + (a.is_text ? quoted(a.text) : number);
     }
-    FILE *f = std::fopen((path + "/attributes.json").c_str(), "w");
-    if (!f || std::fprintf(f, "%s}\n", json.c_str()) < 0 || std::fclose(f) != 0) return "attributes.json";
-    bytes = {path + "/" + sets.back().name + ".npy", npy_header(sets.back().array).size()};
+    json += "}\n";
+    // The set is replaced as a whole: every file is written and flushed beside
+    // its target first, and renamed into place only once all of them are, so
+    // that a failed write leaves the old set, never old and new files mixed.
+    const std::vector<std::string> files = data_files(o, d);
+    std::vector<std::unique_ptr<FileReplacement>> written;
+    const std::string why = failure_of([&] {
+        for (std::size_t i = 0; i < files.size(); ++i) {
+            const std::string content = i < sets.size() ? npy_file(sets[i].array) : json;
+            written.push_back(std::make_unique<FileReplacement>(files[i]));
+            written.back()->write(reinterpret_cast<const unsigned char *>(content.data()), content.size());
+            written.back()->sync();
+        }
+        for (auto &file : written) file->commit();
+    });
+    if (!why.empty()) return why;
+    bytes = {in_out_dir, npy_header(sets.back().array).size()};
     return "";
 }
 
 // The snapshots of the interrupted run up to `start`, from its data; a note
 // on stdout (not an error) when they cannot be read.
-void keep_snapshots(const RunOptions &o, int64_t start, RunData &d) {
+std::string keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunData &d) {
+    // The data's row at the checkpoint's step holds its time, as the CSV's
+    // does (run.cpp): another time there is another --dt.
+    Array row_steps, row_times;
+    if (read_data_array(o, "step", row_steps).empty() && read_data_array(o, "time", row_times).empty() &&
+        row_steps.values.size() == row_times.values.size())
+        for (std::size_t i = 0; i < row_steps.values.size(); ++i)
+            if (row_steps.values[i] == static_cast<double>(start) && row_times.values[i] != start_time)
+                return format("lpi run: --resume: the checkpoint's time %.17g is step %lld of this run's --dt, "
+                              "but %s has t = %.17g at that step: resume with the options of the interrupted run",
+                              start_time, static_cast<long long>(start), data_path(o).c_str(), row_times.values[i]);
     Array steps, times, shots;
     std::string why = read_data_array(o, "snapshot_step", steps);
     if (why.empty()) why = read_data_array(o, "snapshot_time", times);
@@ -127,12 +159,13 @@ void keep_snapshots(const RunOptions &o, int64_t start, RunData &d) {
     if (!why.empty()) {
         std::printf("%s: %s; the data keeps the snapshots from step %lld on\n", data_path(o).c_str(),
                     why.c_str(), static_cast<long long>(start));
-        return;
+        return "";
     }
     d.snapshot_step = steps.values;
     d.snapshot_time = times.values;
     d.snapshots = shots.values;
     d.keep_up_to(start);
+    return "";
 }
 
 
@@ -179,48 +212,42 @@ int initial_grid(const std::string &path, int *N, std::vector<double> &grid, std
 // Draws every vorticity snapshot of the data as PNG and SVG with gnuplot,
 // which reads the doubles straight from the data file (nothing is copied
 // and nothing deleted).
-Plot plot_vorticity(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
-                    const std::string &method) {
+std::string plot_vorticity(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
+                           const std::string &method) {
     const std::size_t N = d.snapshot_shape[0], shots = d.snapshot_step.size();
-    if (shots == 0 || bytes.offset == UINT64_MAX) return Plot::gnuplot_failed;
+    if (shots == 0 || bytes.offset == UINT64_MAX) return "no snapshot data to draw from in " + data_path(o);
     double scale = 0.0;  // one symmetric colour range for every snapshot
     for (double v : d.snapshots) scale = std::max(scale, std::fabs(v));
     if (!(scale > 0.0)) scale = 1.0;
-    const std::string script = o.out_dir + "/vorticity.gp";
-    FILE *g = std::fopen(script.c_str(), "w");
-    if (!g) {
-        cannot_write(script);
-        return Plot::not_written;
-    }
+    PlotScript script(o.out_dir, "vorticity.gp");
     // Grid point (a, b) is x = 2 pi a / N, y = 2 pi b / N: the axes count
     // x / 2 pi, each pixel centred on its point. The array is [a][b], b
     // fastest: gnuplot reads it with x and y swapped back (transpose).
-    std::fprintf(g,
-                 "set size ratio -1\nset palette defined (0 '#2166ac', 0.5 'white', 1 '#b2182b')\n"
-                 "unset key\nset xrange [%.17g:%.17g]\nset yrange [%.17g:%.17g]\n"
-                 "set xtics 0.25 out nomirror\nset ytics 0.25 out nomirror\nset format x '%%g'\n"
-                 "set format y '%%g'\nset cbrange [%.6g:%.6g]\nset cbtics out\n"
-                 "set xlabel 'x / 2{/Symbol p}'\nset ylabel 'y / 2{/Symbol p}'\n"
-                 "set cblabel 'vorticity {/Symbol w}(x, y)'\n",
-                 -0.5 / N, 1.0 - 0.5 / N, -0.5 / N, 1.0 - 0.5 / N, -scale, scale);
+    script += format("set size ratio -1\nset palette defined (0 '#2166ac', 0.5 'white', 1 '#b2182b')\n"
+                     "unset key\nset xrange [%.17g:%.17g]\nset yrange [%.17g:%.17g]\n"
+                     "set xtics 0.25 out nomirror\nset ytics 0.25 out nomirror\nset format x '%%g'\n"
+                     "set format y '%%g'\nset cbrange [%.6g:%.6g]\nset cbtics out\n"
+                     "set xlabel 'x / 2{/Symbol p}'\nset ylabel 'y / 2{/Symbol p}'\n"
+                     "set cblabel 'vorticity {/Symbol w}(x, y)'\n",
+                     -0.5 / N, 1.0 - 0.5 / N, -0.5 / N, 1.0 - 0.5 / N, -scale, scale);
     const char *terminals[][2] = {{"pngcairo size 720,640 enhanced font ',12'", "png"},
                                   {"svg size 720,640 enhanced font 'Helvetica,12' background '#ffffff'", "svg"}};
     for (std::size_t k = 0; k < shots; ++k) {
         char name[64];
         const int64_t row = static_cast<int64_t>(d.snapshot_step[k]);
         std::snprintf(name, sizeof name, "vorticity_%06lld", static_cast<long long>(row));
-        std::fprintf(g, "set title '%s, N = %zu, %s, dt = %g: t = %.6g (step %lld)' noenhanced\n",
-                     o.scene.c_str(), N, method.c_str(), dt, d.snapshot_time[k], static_cast<long long>(row));
-        for (const auto &terminal : terminals)
-            std::fprintf(g,
-                         "set terminal %s\nset output '%s/%s.%s'\n"
-                         "plot '%s' binary array=(%zu,%zu) format='%%float64' endian=little skip=%llu "
-                         "transpose dx=%.17g dy=%.17g origin=(0,0) with image\n",
-                         terminal[0], o.out_dir.c_str(), name, terminal[1], bytes.file.c_str(), N, N,
-                         static_cast<unsigned long long>(bytes.offset + 8 * k * N * N), 1.0 / N, 1.0 / N);
+        script += format("set title '%s, N = %zu, %s, dt = %g: t = %.6g (step %lld)' noenhanced\n", o.scene.c_str(),
+                         N, method.c_str(), dt, d.snapshot_time[k], static_cast<long long>(row));
+        for (const auto &terminal : terminals) {
+            script += format("set terminal %s\n", terminal[0]) + script.output(name + std::string(".") + terminal[1]);
+            script += format("plot '%s' binary array=(%zu,%zu) format='%%float64' endian=little skip=%llu "
+                             "transpose dx=%.17g dy=%.17g origin=(0,0) with image\n",
+                             bytes.file.c_str(), N, N, static_cast<unsigned long long>(bytes.offset + 8 * k * N * N),
+                             1.0 / N, 1.0 / N);
+        }
     }
-    std::fprintf(g, "set output\n");
-    return finish_plot(g, script);
+    script += "set output\n";
+    return script.draw();
 }
 
 }  // namespace lpi_cli

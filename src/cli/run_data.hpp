@@ -44,7 +44,7 @@ struct RunData {
 
 // Where the snapshots' raw doubles start in the written data (for gnuplot).
 struct SnapshotBytes {
-    std::string file;
+    std::string file;  // relative to the output directory
     std::uint64_t offset = UINT64_MAX;
 };
 
@@ -52,13 +52,19 @@ struct SnapshotBytes {
 // Where a run's data lives: DIR/SCENE.h5, or the folder DIR/SCENE of .npy files.
 std::string data_path(const RunOptions &o);
 
-// Writes the data atomically (each .npy file on its own); "" or the reason.
+// Every file of a run's data: DIR/SCENE.h5, or the .npy files and
+// attributes.json in DIR/SCENE.
+std::vector<std::string> data_files(const RunOptions &o, const RunData &d);
+
+// Writes the data atomically (output.hpp), the .npy files and their
+// attributes.json as one set; "" or the reason.
 std::string write_data(const RunOptions &o, const RunData &d, const std::vector<Attribute> &attributes,
                        SnapshotBytes &bytes);
 
 // The snapshots of the interrupted run up to `start`, from its data; a note
-// on stdout (not an error) when they cannot be read.
-void keep_snapshots(const RunOptions &o, int64_t start, RunData &d);
+// on stdout (not an error) when they cannot be read. Returns "", or why the
+// data is not that of this run (its time at `start` is not `start_time`).
+std::string keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunData &d);
 
 // The initial grid of --init into `grid`, checked against the system's N:
 // 0, or the exit status with the message in `why` (each process reads the
@@ -68,8 +74,8 @@ int initial_grid(const std::string &path, int *N, std::vector<double> &grid, std
 
 // Draws every vorticity snapshot of the data as PNG and SVG with gnuplot,
 // which reads the doubles straight from the data file (nothing is copied
-// and nothing deleted).
-Plot plot_vorticity(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
+// and nothing deleted): "" or why not.
+std::string plot_vorticity(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
                            const std::string &method);
 
 }  // namespace lpi_cli

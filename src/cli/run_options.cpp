@@ -41,7 +41,8 @@ void run_usage(FILE *to) {
                  "                    HDF5) or NumPy files DIR/SCENE/NAME.npy\n"
                  "  --out DIR         output directory (default ./lpi-run)\n"
                  "  --checkpoint FILE save a checkpoint (atomically) at the start, every 10 rows\n"
-                 "                    and at the end; a failed save stops the run (exit status 1)\n"
+                 "                    and at the end, the CSV with it; a failed save stops the run\n"
+                 "                    (exit status 1); not for moments, nor a FILE the run writes\n"
                  "  --checkpoint-every K   ... every K rows instead (0: at the start and end only)\n"
                  "  --resume FILE     continue an interrupted run from its checkpoint, with the\n"
                  "                    options of that run: it ends bit for bit where the run\n"
@@ -51,7 +52,8 @@ void run_usage(FILE *to) {
                  "  The options that configure a scene (lpi --help lists each scene's in brackets)\n"
                  "  are refused for a scene that does not take them.\n"
                  "  writes DIR/SCENE.csv: step, time, energy, relative energy error (to the energy\n"
-                 "  at step 0), Casimirs; and the data (rows and snapshots) as --format says; a\n"
+                 "  at step 0; absolute where that is 0), Casimirs; and the data (rows and\n"
+                 "  snapshots) as --format says, each file atomically (lpi(1)); a\n"
                  "  progress bar with the time left is shown on a terminal only. Ctrl-C (SIGINT) or\n"
                  "  SIGTERM stops within a few steps, writes a row at that step, the data and the\n"
                  "  checkpoint of the last row on the --every grid, and exits with status 130 (143).\n");
@@ -93,11 +95,11 @@ bool parse_run_options(int argc, char **argv, RunOptions &o) {
         else if (arg == "--inertia") {
             const std::vector<double> I = args.positives(arg, 3);
             std::copy(I.begin(), I.end(), o.scene_options.inertia);
-        } else if (Arguments::is_help(arg)) {
+        } else if (args.help(arg)) {
             run_usage(stdout);
             return false;
         } else {
-            args.refuse_unknown_option(arg);
+            args.operand(arg, "SCENE");
             if (!o.scene.empty()) args.fail("one scene only ('" + o.scene + "' and '" + arg + "')");
             o.scene = arg;
         }

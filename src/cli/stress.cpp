@@ -153,12 +153,13 @@ int stress_command(int argc, char **argv) {
     while (!args.done()) {
         const std::string arg = args.next();
         if (arg == "--quick") {
+            args.flag(arg);
             quick = true;
-        } else if (Arguments::is_help(arg)) {
+        } else if (args.help(arg)) {
             print_usage(stdout);
             return 0;
         } else {
-            args.refuse_unknown_option(arg);
+            args.operand(arg, "FILTER");
             if (!filter.empty()) args.fail("one FILTER only ('" + filter + "' and '" + arg + "')");
             filter = arg;
         }

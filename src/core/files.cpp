@@ -83,42 +83,80 @@ SaveTarget save_target(const std::string &path) {
 
 }  // namespace
 
-void write_file_atomically(const std::string &path, const unsigned char *bytes, std::size_t size) {
+FileReplacement::FileReplacement(const std::string &path) : path_(path) {
     const SaveTarget target = save_target(path);
-    const std::string dir = directory_of(target.path);
-    std::string temp;
-    const int fd = create_temporary(dir, temp);
-    if (fd < 0)
-        fail(LPI_ERR_IO, "cannot save '" + path + "': cannot create a file in '" + dir + "': " + io_reason(errno));
-    // Until the rename, the target is untouched: a failure leaves the old file.
-    auto abandon = [&](const std::string &what, int error, bool open) {
-        if (open) ::close(fd);
-        ::unlink(temp.c_str());
-        fail(LPI_ERR_IO, "cannot save '" + path + "': " + what + ": " + io_reason(error));
-    };
-    if (target.exists && ::fchmod(fd, target.permissions) != 0)
-        abandon("cannot give '" + temp + "' the permissions of the old file", errno, true);
+    target_ = target.path;
+    exists_ = target.exists;
+    permissions_ = target.permissions;
+    dir_ = directory_of(target_);
+    fd_ = create_temporary(dir_, temp_);
+    if (fd_ < 0)
+        fail(LPI_ERR_IO, "cannot save '" + path + "': cannot create a file in '" + dir_ + "': " + io_reason(errno));
+}
+
+FileReplacement::~FileReplacement() {
+    if (fd_ >= 0) ::close(fd_);
+    if (!committed_) ::unlink(temp_.c_str());
+}
+
+// Until the rename, the target is untouched: a failure leaves the old file.
+void FileReplacement::abandon(const std::string &what, int error) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+    ::unlink(temp_.c_str());
+    committed_ = true;  // nothing left to remove
+    fail(LPI_ERR_IO, "cannot save '" + path_ + "': " + what + ": " + io_reason(error));
+}
+
+void FileReplacement::write(const unsigned char *bytes, std::size_t size) {
+    if (fd_ < 0) fd_ = ::open(temp_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+    if (fd_ < 0) abandon("cannot write '" + temp_ + "'", errno);
     std::size_t done = 0;
     while (done < size) {
-        const ssize_t n = ::write(fd, bytes + done, size - done);
+        const ssize_t n = ::write(fd_, bytes + done, size - done);
         if (n < 0) {
             if (errno == EINTR) continue;
-            abandon("cannot write '" + temp + "'", errno, true);
+            abandon("cannot write '" + temp_ + "'", errno);
         }
         done += static_cast<std::size_t>(n);
     }
-    if (::fsync(fd) != 0) abandon("cannot flush '" + temp + "'", errno, true);
-    if (::close(fd) != 0) abandon("cannot close '" + temp + "'", errno, false);
-    if (::rename(temp.c_str(), target.path.c_str()) != 0)
-        abandon("cannot rename '" + temp + "' to " + (target.path == path ? "it" : "'" + target.path + "'"),
-                errno, false);
+}
+
+void FileReplacement::close_descriptor() {
+    const int fd = fd_;
+    fd_ = -1;
+    if (fd >= 0 && ::close(fd) != 0) abandon("cannot close '" + temp_ + "'", errno);
+}
+
+void FileReplacement::sync() {
+    // Read-only suffices for fchmod and fsync, whatever the file's mode.
+    if (fd_ < 0) fd_ = ::open(temp_.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd_ < 0) abandon("cannot open '" + temp_ + "'", errno);
+    if (exists_ && ::fchmod(fd_, static_cast<mode_t>(permissions_)) != 0)
+        abandon("cannot give '" + temp_ + "' the permissions of the old file", errno);
+    if (::fsync(fd_) != 0) abandon("cannot flush '" + temp_ + "'", errno);
+    close_descriptor();
+    synced_ = true;
+}
+
+void FileReplacement::commit() {
+    if (!synced_) sync();
+    if (::rename(temp_.c_str(), target_.c_str()) != 0)
+        abandon("cannot rename '" + temp_ + "' to " + (target_ == path_ ? "it" : "'" + target_ + "'"), errno);
+    committed_ = true;
     // Make the rename itself durable. Best effort: the file is complete and in
     // place either way, and some file systems cannot sync a directory.
-    const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    const int dfd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (dfd >= 0) {
         ::fsync(dfd);
         ::close(dfd);
     }
+}
+
+void write_file_atomically(const std::string &path, const unsigned char *bytes, std::size_t size) {
+    FileReplacement file(path);
+    file.write(bytes, size);
+    file.commit();
 }
 
 RegularFileReader::RegularFileReader(const std::string &path) : path_(path) {

@@ -21,6 +21,44 @@ std::string io_reason(int error);
 // no temporary file is left behind.
 void write_file_atomically(const std::string &path, const unsigned char *bytes, std::size_t size);
 
+// The steps of write_file_atomically, for a writer that fills the temporary
+// file itself, by write() or by its name (HDF5, gnuplot), or that replaces
+// several files together (sync() each, then commit() each). The constructor
+// checks the target and creates the temporary, empty, beside it; commit()
+// puts it in place; the destructor removes a temporary not committed, so a
+// failure anywhere leaves the old file. Every failure is LPI_ERR_IO with the
+// messages of write_file_atomically.
+class FileReplacement {
+public:
+    explicit FileReplacement(const std::string &path);
+    ~FileReplacement();
+    FileReplacement(const FileReplacement &) = delete;
+    FileReplacement &operator=(const FileReplacement &) = delete;
+
+    const std::string &path() const { return path_; }
+    // The temporary file, for a writer that opens it by name (and truncates
+    // it or writes it whole: sync() gives it its permissions).
+    const std::string &temporary() const { return temp_; }
+    // Appends to the temporary file.
+    void write(const unsigned char *bytes, std::size_t size);
+    // Closes this object's descriptor of the temporary (a writer by name
+    // needs none, and many files may then be prepared at once).
+    void close_descriptor();
+    // Gives the temporary the old file's permission bits and flushes it to disk.
+    void sync();
+    // sync() when not done yet, then the rename over the target.
+    void commit();
+
+private:
+    [[noreturn]] void abandon(const std::string &what, int error);
+
+    std::string path_, target_, dir_, temp_;
+    int fd_ = -1;
+    bool exists_ = false;
+    unsigned permissions_ = 0;
+    bool synced_ = false, committed_ = false;
+};
+
 // A file opened for reading that is known to be a regular file (opened
 // without blocking, so a FIFO given by mistake is refused, not waited on):
 // LPI_ERR_IO naming path when it cannot be opened, is a directory or is no

@@ -1,0 +1,177 @@
+#!/bin/sh
+# check_lpi_files.sh LPI OUTDIR
+# Nothing lpi writes is lost, and no failure passes for success:
+#  - gnuplot runs without a shell: an --out with quotes and ';' runs nothing;
+#  - a plot gnuplot fails to draw (a gnuplot that fails, an image path that
+#    is a directory) fails lpi run, report figure2, sine-euler-long and
+#    rollup naming the file; without gnuplot the plots are skipped, said so;
+#  - a write that fails (RLIMIT_FSIZE, as a full disk) keeps the old CSV and
+#    the old .npy set whole, names the file and the reason, and leaves no
+#    temporary file; a replaced file keeps its mode, a new one gets the
+#    umask's; a FIFO where an output goes is refused, not replaced;
+#  - --checkpoint that cannot work (moments) or names an output of the run
+#    is refused (2) and one that fails leaves the old CSV; --resume with
+#    another --dt is refused (2); --init refuses a FIFO (1) at once;
+#  - H(0) = 0 gives an absolute energy error, labelled, not -nan;
+#  - rollup stops on SIGINT (130) and SIGTERM (143) with its CSV written.
+# The sine-Euler parts are left out (and named) in a build without FFTW.
+set -eu
+lpi="$1"; out="$2"
+case $lpi in /*) ;; *) lpi="$(pwd)/$lpi" ;; esac
+rm -rf "$out"; mkdir -p "$out"
+out=$(cd "$out" && pwd)
+fail() { echo "FAIL: $*"; exit 1; }
+expect() {  # expect STATUS MESSAGE-PART lpi-arguments...: exit status and a message on stderr
+    want=$1 what=$2; shift 2
+    rc=0
+    timeout 60 "$lpi" "$@" >"$out/stdout" 2>"$out/stderr" || rc=$?
+    [ "$rc" -eq "$want" ] || { cat "$out/stderr"; fail "lpi $*: exit status $rc, expected $want"; }
+    grep -q -e "$what" "$out/stderr" || { cat "$out/stderr"; fail "lpi $*: no message with '$what'"; }
+}
+no_temporaries() {  # no_temporaries DIR: no temporary file of a write left behind
+    ! ls -a "$1" | grep -q '^\.lpi-' || fail "temporary files left in $1: $(ls -a "$1")"
+}
+have_se=1
+"$lpi" run sine-euler --N 5 --steps 1 --out "$out/probe" >/dev/null 2>&1 || have_se=0
+[ "$have_se" = 1 ] || echo "not checked: the plots, .npy sets, H(0) = 0 and rollup (no sine-Euler in this build)"
+
+# Fake gnuplots: one that records how it was run, one that fails, none at all.
+mkdir -p "$out/ok-gnuplot" "$out/bad-gnuplot" "$out/no-gnuplot"
+cat > "$out/ok-gnuplot/gnuplot" <<EOF
+#!/bin/sh
+{ pwd; echo "\$#"; printf '%s\n' "\$@"; } > "$out/gnuplot.log"
+EOF
+printf '#!/bin/sh\necho "fake gnuplot: cannot draw" >&2\nexit 1\n' > "$out/bad-gnuplot/gnuplot"
+chmod +x "$out/ok-gnuplot/gnuplot" "$out/bad-gnuplot/gnuplot"
+ok_path="$out/ok-gnuplot:$PATH"; bad_path="$out/bad-gnuplot:$PATH"
+
+if [ "$have_se" = 1 ]; then
+    # No shell: the directory name reaches gnuplot (run in it) as no command.
+    inject="x';touch INJECTED;'y"
+    (cd "$out" && PATH="$ok_path" "$lpi" run sine-euler --N 5 --steps 2 --out "$inject" >/dev/null) ||
+        fail "lpi run with a quote in --out"
+    [ ! -e "$out/INJECTED" ] || fail "--out \"$inject\" ran a shell command"
+    [ "$(sed -n 1p "$out/gnuplot.log")" = "$out/$inject" ] && [ "$(sed -n 2p "$out/gnuplot.log")" = 1 ] ||
+        { cat "$out/gnuplot.log"; fail "gnuplot was not run in the output directory with one argument"; }
+    if command -v gnuplot >/dev/null 2>&1; then
+        (cd "$out" && "$lpi" run sine-euler --N 5 --steps 2 --out "y';system('touch INJECTED2');'z" >/dev/null) ||
+            fail "lpi run with gnuplot's quotes in --out"
+        [ ! -e "$out/INJECTED2" ] || fail "a gnuplot command in --out was run"
+    fi
+    # A plot that is not drawn fails the command, naming the file.
+    PATH="$bad_path" expect 1 "vorticity.gp.*fake gnuplot" run sine-euler --N 5 --steps 2 --out "$out/p1"
+    PATH="$bad_path" expect 1 "figure2.gp.*fake gnuplot" report figure2 --out "$out/p2"
+    PATH="$bad_path" expect 1 "sine-euler-long.gp.*fake gnuplot" report sine-euler-long --N 5 --T 5 --out "$out/p3"
+    PATH="$bad_path" expect 1 "rollup.gp.*fake gnuplot" run rollup --N 5 --steps 3 --out "$out/p4"
+    mkdir -p "$out/p5/figure2.png" "$out/p6/vorticity_000000.png"
+    PATH="$ok_path" expect 1 "figure2.png.*directory" report figure2 --out "$out/p5"
+    PATH="$ok_path" expect 1 "vorticity_000000.png.*directory" run sine-euler --N 5 --steps 2 --out "$out/p6"
+    # Without gnuplot the plots are skipped, and the run says so.
+    rc=0; PATH="$out/no-gnuplot" "$lpi" run sine-euler --N 5 --steps 2 --out "$out/p7" >"$out/stdout" 2>&1 || rc=$?
+    [ "$rc" -eq 0 ] && grep -q "gnuplot not found" "$out/stdout" ||
+        { cat "$out/stdout"; fail "without gnuplot: exit status $rc"; }
+fi
+
+# A write that fails keeps the old file whole and says why. RLIMIT_FSIZE
+# (SIGXFSZ ignored: the write fails with EFBIG) stands for a full disk; the
+# limit (40 blocks of 512 or 1024 bytes) is above the old files, below the new.
+limited() { (trap '' XFSZ; ulimit -f 40; exec "$lpi" "$@"); }
+"$lpi" run rigid-body --steps 10 --every 1 --format npy --out "$out/full" >/dev/null
+cp "$out/full/rigid-body.csv" "$out/old.csv"
+rc=0; limited run rigid-body --steps 5000 --every 1 --format npy --out "$out/full" >/dev/null 2>"$out/stderr" || rc=$?
+[ "$rc" -eq 1 ] && grep -q "rigid-body.csv.*File too large" "$out/stderr" ||
+    { cat "$out/stderr"; fail "a CSV too large to write: exit status $rc"; }
+cmp -s "$out/old.csv" "$out/full/rigid-body.csv" || fail "a CSV that could not be written lost the old one"
+no_temporaries "$out/full"
+if [ "$have_se" = 1 ]; then
+    # The .npy files are replaced as one set: the last one failing keeps them all.
+    set -- run sine-euler --N 31 --every 1 --snapshots 1 --format npy --out "$out/set"
+    "$lpi" "$@" --steps 4 >/dev/null
+    (cd "$out/set/sine-euler" && md5sum -- * > "$out/set.md5")
+    rc=0; limited "$@" --steps 6 >/dev/null 2>"$out/stderr" || rc=$?
+    [ "$rc" -eq 1 ] && grep -q "vorticity.npy.*File too large" "$out/stderr" ||
+        { cat "$out/stderr"; fail "a .npy set too large to write: exit status $rc"; }
+    (cd "$out/set/sine-euler" && md5sum -c --quiet "$out/set.md5") || fail "a failed .npy set mixed new files with old"
+    no_temporaries "$out/set/sine-euler"
+fi
+# Modes: a replaced file keeps its own, a new one gets the umask's; a FIFO
+# at an output is refused before the work, and stays a FIFO.
+formats=npy
+"$lpi" run rigid-body --steps 1 --format h5 --out "$out/probe" >/dev/null 2>&1 && formats="npy h5"
+for format in $formats; do
+    data=rigid-body.h5; [ "$format" = h5 ] || data=rigid-body/state.npy
+    rm -rf "$out/mode"
+    (umask 022; "$lpi" run rigid-body --steps 2 --format $format --out "$out/mode" >/dev/null)
+    [ "$(stat -c %a "$out/mode/$data")" = 644 ] || fail "a new $data has mode $(stat -c %a "$out/mode/$data"), not 644"
+    chmod 640 "$out/mode/$data" "$out/mode/rigid-body.csv"
+    (umask 022; "$lpi" run rigid-body --steps 2 --format $format --out "$out/mode" >/dev/null)
+    for f in "$data" rigid-body.csv; do
+        [ "$(stat -c %a "$out/mode/$f")" = 640 ] || fail "a replaced $f has mode $(stat -c %a "$out/mode/$f"), not 640"
+    done
+    rm -f "$out/mode/$data"
+    if mkfifo "$out/mode/$data" 2>/dev/null; then
+        expect 1 "$data.*not a regular file" run rigid-body --steps 2 --format $format --out "$out/mode"
+        [ -p "$out/mode/$data" ] || fail "a FIFO at $data was replaced"
+    fi
+done
+
+# --checkpoint: refused up front when it cannot work or would overwrite an
+# output, and a failed first save leaves the old CSV.
+"$lpi" run moments --steps 3 --out "$out/ck" >/dev/null
+"$lpi" run rigid-body --steps 3 --out "$out/ck" >/dev/null
+cp "$out/ck/moments.csv" "$out/moments.csv"; cp "$out/ck/rigid-body.csv" "$out/rigid.csv"
+expect 2 "moments cannot be checkpointed" run moments --steps 3 --out "$out/ck" --checkpoint "$out/m.lpi"
+expect 2 "moments cannot be checkpointed" run moments --steps 3 --out "$out/ck" --resume "$out/m.lpi"
+expect 1 "no-such-dir" run rigid-body --steps 9 --out "$out/ck" --checkpoint "$out/no-such-dir/x.lpi"
+mkdir -p "$out/a-dir.lpi"
+expect 1 "a-dir.lpi.*directory" run rigid-body --steps 9 --out "$out/ck" --checkpoint "$out/a-dir.lpi"
+expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$out/ck" --checkpoint "$out/ck/rigid-body.csv"
+expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$out/ck" --checkpoint "$out/ck//./rigid-body.csv"
+expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$out/ck" --format npy \
+    --checkpoint "$out/ck/rigid-body/state.npy"
+case $formats in *h5*)
+    expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$out/ck" --format h5 \
+        --checkpoint "$out/ck/rigid-body.h5" ;;
+esac
+cmp -s "$out/moments.csv" "$out/ck/moments.csv" || fail "a refused --checkpoint changed moments.csv"
+cmp -s "$out/rigid.csv" "$out/ck/rigid-body.csv" || fail "a failed --checkpoint changed rigid-body.csv"
+# --resume with another --dt: the checkpoint's time at step 10 of 0.1 is
+# step 20 of 0.05 (as the CSV says, or the data without the CSV).
+"$lpi" run rigid-body --dt 0.05 --steps 20 --out "$out/dt" --checkpoint "$out/dt.lpi" >/dev/null
+expect 2 "resume with the options of the interrupted run" run rigid-body --dt 0.1 --steps 30 --out "$out/dt" \
+    --resume "$out/dt.lpi"
+rm "$out/dt/rigid-body.csv"
+expect 2 "resume with the options of the interrupted run" run rigid-body --dt 0.1 --steps 30 --out "$out/dt" \
+    --resume "$out/dt.lpi"
+# --init: a FIFO is refused, not waited on.
+rm -f "$out/fifo.npy"
+if mkfifo "$out/fifo.npy" 2>/dev/null; then
+    expect 1 "not a regular file" run sine-euler --init "$out/fifo.npy" --steps 1 --out "$out/init"
+fi
+
+if [ "$have_se" = 1 ]; then
+    # H(0) = 0: the absolute energy error, named so in the CSV.
+    "$lpi" run qg --N 9 --kd 1e200 --steps 3 --out "$out/zero" >"$out/stdout" || fail "lpi run qg --kd 1e200"
+    ! grep -qi nan "$out/stdout" "$out/zero/qg.csv" || { cat "$out/stdout"; fail "H(0) = 0: a NaN energy error"; }
+    head -n 1 "$out/zero/qg.csv" | grep -q "^step,time,energy,absolute_energy_error," ||
+        fail "H(0) = 0: the CSV does not say the error is absolute"
+    # rollup stops on SIGINT and SIGTERM as lpi run does, its CSV written.
+    for signal in INT TERM; do
+        rm -rf "$out/roll"
+        "$lpi" run rollup --N 9 --steps 1000000000 --out "$out/roll" >"$out/roll.out" 2>&1 &
+        pid=$!
+        waited=0
+        # Its signal handler is in place once it says it is stepping.
+        until grep -q "stepping" "$out/roll.out" || [ $waited -ge 300 ]; do sleep 0.1; waited=$((waited + 1)); done
+        sleep 0.3
+        kill -$signal $pid
+        rc=0; wait $pid || rc=$?
+        want=130; [ $signal = TERM ] && want=143
+        [ "$rc" -eq $want ] && grep -q "interrupted at step" "$out/roll.out" ||
+            { cat "$out/roll.out"; fail "rollup, SIG$signal: exit status $rc, expected $want"; }
+        [ "$(wc -l < "$out/roll/rollup.csv")" -ge 2 ] && [ -s "$out/roll/rollup_spectra.csv" ] ||
+            fail "rollup, SIG$signal: the CSV files were not written"
+        [ "$(tail -n 1 "$out/roll/rollup.csv" | tr -cd , | wc -c)" -eq 3 ] || fail "rollup, SIG$signal: last row cut"
+    done
+fi
+echo "PASS: lpi's files: no shell, failed plots and writes reported, old files kept, paths checked"
