@@ -269,6 +269,7 @@ private:
     void apply_scalings(const double *g, double t, double *x);  // DiagonalSeries: exp(tD) after N
     bool shear(double *x);  // depth 1, x untouched on failure
     void apply_plane(double t, double *x);  // a block of order 1 or 2
+    void apply_shears(const double A[4], double x0, double x1, double *x);  // the plane's elliptic flows
     void apply_pade(double t, double *x);
     void check_norm(double norm, double t) const;
     // Throws LPI_ERR_NONFINITE naming the first moved index whose entry of

@@ -531,6 +531,46 @@ void SparseExponential::apply_scalings(const double *g, double t, double *x) {
     for (std::size_t d = 0; d < scalings_.size(); ++d) x[scalings_[d].global] = scaled_values_[d];
 }
 
+// exp(A) of a traceless A with complex eigenvalues (a rotation of so(3) or
+// e(2), an elliptic flow of sl(2)): M = [[m00, m01], [m10, m11]], det M = 1,
+// as three shears, M = U(a) L(m10) U(c) with U(a) = [[1, a], [0, 1]], L the
+// lower one, a = (m00 - 1) / m10, c = (m11 - 1) / m10. Formed as x + (M - I)
+// x from a rounded M, the map's determinant was off 1 by the same amount in
+// every flow whose angle is the same (a linear Hamiltonian: a spin in a
+// field), and the Casimir drifted with one sign (so(3), H = x1, t = 0.7: 59
+// standard errors over 6e4 random states). Shears keep the determinant 1
+// whatever their rounded coefficients: what is left is a symmetric traceless
+// error, which averages out over the directions of x. Past a quarter turn
+// (m00 + m11 < 0) the shears of -M are applied and x negated. A rotation
+// [[0, b], [-b, 0]] takes a = c = tan(b / 2) (or -cot(b / 2)) and m10 = -sin b
+// from the half angle's sine and cosine.
+void SparseExponential::apply_shears(const double A[4], double x0, double x1, double *x) {
+    double first, lower, last;
+    bool turned;
+    if (A[0] == 0.0 && A[2] == -A[1]) {
+        const double sine = std::sin(0.5 * A[1]), cosine = std::cos(0.5 * A[1]);
+        turned = std::fabs(cosine) < std::fabs(sine);
+        first = last = turned ? -cosine / sine : sine / cosine;
+        lower = turned ? 2.0 * sine * cosine : -2.0 * sine * cosine;
+    } else {
+        double W[4];  // M - I
+        plane_expm1(A[0], A[1], A[2], A[3], W);
+        turned = W[0] + W[3] < -2.0;
+        lower = turned ? -W[2] : W[2];
+        first = turned ? (2.0 + W[0]) / W[2] : W[0] / W[2];
+        last = turned ? (2.0 + W[3]) / W[2] : W[3] / W[2];
+    }
+    double y0 = x0 + last * x1;
+    const double y1 = x1 + lower * y0;
+    y0 = y0 + first * y1;
+    const double z0 = turned ? -y0 : y0, z1 = turned ? -y1 : y1;
+    increment_[0] = z0 - x0;  // only to name a non-finite component
+    increment_[1] = z1 - x1;
+    if (!std::isfinite(z0) || !std::isfinite(z1)) fail_nonfinite();
+    x[moved_[0]] = z0;
+    x[moved_[1]] = z1;
+}
+
 void SparseExponential::apply_plane(double t, double *x) {
     double A[4] = {0.0, 0.0, 0.0, 0.0};
     for (std::size_t j = 0; j < block_.size(); ++j) A[block_[j].row * 2 + block_[j].col] = scaled_[j];
@@ -546,6 +586,10 @@ void SparseExponential::apply_plane(double t, double *x) {
     const double x1 = x[moved_[1]];
     const double tau = 0.5 * (A[0] + A[3]), p = 0.5 * (A[0] - A[3]);
     const double delta = p * p + A[1] * A[2];
+    if (tau == 0.0 && delta < 0.0) {
+        apply_shears(A, x0, x1, x);
+        return;
+    }
     const bool apart = delta > 0.0 && std::sqrt(delta) > kIncrementFormLimit;
     if (!apart && tau >= -kIncrementFormLimit) {
         double W[4];
