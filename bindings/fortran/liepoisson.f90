@@ -14,7 +14,8 @@
 ! What C cannot see is refused here, before any C call and changing nothing:
 ! a string holding a NUL (LPI_ERR_INVALID: C would stop reading there), a
 ! negative dim (LPI_ERR_INVALID), sine-Euler arrays not N x N and the four
-! bracket arrays of lpi_generic_create differing in length (LPI_ERR_SIZE).
+! bracket arrays of lpi_generic_create differing in length, and an array for
+! lpi_rigid_body_exact of other than 3 values (LPI_ERR_SIZE).
 ! lpi_last_error does not describe these; the stop message does.
 ! Handles are type(c_ptr). Index sets and bracket indices are 0-based, as in C.
 ! Sine-Euler modes and grids are arrays w(0:N-1, 0:N-1) with w(a, b) = mode
@@ -621,8 +622,16 @@ contains
     subroutine lpi_rigid_body_exact(sys, t, m, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: t
-        real(c_double), intent(out) :: m(3)
+        real(c_double), intent(out) :: m(:)
         integer, intent(out), optional :: status
+        character(len=24) :: text
+        ! C writes three values and is told no length: any other size is
+        ! refused here (a size 2 array was written past its end).
+        if (size(m) /= 3) then
+            write (text, '(i0)') size(m)
+            call refuse(LPI_ERR_SIZE, "m has "//trim(text)//" elements, the exact solution 3", status)
+            return
+        end if
         call finish(c_lpi_rigid_body_exact(sys, t, m), sys, status)
     end subroutine
 
@@ -1161,7 +1170,9 @@ contains
 
     subroutine lpi_load_buffer(sys, bytes, status)
         type(c_ptr), intent(out) :: sys
-        integer(c_int8_t), target, intent(in) :: bytes(:)
+        ! contiguous: a strided or reversed section is copied in, so that the
+        ! address C reads from holds the bytes in order.
+        integer(c_int8_t), contiguous, target, intent(in) :: bytes(:)
         integer, intent(out), optional :: status
         call finish(c_lpi_load_buffer(sys, c_loc(bytes), size(bytes, kind=c_size_t)), c_null_ptr, status)
     end subroutine

@@ -149,8 +149,8 @@ contains
 
     subroutine test_rigid_body()
         type(c_ptr) :: sys, copy, copy2
-        real(c_double) :: m(3), m_copy(3), c0(1), c1(1), exact(3), h
-        integer(c_int8_t), allocatable :: bytes(:)
+        real(c_double) :: m(3), m_copy(3), c0(1), c1(1), exact(3), h, short_m(2)
+        integer(c_int8_t), allocatable :: bytes(:), spread_bytes(:)
         integer :: flows, status
         call lpi_rigid_body_create(sys, 1.0_c_double, 2.0_c_double, 3.0_c_double)
         call check(lpi_dim(sys) == 3, "rigid body dim")
@@ -182,6 +182,19 @@ contains
         call check(all(m == m_copy), "checkpoint resumes bit for bit")
         call lpi_load_buffer(copy2, bytes(1:size(bytes) - 1), status)
         call check(status == LPI_ERR_FORMAT, "truncated checkpoint refused")
+        ! A strided section holding the checkpoint loads (C was handed the
+        ! address of its first element and read the gaps).
+        allocate (spread_bytes(2 * size(bytes)))
+        spread_bytes = 0
+        spread_bytes(1::2) = bytes
+        call lpi_load_buffer(copy2, spread_bytes(1::2), status)
+        call check(status == LPI_OK, "checkpoint from a strided section")
+        call lpi_get_state(copy2, m_copy)
+        call lpi_destroy(copy2)
+        ! The exact solution has 3 values: any other array is refused, not
+        ! written past its end.
+        call lpi_rigid_body_exact(sys, 1.0_c_double, short_m, status)
+        call check(status == LPI_ERR_SIZE, "exact solution into 2 values refused")
         call lpi_destroy(copy)
         call lpi_destroy(sys)
         call check(.not. c_associated(sys), "destroy nulls the handle")

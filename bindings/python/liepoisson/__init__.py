@@ -118,6 +118,14 @@ def _complex(value, what):
     return complex(value)
 
 
+def _callable(value, what):
+    """value itself if it can be called, else TypeError: the library hands C
+    a wrapper that always exists, so C's own check for NULL never sees None."""
+    if not callable(value):
+        raise TypeError("%s must be callable, not %s" % (what, type(value).__name__))
+    return value
+
+
 def _is_array(value):
     """Whether value is an array to read entry by entry: a sequence (list,
     tuple, array.array, range) or an array object (numpy's, anything with
@@ -406,9 +414,15 @@ def _real_array(values, what, kinds="iuf"):
     numbers: TypeError for strings, objects, booleans and (unless allowed)
     complex numbers, which numpy would otherwise convert or truncate, and
     for what list mode refuses (a set, a dict, bytes)."""
-    a = np.asarray(_array(values, what))
-    if a.dtype == object:  # each entry through the scalar check, as in list mode
-        a = np.asarray(_nested(values, what, _complex if "c" in kinds else _real))
+    convert = _complex if "c" in kinds else _real
+    if isinstance(values, np.ndarray):
+        a = values
+        if a.dtype == object:  # each entry through the scalar check, as in list mode
+            a = np.asarray(_nested(values, what, convert))
+    else:
+        # A sequence entry by entry, as list mode reads it: np.asarray would
+        # take a bool among floats as 1.0.
+        a = np.asarray(_nested(values, what, convert))
     if a.dtype.kind not in kinds:
         raise TypeError("%s must be %s numbers, not an array of %s"
                         % (what, "complex" if "c" in kinds else "real", a.dtype))
@@ -926,6 +940,9 @@ class System:
             if n < previous:
                 raise ValueError("t_eval entry %r lies behind %s (steps of %r from the time %r)"
                                  % (t, "the previous one" if counts else "the current time", dt, start))
+            if n > 2**63 - 1:  # refused here, not after stepping to the times before it
+                raise ValueError("t_eval entry %r is %.6g steps of %r from the time %r: more than a "
+                                 "step count holds (2**63 - 1)" % (t, exact, dt, start))
             counts.append(n)
             previous = n
         dim, ncas = self.dim, self.casimir_count
@@ -1259,7 +1276,11 @@ class Generic(System):
         ------
         NotAbelianError
             The indices do not commute under the bracket.
+        TypeError
+            `gradient` or `energy` is not callable.
         """
+        _callable(gradient, "gradient")
+        _callable(energy, "energy")
         idx, n = _int32s(indices, "piece index")
 
         def grad_body(m, x, out, user):
@@ -1284,7 +1305,14 @@ class Generic(System):
         ----------
         casimir : callable
             ``casimir(x)`` of the full state returns a float.
+
+        Raises
+        ------
+        TypeError
+            `casimir` is not callable.
         """
+        _callable(casimir, "casimir")
+
         def body(dim, x, out, user):
             out[0] = _real(casimir(_callback_view(x, dim)), "Casimir's result")
 
@@ -1344,7 +1372,15 @@ class Moments(Generic):
             ``h(u)``, the piece as a function of u = x1 x3.
         dh : callable
             ``dh(u)``, its derivative H'(u).
+
+        Raises
+        ------
+        TypeError
+            `h` or `dh` is not callable.
         """
+        _callable(h, "h")
+        _callable(dh, "dh")
+
         def scalar_body(f, what):
             def body(u, out, user):
                 out[0] = _real(f(u), what)

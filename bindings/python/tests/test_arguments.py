@@ -141,10 +141,28 @@ class TestArraysAndStrings(unittest.TestCase):
     def test_states_must_be_real_vectors(self):
         with rigid_body() as b:
             state = as_list(b.state)
-            for bad in (["1", "2", "3"], [1.0, None, 2.0], [1j, 0.0, 0.0]):
+            # [True, 0.5, 0.3]: numpy took the bool among floats as 1.0.
+            for bad in (["1", "2", "3"], [1.0, None, 2.0], [1j, 0.0, 0.0], [True, 0.5, 0.3],
+                        (0.5, False, 0.3)):
                 with self.assertRaises(TypeError):
                     b.state = bad
                 self.assertEqual(as_list(b.state), state)
+
+    def test_callbacks_must_be_callable(self):
+        # Refused when added: they used to fail only at the first step.
+        g = lp.Generic(3, SO3)
+        for gradient, energy in ((None, lambda x: 0.0), (lambda x: [0.0], None), (42, 42)):
+            with self.assertRaises(TypeError):
+                g.add_piece([0], gradient, energy)
+        with self.assertRaises(TypeError):
+            g.add_casimir(None)
+        g.close()
+        m = lp.Moments()
+        with self.assertRaises(TypeError):
+            m.add_product_piece(None, 42)
+        with self.assertRaises(TypeError):
+            m.add_product_piece(lambda u: u, "dh")
+        m.close()
 
     def test_arrays_are_sequences_in_both_modes(self):
         # Iterating these gives byte values, keys, characters or an arbitrary

@@ -59,8 +59,9 @@ class TestIntegrate(unittest.TestCase):
 
     def test_times_off_the_grid_or_behind_are_refused(self):
         with body() as b:
+            # [0.5, 1e30]: a step count past int64, refused before stepping to 0.5.
             for bad, dt in (([0.0, 0.105], DT), ([0.5, 0.2], DT), ([-0.01], DT), ([0.1], -DT),
-                            ([float("nan")], DT), ([float("inf")], DT)):
+                            ([float("nan")], DT), ([float("inf")], DT), ([0.5, 1e30], DT)):
                 with self.assertRaises(ValueError, msg=repr(bad)):
                     b.integrate(bad, dt)
                 self.assertEqual(b.time, 0.0)  # nothing stepped
