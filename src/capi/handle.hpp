@@ -71,9 +71,10 @@ inline const char *refusal(const lpi_system *sys, bool mutates) {
     return sys->activity == Activity::Observing
                ? "called from this handle's observer, which may only read the handle (functions "
                  "taking a const lpi_system *); nothing was changed"
-               : "called from a callback that the library is running inside a call on this "
-                 "handle (a piece, Casimir or product-piece callback); no call on the handle is "
-                 "allowed there, and nothing was changed";
+               : "the handle is inside a call already: called from a callback that the library "
+                 "is running in it (a piece, Casimir or product-piece callback), where no call on "
+                 "the handle is allowed, or from another thread (a handle is used by one thread at "
+                 "a time); nothing was changed";
 }
 
 // A string argument compared by its contents (other pointers are compared
