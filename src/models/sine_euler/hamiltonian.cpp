@@ -22,10 +22,11 @@ std::string mode_name(std::size_t i, int N) {
            std::to_string(i % static_cast<std::size_t>(N)) + ")";
 }
 
-// The zero mode's entries (the first per_mode) are ignored, as documented.
+// Every entry, the zero mode's too: ignored, they must still be numbers (a
+// NaN there was taken silently).
 void require_finite(const double *values, std::size_t n, std::size_t per_mode, const char *what,
                     int N) {
-    for (std::size_t i = per_mode; i < n; ++i)
+    for (std::size_t i = 0; i < n; ++i)
         if (!std::isfinite(values[i]))
             fail(LPI_ERR_NONFINITE, std::string(what) + " of mode " + mode_name(i / per_mode, N) +
                                         " at index " + std::to_string(i) + " is not finite");
