@@ -327,10 +327,19 @@ function _keep!(sys::System, f)
     cb
 end
 
+# A callback must be callable: C is handed a trampoline that always exists,
+# so `nothing` or a number would fail only at the first step.
+function _callable(f, what)
+    (f isa Function || !isempty(methods(f))) ||
+        throw(ArgumentError("$what must be callable, not $(typeof(f))"))
+    f
+end
+
 """add_piece!(sys, indices, gradient, energy): the piece on the 0-based abelian set
 `indices`; gradient(x_sigma) returns n values and energy(x_sigma) a number. The
 gradient and energy share one user pointer each: two pieces of state are kept."""
 function add_piece!(sys::System, indices::AbstractVector{<:Integer}, gradient, energy)
+    _callable(gradient, "gradient"); _callable(energy, "energy")
     idx = Vector{Int32}(indices)
     g = _keep!(sys, gradient); e = _keep!(sys, energy)
     # The C function takes one user pointer for both callbacks: a pair dispatches.
@@ -351,12 +360,14 @@ _pair_energy_ptr() = @cfunction(_pair_energy, Cint, (Csize_t, Ptr{Cdouble}, Ptr{
 
 """add_casimir!(sys, f): declares the Casimir f(x) of the full state."""
 function add_casimir!(sys::System, f)
+    _callable(f, "the Casimir")
     cb = _keep!(sys, f)
     _call(h -> C.lpi_add_casimir(h, _scalar_of_vector_ptr(), pointer_from_objref(cb)), sys)
 end
 
 """add_product_piece!(sys, H, dH): the moment piece H(x1 x3) with H'(u) = dH(u)."""
 function add_product_piece!(sys::System, H, dH)
+    _callable(H, "H"); _callable(dH, "dH")
     pair = _keep!(sys, (_keep!(sys, H), _keep!(sys, dH)))
     _call(h -> C.lpi_moments_add_product_piece(h, _pair_h_ptr(), _pair_dh_ptr(),
                                                pointer_from_objref(pair)), sys)
