@@ -114,14 +114,14 @@ inline bool may_contract_by_half(double a) { return std::fabs(a) > 0.5; }
 // by the rounding of values that depend on the state. A constant rounded the
 // same way in every flow (the same t and g) moves each flow off the group in
 // the same direction, and the Casimirs drift linearly: the moments' I by
-// 2.7e-18 of its terms a leapfrog step at dt = 0.2 (38 standard errors over
-// 2e5 random states), 2e-12 after 1e6 steps, where rounding alone gives
-// 1e-13. Two such constants are kept out:
+// -8.6e-18 of its terms in one flow of V at t = 0.2 (38 standard errors over
+// 2e5 random states), 2e-12 after 1e6 leapfrog steps, where rounding alone
+// gives 1e-13. Two such constants are kept out:
 //  - the entries t c g_p of t A, each rounded on its own, are no multiple of
 //    the C_p. So s_p = t g_p is rounded once (exp(s_p C_p) is still a flow
-//    of the algebra) and shortened to a width at which c s_p is exact for
-//    every coefficient c of parameter p (shortening_bits; a coefficient with
-//    more than kMaxShorteningBits significant bits is left to round).
+//    of the algebra) and cut to a width at which c s_p is exact for every
+//    coefficient c of parameter p (shortening_bits; a coefficient with more
+//    than kMaxShorteningBits significant bits is left to round).
 //  - the 1/k of the series (1/3, 1/5, ...): the k-th terms are acc / k =
 //    acc hi + acc lo, hi + lo = 1/k to twice the precision.
 constexpr int kMaxShorteningBits = 8;
