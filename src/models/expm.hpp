@@ -182,6 +182,11 @@ inline double divided(double acc, std::size_t k, const Reciprocal &r) {
     return (k & (k - 1)) == 0 ? acc * r.hi : acc * r.hi + acc * r.lo;
 }
 
+// The terms split by the blocks of indices they join (rows and columns
+// together; an index touched by no term is in none), each block's terms in
+// their order. One block: the terms themselves.
+std::vector<std::vector<SparseTerm>> disjoint_blocks(const std::vector<SparseTerm> &terms);
+
 // LPI_ERR_NONFINITE: the exact flow's increment of `component` is not finite.
 [[noreturn]] void fail_flow_overflow(std::size_t component);
 
@@ -222,6 +227,12 @@ public:
     ExpmPath path() const { return path_; }
     // The longest path of a nilpotent pattern (A^(depth+1) = 0), else -1.
     long depth() const { return path_ == ExpmPath::Nilpotent ? static_cast<long>(depth_) : -1; }
+
+    // Per parameter, the bits cut from s_p = t g_p (see shortened), and a
+    // wider cut to share with the other blocks of one flow (disjoint_blocks),
+    // so that every block runs for the very same times s_p.
+    const std::vector<int> &shortening() const { return shortening_; }
+    void widen_shortening(const std::vector<int> &bits);
 
     // Applies x <- exp(t A) x in place for A = sum_p g[p] C_p.
     // Throws lpi::Error, x unchanged, when the result is not finite

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -156,6 +157,28 @@ constexpr double kIncrementFormLimit = 0.6931471805599453;
 }  // namespace
 
 // ---- sparse exponentials of a fixed pattern -----------------------------------
+
+std::vector<std::vector<SparseTerm>> disjoint_blocks(const std::vector<SparseTerm> &terms) {
+    // Union-find over the indices the terms name.
+    std::map<std::uint32_t, std::uint32_t> parent;
+    auto root = [&](std::uint32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    for (const SparseTerm &t : terms) {
+        parent.emplace(t.row, t.row);
+        parent.emplace(t.col, t.col);
+        parent[root(t.row)] = root(t.col);
+    }
+    std::map<std::uint32_t, std::size_t> block_of;  // root -> block, in order of first term
+    std::vector<std::vector<SparseTerm>> blocks;
+    for (const SparseTerm &t : terms) {
+        const auto found = block_of.emplace(root(t.row), blocks.size());
+        if (found.second) blocks.emplace_back();
+        blocks[found.first->second].push_back(t);
+    }
+    return blocks;
+}
 
 SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> terms) {
     std::sort(terms.begin(), terms.end(), [](const SparseTerm &a, const SparseTerm &b) {
@@ -386,6 +409,12 @@ void SparseExponential::check_norm(double norm, double t) const {
                       norm, kMaxSquarings);
         fail(LPI_ERR_INVALID, text);
     }
+}
+
+void SparseExponential::widen_shortening(const std::vector<int> &bits) {
+    if (shortening_.size() < bits.size()) shortening_.resize(bits.size(), 0);
+    for (std::size_t p = 0; p < bits.size(); ++p) shortening_[p] = std::max(shortening_[p], bits[p]);
+    times_.resize(shortening_.size());
 }
 
 void SparseExponential::shorten_times(const double *g, double t) {

@@ -4,7 +4,6 @@
 #include <cfloat>
 #include <cmath>
 #include <map>
-#include <optional>
 #include <tuple>
 
 #include "../core/error.hpp"
@@ -227,7 +226,7 @@ public:
         for (std::size_t p = 1; p < sigma_.size(); ++p)
             consecutive_ = consecutive_ && sigma_[p] == sigma_[p - 1] + 1;
         if (!compiled_) {
-            exponential_.emplace(constants_.dim(), flow_terms(constants_, sigma_));
+            plan_blocks(flow_terms(constants_, sigma_));
             return;
         }
         // A compiled flow takes g in the order of the sorted index set.
@@ -248,8 +247,17 @@ public:
                 }
                 const long failed = compiled_(g, t, x);
                 if (failed >= 0) fail_flow_overflow(static_cast<std::size_t>(failed));
+            } else if (exponentials_.size() == 1) {
+                exponentials_.front().apply(g_.data(), t, x);
             } else {
-                exponential_->apply(g_.data(), t, x);
+                // x as it was when a block fails after others wrote theirs.
+                std::copy(x, x + backup_.size(), backup_.begin());
+                try {
+                    for (SparseExponential &block : exponentials_) block.apply(g_.data(), t, x);
+                } catch (...) {
+                    std::copy(backup_.begin(), backup_.end(), x);
+                    throw;
+                }
             }
         } catch (const Error &e) {
             fail(e.status(), label() + ": " + e.what());
@@ -283,6 +291,30 @@ private:
             for (const StructureConstants::Term &t : constants.column(sigma[p]))
                 terms.push_back({t.i, t.l, static_cast<std::uint32_t>(p), t.c});
         return terms;
+    }
+
+    // The general plan. A pattern that falls apart into blocks sharing no
+    // index and, whole, would take the Pade path (e(3) with H = J1 rotates
+    // (J2, J3) and (P2, P3)) is applied block by block, each plane in closed
+    // form: the whole's exp(tA), rounded once a flow, is a constant of the
+    // flow wherever g is, and |P|^2 drifted with one sign (84 standard errors
+    // over 1e5 random states at t = 0.7). The blocks share their cut of s_p,
+    // so that all run for the very same times.
+    void plan_blocks(const std::vector<SparseTerm> &terms) {
+        exponentials_.emplace_back(constants_.dim(), terms);
+        if (exponentials_.front().path() != ExpmPath::Pade) return;
+        std::vector<std::vector<SparseTerm>> blocks = disjoint_blocks(terms);
+        if (blocks.size() < 2) return;
+        exponentials_.clear();
+        std::vector<int> shortening;
+        for (std::vector<SparseTerm> &block : blocks) {
+            exponentials_.emplace_back(constants_.dim(), std::move(block));
+            const std::vector<int> &bits = exponentials_.back().shortening();
+            if (shortening.size() < bits.size()) shortening.resize(bits.size(), 0);
+            for (std::size_t p = 0; p < bits.size(); ++p) shortening[p] = std::max(shortening[p], bits[p]);
+        }
+        for (SparseExponential &block : exponentials_) block.widen_shortening(shortening);
+        backup_.resize(constants_.dim());
     }
 
     // x_sigma: where the index set is a run of consecutive indices (a single
@@ -322,7 +354,8 @@ private:
     CompiledFlow compiled_;
     std::vector<std::uint32_t> rank_;  // compiled, sigma_ not sorted: sigma_[p]'s place in order
     std::vector<double> sorted_g_;
-    std::optional<SparseExponential> exponential_;  // the general plan, without one
+    std::vector<SparseExponential> exponentials_;  // the general plan, without one: its blocks
+    std::vector<double> backup_;                   // x before the blocks, where there are several
 };
 
 }  // namespace
