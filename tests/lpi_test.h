@@ -111,6 +111,29 @@ static inline void lpi_assert_unchanged(const lpi_system *sys, const lpi_snapsho
         if (sys) lpi_assert_unchanged(sys, &lpi_before_);                                 \
     } while (0)
 
+/* Random numbers in [-1, 1) from a 64-bit linear congruential generator:
+ * the same sequence on every platform, for the tests' random states. */
+static inline double lpi_test_uniform(uint64_t *seed) {
+    *seed = *seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*seed >> 11) * 0x1p-52 - 1.0;
+}
+
+/* Whether a quantity's mean is zero: samples added one by one, then the mean,
+ * the spread and the mean in standard errors (z), for the bias tests. */
+typedef struct {
+    double sum, squares;
+    long count;
+} lpi_test_mean;
+
+static inline void lpi_test_mean_add(lpi_test_mean *m, double value) {
+    m->sum += value, m->squares += value * value, ++m->count;
+}
+static inline double lpi_test_mean_z(const lpi_test_mean *m, double *mean, double *spread) {
+    *mean = m->sum / (double)m->count;
+    *spread = sqrt(m->squares / (double)m->count - *mean * *mean);
+    return *mean / (*spread / sqrt((double)m->count));
+}
+
 /* Classical RK4 written independently of the library, for references. */
 typedef void (*lpi_test_field)(const double *x, double *dx, const void *ctx);
 

@@ -443,26 +443,20 @@ static void test_constant_rotation_without_bias(void **state) {
     assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
     const double steps[3] = {0.7, 0.3, 2.5}; /* 2.5: the turned shears (past pi / 2) */
     for (int d = 0; d < 3; ++d) {
-        const int samples = 60000;
         uint64_t seed = 99;
-        double sum = 0.0, squares = 0.0;
-        for (int m = 0; m < samples; ++m) {
+        lpi_test_mean change = {0};
+        for (int m = 0; m < 60000; ++m) {
             double x[3], y[3];
-            for (int e = 0; e < 3; ++e) {
-                seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-                x[e] = (double)(seed >> 11) * 0x1p-52 - 1.0;
-            }
+            for (int e = 0; e < 3; ++e) x[e] = lpi_test_uniform(&seed);
             assert_int_equal(lpi_set_state(sys, x, 3), LPI_OK);
             assert_int_equal(lpi_step(sys, steps[d], 1), LPI_OK);
             assert_int_equal(lpi_get_state(sys, y, 3), LPI_OK);
             long double before = 0.0L, after = 0.0L;
             for (int e = 0; e < 3; ++e) before += (long double)x[e] * x[e], after += (long double)y[e] * y[e];
-            const double change = (double)((after - before) / before);
-            sum += change;
-            squares += change * change;
+            lpi_test_mean_add(&change, (double)((after - before) / before));
         }
-        const double mean = sum / samples, spread = sqrt(squares / samples - mean * mean);
-        const double z = mean / (spread / sqrt((double)samples));
+        double mean, spread;
+        const double z = lpi_test_mean_z(&change, &mean, &spread);
         printf("so(3), H = x1, one flow of %g: mean change of |x|^2 %.2e, %.1f standard errors "
                "(rounding: %.2e a flow)\n", steps[d], mean, z, spread);
         assert_true(fabs(z) < 5.0);
@@ -486,15 +480,11 @@ static void test_disjoint_blocks_without_bias(void **state) {
     const int32_t axis = 0;
     assert_int_equal(lpi_add_piece(sys, 1, &axis, field_gradient, field_energy, NULL), LPI_OK);
     assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
-    const int samples = 60000;
     uint64_t seed = 7;
-    double sums[2] = {0.0, 0.0}, squares[2] = {0.0, 0.0};
-    for (int m = 0; m < samples; ++m) {
+    lpi_test_mean changes[2] = {{0.0, 0.0, 0}, {0.0, 0.0, 0}};
+    for (int m = 0; m < 60000; ++m) {
         double x[6], y[6];
-        for (int e = 0; e < 6; ++e) {
-            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-            x[e] = (double)(seed >> 11) * 0x1p-52 - 1.0;
-        }
+        for (int e = 0; e < 6; ++e) x[e] = lpi_test_uniform(&seed);
         assert_int_equal(lpi_set_state(sys, x, 6), LPI_OK);
         assert_int_equal(lpi_step(sys, 0.7, 1), LPI_OK);
         assert_int_equal(lpi_get_state(sys, y, 6), LPI_OK);
@@ -503,12 +493,12 @@ static void test_disjoint_blocks_without_bias(void **state) {
             p0 += (long double)x[e] * x[e], p1 += (long double)y[e] * y[e];
             q0 += (long double)x[e - 3] * x[e], q1 += (long double)y[e - 3] * y[e];
         }
-        const double change[2] = {(double)((p1 - p0) / p0), (double)((q1 - q0) / sqrtl(3.0L * p0))};
-        for (int q = 0; q < 2; ++q) sums[q] += change[q], squares[q] += change[q] * change[q];
+        lpi_test_mean_add(&changes[0], (double)((p1 - p0) / p0));
+        lpi_test_mean_add(&changes[1], (double)((q1 - q0) / sqrtl(3.0L * p0)));
     }
     for (int q = 0; q < 2; ++q) {
-        const double mean = sums[q] / samples, spread = sqrt(squares[q] / samples - mean * mean);
-        const double z = mean / (spread / sqrt((double)samples));
+        double mean, spread;
+        const double z = lpi_test_mean_z(&changes[q], &mean, &spread);
         printf("e(3), H = J1, one flow of 0.7: mean change of %s %.2e, %.1f standard errors\n",
                q == 0 ? "|P|^2" : "J.P", mean, z);
         assert_true(fabs(z) < 5.0);

@@ -518,25 +518,19 @@ static void test_casimirs_without_bias(void **state) {
     assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
     const double steps[3] = {0.2, 0.1, 0.05};
     for (int d = 0; d < 3; ++d) {
-        const int samples = 60000;
         uint64_t seed = 12345;
-        double sum = 0.0, squares = 0.0;
-        for (int m = 0; m < samples; ++m) {
+        lpi_test_mean change = {0};
+        for (int m = 0; m < 60000; ++m) {
             double x[8], y[8];
-            for (int i = 0; i < 8; ++i) {
-                seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-                x[i] = (double)(seed >> 11) * 0x1p-52 - 1.0; /* [-1, 1) */
-            }
+            for (int i = 0; i < 8; ++i) x[i] = lpi_test_uniform(&seed);
             assert_int_equal(lpi_set_state(sys, x, 8), LPI_OK);
             assert_int_equal(lpi_step(sys, steps[d], 1), LPI_OK);
             assert_int_equal(lpi_get_state(sys, y, 8), LPI_OK);
             const double terms = fabs(x[3] * x[7]) + 4.0 * fabs(x[4] * x[6]) + 3.0 * x[5] * x[5];
-            const double change = (double)(wide_I(y) - wide_I(x)) / terms;
-            sum += change;
-            squares += change * change;
+            lpi_test_mean_add(&change, (double)(wide_I(y) - wide_I(x)) / terms);
         }
-        const double mean = sum / samples, spread = sqrt(squares / samples - mean * mean);
-        const double z = mean / (spread / sqrt((double)samples));
+        double mean, spread;
+        const double z = lpi_test_mean_z(&change, &mean, &spread);
         printf("moments, one lie-trotter step of %g: mean change of I %.2e of its terms, %.1f standard "
                "errors (rounding: %.2e a step)\n", steps[d], mean, z, spread);
         assert_true(fabs(z) < 5.0);
