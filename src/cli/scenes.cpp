@@ -93,14 +93,14 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         "pendulum", "planar pendulum H = x3^2/2 + x2, x(0) = (sin 2, -cos 2, 0.3)",
         [] { return pendulum({std::sin(2.0), -std::cos(2.0), 0.3}); }, 100.0,
         {0.8, 0.4, 0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625});
-    pendulum_scene.reference_method = "rk4";
-    pendulum_scene.reference_step = 2e-4;
+    pendulum_scene.reference_method = "kahan-li-8";
+    pendulum_scene.reference_step = 0.005;
     scenes.push_back(pendulum_scene);
 
     Scene moments = sweep_scene("moments", "moment algebra (8-dim), pieces V(x1,x4) + T(x3,x8) + P(x1 x3)",
                                 coupled_moments, 20.0, {0.05, 0.025, 0.0125, 0.00625, 0.003125});
     moments.reference_method = "kahan-li-8";
-    moments.reference_step = 5e-4;
+    moments.reference_step = 0.01;
     scenes.push_back(moments);
     {
         Scene s;
