@@ -149,6 +149,14 @@ static void test_recursive_names(void **state) {
     }
     LPI_ASSERT_FAILS(sys, lpi_set_method(sys, "triple-jump-7"), LPI_ERR_INVALID, "lpi_set_method");
     assert_non_null(strstr(lpi_last_error(sys), "must be even, from 2 to 16"));
+    /* A malformed order is an unknown name, not a wrong order (p = 4 is
+     * right), and control characters are shown escaped, on one line. */
+    LPI_ASSERT_FAILS(sys, lpi_set_method(sys, "triple-jump-4 "), LPI_ERR_INVALID, "lpi_set_method");
+    assert_non_null(strstr(lpi_last_error(sys), "unknown method 'triple-jump-4 ' (known: "));
+    assert_null(strstr(lpi_last_error(sys), "must be even"));
+    LPI_ASSERT_FAILS(sys, lpi_set_method(sys, "leapfrog\n\x01"), LPI_ERR_INVALID, "lpi_set_method");
+    assert_non_null(strstr(lpi_last_error(sys), "unknown method 'leapfrog\\n\\x01' (known: "));
+    assert_null(strchr(lpi_last_error(sys), '\n'));
     LPI_ASSERT_FAILS(sys, lpi_set_method(sys, "custom"), LPI_ERR_INVALID, "lpi_set_method");
     lpi_destroy(sys);
 }

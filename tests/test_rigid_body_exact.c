@@ -428,7 +428,8 @@ static void test_bad_input(void **state) {
     assert_int_equal(lpi_rigid_body_create(&spread, 1e-165, 1.0, 1e165), LPI_OK);
     assert_int_equal(lpi_set_state(spread, m, 3), LPI_OK);
     LPI_ASSERT_FAILS(spread, lpi_rigid_body_exact(spread, 1.0, out), LPI_ERR_OVERFLOW, "lpi_rigid_body_exact");
-    assert_non_null(strstr(lpi_last_error(spread), "ratio of the inertias"));
+    /* The message names the two inertias, not an internal scaling. */
+    assert_non_null(strstr(lpi_last_error(spread), "ratio of the inertias 9.999999999999999e+164 and 1e-165"));
     lpi_destroy(spread);
     lpi_destroy(body);
     lpi_destroy(pendulum);

@@ -139,11 +139,13 @@ void rigid_body_exact(const double inertia[3], const double m0[3], double t, dou
     // |m| is conserved, so the solution itself is always a double; what may
     // not be is, for inertias more than 2^1022 apart, the smallest scaled to
     // the largest, or (below) the phase, t times the body's rates.
+    const double largest = std::max({inertia[0], inertia[1], inertia[2]});
     for (int k = 0; k < 3; ++k)
         if (!std::isnormal(I[k]))
-            fail(LPI_ERR_OVERFLOW, "the ratio of the inertias " + number_text(inertia[k]) + " and 2^" +
-                                       std::to_string(i_exponent) +
-                                       " overflows a double: the exact solution needs it");
+            fail(LPI_ERR_OVERFLOW, "the ratio of the inertias " + number_text(largest) + " and " +
+                                       number_text(inertia[k]) +
+                                       " is beyond 2^1022: the exact solution needs it as a "
+                                       "normal double");
 
     if (I[0] == I[1]) {
         symmetric_top(I, m, 2, scaled_t, out);

@@ -6,6 +6,7 @@
 
 #include "../core/checkpoint.hpp"
 #include "../core/files.hpp"
+#include "../core/text.hpp"
 #include "handle.hpp"
 
 using lpi::capi::Arguments;
@@ -39,7 +40,7 @@ int load(lpi_system **out, const char *function, const char *path, Read &&read) 
             *out = handle.release();
         } catch (const lpi::Error &e) {
             if (!path || (e.status() != LPI_ERR_FORMAT && e.status() != LPI_ERR_UNSUPPORTED)) throw;
-            lpi::fail(e.status(), std::string("'") + path + "': " + e.what());
+            lpi::fail(e.status(), lpi::quoted(path) + ": " + e.what());
         }
     });
 }

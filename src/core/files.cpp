@@ -16,6 +16,7 @@
 #include <system_error>
 
 #include "error.hpp"
+#include "text.hpp"
 
 namespace lpi {
 
@@ -56,7 +57,7 @@ struct SaveTarget {
 };
 
 SaveTarget save_target(const std::string &path) {
-    auto refuse = [&path](const std::string &why) { fail(LPI_ERR_IO, "cannot save '" + path + "': " + why); };
+    auto refuse = [&path](const std::string &why) { fail(LPI_ERR_IO, "cannot save " + quoted(path) + ": " + why); };
     SaveTarget target{path};
     struct stat st;
     if (::stat(path.c_str(), &st) != 0) {
@@ -91,7 +92,7 @@ FileReplacement::FileReplacement(const std::string &path) : path_(path) {
     dir_ = directory_of(target_);
     fd_ = create_temporary(dir_, temp_);
     if (fd_ < 0)
-        fail(LPI_ERR_IO, "cannot save '" + path + "': cannot create a file in '" + dir_ + "': " + io_reason(errno));
+        fail(LPI_ERR_IO, "cannot save " + quoted(path) + ": cannot create a file in " + quoted(dir_) + ": " + io_reason(errno));
 }
 
 FileReplacement::~FileReplacement() {
@@ -105,18 +106,18 @@ void FileReplacement::abandon(const std::string &what, int error) {
     fd_ = -1;
     ::unlink(temp_.c_str());
     committed_ = true;  // nothing left to remove
-    fail(LPI_ERR_IO, "cannot save '" + path_ + "': " + what + ": " + io_reason(error));
+    fail(LPI_ERR_IO, "cannot save " + quoted(path_) + ": " + what + ": " + io_reason(error));
 }
 
 void FileReplacement::write(const unsigned char *bytes, std::size_t size) {
     if (fd_ < 0) fd_ = ::open(temp_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
-    if (fd_ < 0) abandon("cannot write '" + temp_ + "'", errno);
+    if (fd_ < 0) abandon("cannot write " + quoted(temp_), errno);
     std::size_t done = 0;
     while (done < size) {
         const ssize_t n = ::write(fd_, bytes + done, size - done);
         if (n < 0) {
             if (errno == EINTR) continue;
-            abandon("cannot write '" + temp_ + "'", errno);
+            abandon("cannot write " + quoted(temp_), errno);
         }
         done += static_cast<std::size_t>(n);
     }
@@ -125,16 +126,16 @@ void FileReplacement::write(const unsigned char *bytes, std::size_t size) {
 void FileReplacement::close_descriptor() {
     const int fd = fd_;
     fd_ = -1;
-    if (fd >= 0 && ::close(fd) != 0) abandon("cannot close '" + temp_ + "'", errno);
+    if (fd >= 0 && ::close(fd) != 0) abandon("cannot close " + quoted(temp_), errno);
 }
 
 void FileReplacement::sync() {
     // Read-only suffices for fchmod and fsync, whatever the file's mode.
     if (fd_ < 0) fd_ = ::open(temp_.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd_ < 0) abandon("cannot open '" + temp_ + "'", errno);
+    if (fd_ < 0) abandon("cannot open " + quoted(temp_), errno);
     if (exists_ && ::fchmod(fd_, static_cast<mode_t>(permissions_)) != 0)
-        abandon("cannot give '" + temp_ + "' the permissions of the old file", errno);
-    if (::fsync(fd_) != 0) abandon("cannot flush '" + temp_ + "'", errno);
+        abandon("cannot give " + quoted(temp_) + " the permissions of the old file", errno);
+    if (::fsync(fd_) != 0) abandon("cannot flush " + quoted(temp_), errno);
     close_descriptor();
     synced_ = true;
 }
@@ -142,7 +143,7 @@ void FileReplacement::sync() {
 void FileReplacement::commit() {
     if (!synced_) sync();
     if (::rename(temp_.c_str(), target_.c_str()) != 0)
-        abandon("cannot rename '" + temp_ + "' to " + (target_ == path_ ? "it" : "'" + target_ + "'"), errno);
+        abandon("cannot rename " + quoted(temp_) + " to " + (target_ == path_ ? "it" : quoted(target_)), errno);
     committed_ = true;
     // Make the rename itself durable. Best effort: the file is complete and in
     // place either way, and some file systems cannot sync a directory.
@@ -162,15 +163,15 @@ void write_file_atomically(const std::string &path, const unsigned char *bytes, 
 RegularFileReader::RegularFileReader(const std::string &path) : path_(path) {
     // O_NONBLOCK: a FIFO given by mistake must not hang the call.
     fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-    if (fd_ < 0) fail(LPI_ERR_IO, "cannot open '" + path + "': " + io_reason(errno));
+    if (fd_ < 0) fail(LPI_ERR_IO, "cannot open " + quoted(path) + ": " + io_reason(errno));
     struct stat st;
     const bool known = ::fstat(fd_, &st) == 0;
     const int error = errno;
     if (!known || !S_ISREG(st.st_mode)) {
         ::close(fd_);
-        if (!known) fail(LPI_ERR_IO, "cannot stat '" + path + "': " + io_reason(error));
-        if (S_ISDIR(st.st_mode)) fail(LPI_ERR_IO, "'" + path + "' is a directory");
-        fail(LPI_ERR_IO, "'" + path + "' is not a regular file");
+        if (!known) fail(LPI_ERR_IO, "cannot stat " + quoted(path) + ": " + io_reason(error));
+        if (S_ISDIR(st.st_mode)) fail(LPI_ERR_IO, quoted(path) + " is a directory");
+        fail(LPI_ERR_IO, quoted(path) + " is not a regular file");
     }
     if (static_cast<std::uint64_t>(st.st_size) > std::numeric_limits<std::size_t>::max()) {
         ::close(fd_);
@@ -187,7 +188,7 @@ std::size_t RegularFileReader::read(unsigned char *data, std::size_t n) {
         const ssize_t got = ::read(fd_, data + done, n - done);
         if (got < 0) {
             if (errno == EINTR) continue;
-            fail(LPI_ERR_IO, "cannot read '" + path_ + "': " + io_reason(errno));
+            fail(LPI_ERR_IO, "cannot read " + quoted(path_) + ": " + io_reason(errno));
         }
         if (got == 0) break;
         done += static_cast<std::size_t>(got);

@@ -182,15 +182,17 @@ std::vector<double> recursive_gammas(int order, int copies) {
 }
 
 // "triple-jump-<p>" / "suzuki-<p>": the order p, or 0 if name has not that
-// form; throws for a malformed or unsupported order.
+// form (p digits only, no leading zero: "triple-jump-4 " is an unknown
+// name); throws for an order p that is odd or too large.
 int recursive_order(const std::string &name, const std::string &prefix) {
     if (name.compare(0, prefix.size(), prefix) != 0) return 0;
     const std::string digits = name.substr(prefix.size());
-    bool ok = !digits.empty() && digits.size() <= 2 && digits[0] != '0';
+    bool ok = !digits.empty() && digits[0] != '0';
     for (char c : digits) ok = ok && c >= '0' && c <= '9';
-    const int p = ok ? std::stoi(digits) : 0;
-    if (!ok || p % 2 != 0 || p > kMaxRecursiveOrder)
-        fail(LPI_ERR_INVALID, "unknown method '" + name + "': the order of " + prefix +
+    if (!ok) return 0;
+    const int p = digits.size() <= 2 ? std::stoi(digits) : kMaxRecursiveOrder + 1;
+    if (p % 2 != 0 || p > kMaxRecursiveOrder)
+        fail(LPI_ERR_INVALID, "unknown method " + quoted(name) + ": the order of " + prefix +
                                   "<p> must be even, from 2 to " +
                                   std::to_string(kMaxRecursiveOrder));
     return p;
@@ -238,7 +240,7 @@ Method find_method(const std::string &requested) {
     std::string known;
     for (const Method &m : method_table()) known += (known.empty() ? "" : ", ") + m.name;
     for (const Alias &a : kAliases) known += std::string(", ") + a.alias;
-    fail(LPI_ERR_INVALID, "unknown method '" + requested + "' (known: " + known +
+    fail(LPI_ERR_INVALID, "unknown method " + quoted(requested) + " (known: " + known +
                               ", triple-jump-<p>, suzuki-<p> for even p <= " +
                               std::to_string(kMaxRecursiveOrder) + ")");
 }

@@ -5,6 +5,7 @@
 
 #include "error.hpp"
 #include "integrator.hpp"
+#include "text.hpp"
 
 namespace lpi {
 
@@ -49,7 +50,7 @@ void SplitChoice::select(const std::string &name, const char *model_kind) {
     }
     std::string known;
     for (const std::string &n : names_) known += (known.empty() ? "" : ", ") + n;
-    fail(LPI_ERR_INVALID, "unknown split '" + name + "' for " + model_kind + " (known: " + known + ")");
+    fail(LPI_ERR_INVALID, "unknown split " + quoted(name) + " for " + model_kind + " (known: " + known + ")");
 }
 
 }  // namespace lpi

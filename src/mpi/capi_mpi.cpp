@@ -6,6 +6,7 @@
 
 #include "../capi/handle.hpp"
 #include "../core/checkpoint.hpp"
+#include "../core/text.hpp"
 #include "../models/sine_euler.hpp"
 #include "communicator.hpp"
 #include "liepoisson_mpi.h"
@@ -64,10 +65,10 @@ LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
             try {
                 cp = lpi::decode_checkpoint(data, static_cast<std::size_t>(size));
             } catch (const lpi::Error &e) {
-                lpi::fail(e.status(), std::string("'") + path + "': " + e.what());
+                lpi::fail(e.status(), lpi::quoted(path) + ": " + e.what());
             }
             if (std::string(cp.model->kind()) != "sine-euler")
-                lpi::fail(LPI_ERR_UNSUPPORTED, std::string("'") + path + "' holds a " +
+                lpi::fail(LPI_ERR_UNSUPPORTED, lpi::quoted(path) + " holds a " +
                                                    cp.model->kind() +
                                                    " system; only sine-euler is spread over processes");
         });

@@ -12,6 +12,7 @@
 
 #include "../../core/error.hpp"
 #include "../../core/files.hpp"
+#include "../../core/text.hpp"
 #include "../sine_euler.hpp"
 #include "lpi_config.h"
 #include "kernels.hpp"
@@ -37,7 +38,7 @@ const char *planning_name(FftPlanning planning) { return kPlanningNames[static_c
 FftPlanning planning_from_name(const std::string &name) {
     for (int i = 0; i < 3; ++i)
         if (name == kPlanningNames[i]) return static_cast<FftPlanning>(i);
-    fail(LPI_ERR_INVALID, "unknown FFTW planning '" + name + "' (estimate, measure or patient)");
+    fail(LPI_ERR_INVALID, "unknown FFTW planning " + quoted(name) + " (estimate, measure or patient)");
 }
 
 #if LPI_HAVE_FFTW
@@ -204,12 +205,12 @@ constexpr std::size_t kMaxWisdomBytes = std::size_t{64} << 20;
 void fftw_wisdom_import_file(const char *path) {
     RegularFileReader file(path);
     if (file.size() > kMaxWisdomBytes)
-        fail(LPI_ERR_INVALID, std::string("'") + path + "' is not FFTW wisdom: " +
+        fail(LPI_ERR_INVALID, quoted(path) + " is not FFTW wisdom: " +
                                   std::to_string(file.size()) + " bytes, more than wisdom takes");
     const std::string text = file.read_rest();
     std::lock_guard<std::mutex> lock(fftw_planner_mutex());
     if (text.find('\0') != std::string::npos || !fftw_import_wisdom_from_string(text.c_str()))
-        fail(LPI_ERR_INVALID, std::string("'") + path + "' is not FFTW wisdom");
+        fail(LPI_ERR_INVALID, quoted(path) + " is not FFTW wisdom");
 }
 
 // Written atomically, as checkpoints are: a failed export keeps the old file.
