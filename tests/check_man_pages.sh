@@ -59,6 +59,20 @@ for page in "$root"/man/man*/*.[1-9]; do
     fi
 done
 
+# ---- SEE ALSO: pages of this manual, each of which exists ------------------
+# Other manuals' pages may not be installed (fftw3 ships no section 3), so
+# they are named in the text instead.
+for page in "$root"/man/man*/*.[1-9]; do
+    [ -L "$page" ] && continue
+    for ref in $(section "$page" "SEE ALSO" | grep -o '[A-Za-z_][A-Za-z0-9_.-]* *([0-9][a-z]*)' | tr -d ' '); do
+        name=${ref%%(*}
+        sec=${ref#*(}
+        sec=${sec%)}
+        [ -e "$root/man/man$sec/$name.$sec" ] ||
+            complain "${page#"$root/"}: SEE ALSO names $ref, which is not a page of this manual"
+    done
+done
+
 # ---- Statuses: only real ones, and the full list on lpi_last_error(3) -----
 statuses=$(sed -n 's/^ *X(\(LPI_[A-Z_]*\), *[-+]\{0,1\}[0-9]*,.*/\1/p' "$header")
 [ -n "$statuses" ] || complain "no status codes found in the LPI_STATUS_LIST of $header"
