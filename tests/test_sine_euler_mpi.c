@@ -321,6 +321,24 @@ static void test_memory_per_process(void **state) {
     assert_true(share <= allowed);
 }
 
+/* An N whose share would pass a process's physical memory is refused on
+ * every process with LPI_ERR_NO_MEMORY, naming the bytes, before anything
+ * is allocated (zero-filled vectors that large bring the out-of-memory
+ * killer, or, with no overcommit, a bare "out of memory"). */
+static void test_too_large_n(void **state) {
+    (void)state;
+    const double physical = (double)sysconf(_SC_PHYS_PAGES) * (double)sysconf(_SC_PAGESIZE);
+    const int32_t N = 1000001; /* N (N / 2P) complex modes a process: ~4e12 bytes over 4 */
+    if (!(physical > 0) || 16.0 * N * (N / 2 / size_) <= physical)
+        LPI_SKIP("this machine's memory holds the share, or it does not say how much it has");
+    lpi_system *sys = (lpi_system *)0x1;
+    LPI_ASSERT_FAILS(NULL, lpi_sine_euler_create_mpi(&sys, N, MPI_COMM_WORLD), LPI_ERR_NO_MEMORY,
+                     "lpi_sine_euler_create_mpi");
+    assert_null(sys);
+    assert_non_null(strstr(lpi_last_error(NULL), "bytes"));
+    assert_non_null(strstr(lpi_last_error(NULL), "physical memory"));
+}
+
 /* Stops the run at step 2 on rank 0 alone. */
 static int stop_on_rank_0(const lpi_system *sys, int64_t step, double t, void *user) {
     (void)sys, (void)t, (void)user;
@@ -460,6 +478,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_checkpoint),
         cmocka_unit_test(test_hamiltonian),
         cmocka_unit_test(test_memory_per_process),
+        cmocka_unit_test(test_too_large_n),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_different_arguments),
     };

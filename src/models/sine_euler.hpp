@@ -77,6 +77,13 @@ public:
 // system would need more bytes than the machine's physical memory.
 std::unique_ptr<Model> make_sine_euler(int N);
 
+// LPI_ERR_NO_MEMORY naming `what` when `bytes` pass this machine's physical
+// memory (nothing checked where the system does not say how much it has):
+// zero-filling vectors larger than the machine brings the out-of-memory
+// killer, not std::bad_alloc. For a system spread over processes, each
+// process asks for its own share.
+void require_physical_memory(double bytes, const std::string &what);
+
 // The FFTW planner is not thread-safe: every plan creation, destruction and
 // wisdom operation in the library holds this lock.
 std::mutex &fftw_planner_mutex();

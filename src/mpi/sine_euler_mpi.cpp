@@ -10,6 +10,7 @@
 #include "sine_euler_mpi.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -374,7 +375,19 @@ std::unique_ptr<Model> make_sine_euler_mpi(int N, std::shared_ptr<const mpi::Com
         fail(LPI_ERR_INVALID, "N must be odd and >= 3 (Zeitlin's su(N) truncation), got " +
                                   std::to_string(N));
     std::unique_ptr<Model> model;
-    communicator->agree([&] { model = std::make_unique<SineEulerMpi>(N, communicator); });
+    communicator->agree([&] {
+        // This process's share, refused before anything is allocated: its
+        // lines and line 0, N complex modes each, in two working states and
+        // the two buffers of an exchange, and lambda and f of as many modes.
+        const double M = (N - 1) / 2, P = communicator->size(), lines = std::ceil(M / P) + 1;
+        const double bytes = static_cast<double>(N) * lines * (4 * 2 + 3) * sizeof(double);
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      "sine-Euler N = %d over %d processes needs about %.3g bytes (%.3g GiB) on each",
+                      N, communicator->size(), bytes, bytes / (1024.0 * 1024.0 * 1024.0));
+        require_physical_memory(bytes, text);
+        model = std::make_unique<SineEulerMpi>(N, communicator);
+    });
     return model;
 }
 

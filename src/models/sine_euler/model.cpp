@@ -267,14 +267,18 @@ void require_memory(int N) {
                                     ", more than an address space holds");
     }
     bytes = states + tables;
-    const std::size_t available = physical_memory();
-    if (available != 0 && bytes > available)
-        fail(LPI_ERR_NO_MEMORY, what + std::to_string(bytes) + " bytes (" + gib(bytes) + ")" + parts +
-                                    "; this machine has " + std::to_string(available) + " bytes (" +
-                                    gib(available) + ") of physical memory");
+    require_physical_memory(static_cast<double>(bytes), what + std::to_string(bytes) + " bytes (" +
+                                                            gib(static_cast<double>(bytes)) + ")" + parts);
 }
 
 }  // namespace
+
+void require_physical_memory(double bytes, const std::string &what) {
+    const std::size_t available = physical_memory();
+    if (available != 0 && bytes > static_cast<double>(available))
+        fail(LPI_ERR_NO_MEMORY, what + "; this machine has " + std::to_string(available) + " bytes (" +
+                                    gib(static_cast<double>(available)) + ") of physical memory");
+}
 
 std::unique_ptr<Model> make_sine_euler(int N) {
     if (N < 3 || N % 2 == 0)
