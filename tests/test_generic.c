@@ -530,6 +530,67 @@ static void changes_of_e3(lpi_system *sys, const char *hamiltonian) {
     }
 }
 
+/* R^2 x| R^3 with [e0, f] = M f and [e1, f] = -M f: the pieces' matrices
+ * cancel, C_1 = -C_0. H = a0 x0 + a1 x1 flows by exp(t (a0 - a1) C_0):
+ * the identity for a0 = a1, however large. Applied as the factors exp(t a0
+ * C_0) exp(t a1 C_1), each growing what the other shrinks, the product had
+ * scaled x by 1e25 (a0 = a1 = 100, t = 1). */
+static double amplitudes[2];
+static int amplitude_gradient(size_t n, const double *x, double *g, void *user) {
+    (void)x, (void)user;
+    for (size_t p = 0; p < n; ++p) g[p] = amplitudes[p];
+    return 0;
+}
+static int amplitude_energy(size_t n, const double *x, double *h, void *user) {
+    (void)user;
+    *h = 0.0;
+    for (size_t p = 0; p < n; ++p) *h += amplitudes[p] * x[p];
+    return 0;
+}
+static lpi_system *cancelling_actions(int parameters) {
+    static const double M[3][3] = {{0.3, 1.0, 0.0}, {-1.0, 0.3, 0.5}, {0.2, 0.0, -0.7}};
+    int32_t i[18], j[18], k[18];
+    double c[18];
+    size_t nnz = 0;
+    for (int col = 0; col < 3; ++col)
+        for (int row = 0; row < 3; ++row)
+            for (int p = 0; p < parameters && M[row][col] != 0.0; ++p)
+                i[nnz] = p, j[nnz] = col + 2, k[nnz] = row + 2, c[nnz++] = p ? -M[row][col] : M[row][col];
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_generic_create(&sys, 5, nnz, i, j, k, c), LPI_OK);
+    const int32_t set[2] = {0, 1};
+    assert_int_equal(lpi_add_piece(sys, (size_t)parameters, set, amplitude_gradient, amplitude_energy, NULL),
+                     LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
+    return sys;
+}
+static void test_cancelling_factors(void **state) {
+    (void)state;
+    lpi_system *both = cancelling_actions(2), *one = cancelling_actions(1);
+    const double x[5] = {0.1, 0.2, 0.5, -0.25, 0.75};
+    const double cases[][2] = {{1, 1}, {20, 20}, {100, 100}, {50, 49}, {-30, -31.5}, {7, 3}};
+    for (size_t n = 0; n < sizeof cases / sizeof cases[0]; ++n) {
+        double y[5], z[5];
+        amplitudes[0] = cases[n][0], amplitudes[1] = cases[n][1];
+        assert_int_equal(lpi_set_state(both, x, 5), LPI_OK);
+        assert_int_equal(lpi_step(both, 1.0, 1), LPI_OK);
+        assert_int_equal(lpi_get_state(both, y, 5), LPI_OK);
+        /* The same flow on e0's action alone, a0 - a1 its amplitude. */
+        amplitudes[0] = cases[n][0] - cases[n][1];
+        assert_int_equal(lpi_set_state(one, x, 5), LPI_OK);
+        assert_int_equal(lpi_step(one, 1.0, 1), LPI_OK);
+        assert_int_equal(lpi_get_state(one, z, 5), LPI_OK);
+        double error = 0.0, size = 0.0;
+        for (int e = 0; e < 5; ++e) error = fmax(error, fabs(y[e] - z[e])), size = fmax(size, fabs(z[e]));
+        printf("a = (%g, %g): the flow differs from its one-parameter form by %.1e of |x|\n",
+               cases[n][0], cases[n][1], error / size);
+        assert_true(error <= 1e-13 * size);
+        if (cases[n][0] == cases[n][1]) assert_memory_equal(y, x, sizeof x);
+    }
+    lpi_destroy(both);
+    lpi_destroy(one);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_rigid_body_matches_built_in),
@@ -543,6 +604,7 @@ int main(void) {
         cmocka_unit_test(test_hyperbolic_piece_keeps_contracted_components),
         cmocka_unit_test(test_constant_rotation_without_bias),
         cmocka_unit_test(test_disjoint_blocks_without_bias),
+        cmocka_unit_test(test_cancelling_factors),
     };
     return lpi_run_tests(tests);
 }

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
 #include <map>
+#include <memory>
 #include <tuple>
 
 #include "../core/error.hpp"
@@ -249,6 +251,8 @@ public:
                 if (failed >= 0) fail_flow_overflow(static_cast<std::size_t>(failed));
             } else if (exponentials_.size() == 1) {
                 exponentials_.front().apply(g_.data(), t, x);
+            } else if (factors_cancel(t)) {
+                whole_->apply(g_.data(), t, x);
             } else {
                 // x as it was when a block fails after others wrote theirs.
                 std::copy(x, x + backup_.size(), backup_.begin());
@@ -303,6 +307,12 @@ private:
     // nilpotent ones by their series, and Pade only for a block of three or
     // more that one parameter couples. The blocks share their cut of s_p, so
     // that all run for the very same times.
+    //
+    // The factors are exact only in exact arithmetic: where terms of several
+    // parameters meet at one position and cancel (C_1 = -C_0, H = a (x0 +
+    // x1): A = 0), each factor may grow what the next shrinks, and the
+    // product lost everything (x scaled by 1e25 where the flow is the
+    // identity). Such a flow is taken whole (factors_cancel).
     void plan_blocks(const std::vector<SparseTerm> &terms) {
         exponentials_.emplace_back(constants_.dim(), terms);
         if (exponentials_.front().path() != ExpmPath::Pade) return;
@@ -311,6 +321,8 @@ private:
         for (const std::vector<SparseTerm> &factor : factors)
             for (std::vector<SparseTerm> &block : disjoint_blocks(factor)) blocks.push_back(std::move(block));
         if (blocks.size() < 2) return;
+        whole_ = std::make_unique<SparseExponential>(std::move(exponentials_.front()));
+        shared_positions_ = shared_positions(terms);
         exponentials_.clear();
         std::vector<int> shortening;
         for (std::vector<SparseTerm> &block : blocks) {
@@ -322,6 +334,46 @@ private:
         for (SparseExponential &block : exponentials_) block.widen_shortening(shortening);
         backup_.resize(constants_.dim());
     }
+
+    // The terms of the positions that several parameters' terms share, each
+    // position's run ended by a term with parameter kEndOfPosition.
+    static constexpr std::uint32_t kEndOfPosition = UINT32_MAX;
+    static std::vector<SparseTerm> shared_positions(std::vector<SparseTerm> terms) {
+        std::sort(terms.begin(), terms.end(), [](const SparseTerm &a, const SparseTerm &b) {
+            return std::tie(a.row, a.col, a.parameter) < std::tie(b.row, b.col, b.parameter);
+        });
+        std::vector<SparseTerm> shared;
+        for (std::size_t first = 0, end; first < terms.size(); first = end) {
+            end = first + 1;
+            bool several = false;
+            while (end < terms.size() && terms[end].row == terms[first].row && terms[end].col == terms[first].col)
+                several = several || terms[end].parameter != terms[first].parameter, ++end;
+            if (!several) continue;
+            shared.insert(shared.end(), terms.begin() + first, terms.begin() + end);
+            shared.push_back({0, 0, kEndOfPosition, 0.0});
+        }
+        return shared;
+    }
+
+    // Whether the factors' terms cancel at their shared positions by more
+    // than ln 2 in all (sum of |c t g_p| less |sum of c t g_p|): then a factor
+    // may grow by up to that much more than the flow does, and the product
+    // lose as many digits.
+    bool factors_cancel(double t) const {
+        double cancelled = 0.0, sum = 0.0, magnitude = 0.0;
+        for (const SparseTerm &term : shared_positions_) {
+            if (term.parameter == kEndOfPosition) {
+                cancelled += magnitude - std::fabs(sum);
+                sum = magnitude = 0.0;
+                continue;
+            }
+            const double entry = term.coefficient * (t * g_[term.parameter]);
+            sum += entry;
+            magnitude += std::fabs(entry);
+        }
+        return !(cancelled <= kLn2);
+    }
+    static constexpr double kLn2 = 0.6931471805599453;
 
     // x_sigma: where the index set is a run of consecutive indices (a single
     // one included), in place; else gathered into x_sigma_.
@@ -361,6 +413,8 @@ private:
     std::vector<std::uint32_t> rank_;  // compiled, sigma_ not sorted: sigma_[p]'s place in order
     std::vector<double> sorted_g_;
     std::vector<SparseExponential> exponentials_;  // the general plan, without one: its blocks
+    std::unique_ptr<SparseExponential> whole_;      // with blocks: A whole, where they cancel
+    std::vector<SparseTerm> shared_positions_;      // with blocks: see shared_positions
     std::vector<double> backup_;                   // x before the blocks, where there are several
 };
 
