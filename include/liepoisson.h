@@ -5,8 +5,9 @@
  * opaque lpi_system. Fallible functions return an int status: LPI_OK (0), a
  * negative LPI_ERR_* code (lpi_last_error() then gives the detail), or - from
  * lpi_step only - the positive LPI_STOPPED. A failed call leaves the handle's
- * state exactly as it was. The library never prints, aborts or exits, and no
- * C++ exception crosses this interface.
+ * state exactly as it was. The library never prints, aborts or exits (FFTW,
+ * libgomp and libgfortran can, when memory is exhausted: liepoisson(7)), and
+ * no C++ exception crosses this interface.
  *
  * Threading: one handle is used by one thread at a time; different handles
  * are independent and may be used concurrently.

@@ -66,7 +66,7 @@ LPI_API int lpi_destroy(lpi_system *sys) {
     // Freeing the handle under a call in progress on it would leave that
     // call working on freed memory.
     if (const char *why = lpi::capi::refusal(sys, true)) {
-        try { lpi::capi::record(sys, std::string("lpi_destroy: ") + why); } catch (...) {}
+        lpi::capi::record(sys, "lpi_destroy", why);
         return LPI_ERR_BUSY;
     }
     delete sys;

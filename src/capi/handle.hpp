@@ -41,8 +41,19 @@ namespace lpi::capi {
 // Failures of calls with no handle to report on (a failed create, NULL handle).
 std::string &thread_error();
 
-inline void record(const lpi_system *sys, const std::string &message) {
-    (sys ? sys->last_error : thread_error()) = message;
+// Records "function: what" as the message of this call on sys (or the
+// thread). Where memory is exhausted and even that string cannot be built,
+// an older message must not stand for this call's: the slot then says "out
+// of memory", which fits the string's own buffer (no allocation).
+inline void record(const lpi_system *sys, const char *function, const char *what,
+                   const char *more = "") noexcept {
+    std::string &slot = sys ? sys->last_error : thread_error();
+    try {
+        slot.assign(function).append(": ").append(what).append(more);
+    } catch (...) {
+        slot.clear();
+        slot.append("out of memory");
+    }
 }
 
 // Sets a handle's activity for the lifetime of the scope, then restores it.
@@ -135,7 +146,7 @@ template <class Body>
 int run_guarded(const lpi_system *sys, bool mutates, const char *function, const Arguments *arguments,
                 Body &&body) noexcept {
     if (const char *why = refusal(sys, mutates)) {
-        try { record(sys, std::string(function) + ": " + why); } catch (...) {}
+        record(sys, function, why);
         return LPI_ERR_BUSY;
     }
     ActivityScope scope(sys, Activity::Busy);
@@ -152,19 +163,19 @@ int run_guarded(const lpi_system *sys, bool mutates, const char *function, const
             return body();
         }
     } catch (const lpi::Error &e) {
-        try { record(sys, std::string(function) + ": " + e.what()); } catch (...) {}
+        record(sys, function, e.what());
         return e.status();
     } catch (const std::bad_alloc &) {
-        try { record(sys, std::string(function) + ": out of memory"); } catch (...) {}
+        record(sys, function, "out of memory");
         return LPI_ERR_NO_MEMORY;
     } catch (const std::length_error &) {
-        try { record(sys, std::string(function) + ": a buffer of the size this needs cannot be allocated"); } catch (...) {}
+        record(sys, function, "a buffer of the size this needs cannot be allocated");
         return LPI_ERR_NO_MEMORY;
     } catch (const std::exception &e) {
-        try { record(sys, std::string(function) + ": internal error: " + e.what()); } catch (...) {}
+        record(sys, function, "internal error: ", e.what());
         return LPI_ERR_INTERNAL;
     } catch (...) {
-        try { record(sys, std::string(function) + ": internal error"); } catch (...) {}
+        record(sys, function, "internal error");
         return LPI_ERR_INTERNAL;
     }
 }

@@ -82,16 +82,23 @@ inline double time_line_transforms(LineTransforms &T, int N, int lines, int thre
     for (int i = 0; i < threads; ++i)
         std::memset(T.block(static_cast<std::size_t>(i)), 0, sizeof(double) * 2 * N * kBlock);
     const auto start = std::chrono::steady_clock::now();
+    auto transform_block = [&](int b, double *x) {
+        T.forward(lines_in_block(lines, b), x);
+        T.backward(lines_in_block(lines, b), x);
+    };
     for (std::size_t f = 0; f < flows; ++f) {
         T.transform_spectrum();
 #if LPI_HAVE_OPENMP
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && blocks > 1)
-#endif
-        for (int b = 0; b < blocks; ++b) {
-            double *x = T.block(static_cast<std::size_t>(this_thread()));
-            T.forward(lines_in_block(lines, b), x);
-            T.backward(lines_in_block(lines, b), x);
+        // As run_line_flows: one thread runs plain loops and enters no
+        // OpenMP region (libgomp exits the process when it cannot allocate
+        // a region's team).
+        if (threads > 1 && blocks > 1) {
+#pragma omp parallel for num_threads(threads) schedule(static)
+            for (int b = 0; b < blocks; ++b) transform_block(b, T.block(static_cast<std::size_t>(this_thread())));
+            continue;
         }
+#endif
+        for (int b = 0; b < blocks; ++b) transform_block(b, T.block(0));
     }
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

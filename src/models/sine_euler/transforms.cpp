@@ -117,6 +117,9 @@ void LineTransforms::release() {
 }
 
 void LineTransforms::reserve_threads(std::size_t threads) {
+    // The slot first: a push_back that threw after the buffer was allocated
+    // would leave the buffer owned by nothing.
+    if (blocks_.capacity() < threads) blocks_.reserve(threads);
     while (blocks_.size() < threads) {
         fftw_complex *x = fftw_alloc_complex(static_cast<std::size_t>(N_) * kBlock);
         if (!x) throw std::bad_alloc();
