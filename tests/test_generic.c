@@ -591,6 +591,83 @@ static void test_cancelling_factors(void **state) {
     lpi_destroy(one);
 }
 
+/* R x| R^2 with {x0, x_(1+i)} = -A_il x_(1+l): H = x0 flows (x1, x2) by
+ * exp(t A). An elliptic A that is no rotation, turning about a half turn:
+ * its shears were formed as (2 + m00 - 1) / m10, 0 / 0 there, and came out
+ * 3.8e-2 wrong at r = pi. Against M = cos r I + (sin r / r) A in long double. */
+static void test_elliptic_plane_near_half_turns(void **state) {
+    (void)state;
+    const double pi = 3.14159265358979323846;
+    const double radians[] = {pi, pi * (1.0 + 1e-8), pi * (1.0 - 1e-12), 3.0 * pi, 0.5 * pi, 2.0};
+    for (size_t n = 0; n < sizeof radians / sizeof radians[0]; ++n) {
+        /* A = [[3, 0.25], [c, -3]], c chosen so that r^2 = -(9 + 0.25 c). */
+        const double p = 3.0, b = 0.25, c = -(radians[n] * radians[n] + p * p) / b;
+        const double A[2][2] = {{p, b}, {c, -p}};
+        const int32_t i[4] = {0, 0, 0, 0}, j[4] = {1, 1, 2, 2}, k[4] = {1, 2, 1, 2};
+        const double constants[4] = {-A[0][0], -A[0][1], -A[1][0], -A[1][1]};
+        lpi_system *sys = NULL;
+        assert_int_equal(lpi_generic_create(&sys, 3, 4, i, j, k, constants), LPI_OK);
+        const int32_t axis = 0;
+        assert_int_equal(lpi_add_piece(sys, 1, &axis, field_gradient, field_energy, NULL), LPI_OK);
+        assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
+        const double x[3] = {0.1, 1.0, 0.5};
+        double y[3];
+        assert_int_equal(lpi_set_state(sys, x, 3), LPI_OK);
+        assert_int_equal(lpi_step(sys, 1.0, 1), LPI_OK);
+        assert_int_equal(lpi_get_state(sys, y, 3), LPI_OK);
+        const long double r = sqrtl(-((long double)p * p + (long double)b * c));
+        const long double C = cosl(r), S = sinl(r) / r;
+        double error = 0.0;
+        for (int row = 0; row < 2; ++row) {
+            const long double exact = (C + S * A[row][row]) * x[1 + row] + S * A[row][1 - row] * x[2 - row];
+            error = fmax(error, (double)fabsl(y[1 + row] - exact));
+        }
+        printf("elliptic plane, r = %.17g: error %.1e\n", (double)r, error);
+        assert_true(error < 1e-13);
+        lpi_destroy(sys);
+    }
+}
+
+/* R x| R with {x0, x1} = -x1: H = a x0 scales x1 by e^(a t). A contraction
+ * past e^-708, where exp is subnormal, kept only its bits (x1 = 1e300 scaled
+ * by e^-740 was 2.6e-3 off), and a subnormal x1 grown into the normal range
+ * kept only its own (3e-320 e^720: 3.2e-5 off). */
+static double scale_rate;
+static int scale_gradient(size_t n, const double *x, double *g, void *user) {
+    (void)n, (void)x, (void)user;
+    g[0] = scale_rate;
+    return 0;
+}
+static int scale_energy(size_t n, const double *x, double *h, void *user) {
+    (void)n, (void)user;
+    *h = scale_rate * x[0];
+    return 0;
+}
+static void test_scalings_beyond_the_normal_range(void **state) {
+    (void)state;
+    const int32_t i[1] = {0}, j[1] = {1}, k[1] = {1};
+    const double c[1] = {-1.0};
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_generic_create(&sys, 2, 1, i, j, k, c), LPI_OK);
+    const int32_t axis = 0;
+    assert_int_equal(lpi_add_piece(sys, 1, &axis, scale_gradient, scale_energy, NULL), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
+    const double cases[][2] = {{1e300, -740.0}, {1e300, -720.0}, {3e-320, 720.0}, {5e-324, 1000.0}, {1.0, -709.0}};
+    for (size_t n = 0; n < sizeof cases / sizeof cases[0]; ++n) {
+        const double x[2] = {0.0, cases[n][0]};
+        double y[2];
+        scale_rate = cases[n][1];
+        assert_int_equal(lpi_set_state(sys, x, 2), LPI_OK);
+        assert_int_equal(lpi_step(sys, 1.0, 1), LPI_OK);
+        assert_int_equal(lpi_get_state(sys, y, 2), LPI_OK);
+        const long double exact = (long double)cases[n][0] * expl(cases[n][1]);
+        const double error = (double)fabsl((y[1] - exact) / exact);
+        printf("x1 = %g scaled by e^%g: %.17g, relative error %.1e\n", cases[n][0], cases[n][1], y[1], error);
+        assert_true(error < 4e-16);
+    }
+    lpi_destroy(sys);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_rigid_body_matches_built_in),
@@ -605,6 +682,8 @@ int main(void) {
         cmocka_unit_test(test_constant_rotation_without_bias),
         cmocka_unit_test(test_disjoint_blocks_without_bias),
         cmocka_unit_test(test_cancelling_factors),
+        cmocka_unit_test(test_elliptic_plane_near_half_turns),
+        cmocka_unit_test(test_scalings_beyond_the_normal_range),
     };
     return lpi_run_tests(tests);
 }

@@ -575,9 +575,68 @@ static void test_product_piece_product_overflows(void **state) {
     lpi_destroy(sys);
 }
 
+/* The product piece's flow depends on mu and t only through mu t: with
+ * H(u) = mu u, (mu, t) = (1, 0.5), (1e-200, 5e199) and (1e160, 5e-161) are
+ * one flow (mu^2 had underflowed: 7 times off; or overflowed: refused). And
+ * a negative t contracts as well as a positive one: stepping -T equals the
+ * mirror (p -> -p: x2, x5, x7 change sign) of stepping the mirror by +T
+ * (where x2^2 > x1 x3 a negative t had never taken the far form's
+ * projectors: 3e8 ulps off). */
+static double linear_mu;
+static int linear_h(double u, double *out, void *user) {
+    (void)user;
+    *out = linear_mu * u;
+    return 0;
+}
+static int linear_dh(double u, double *out, void *user) {
+    (void)u, (void)user;
+    *out = linear_mu;
+    return 0;
+}
+static void product_step(const double *x, double mu, double t, double *y) {
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_moments_create(&sys), LPI_OK);
+    assert_int_equal(lpi_moments_add_product_piece(sys, linear_h, linear_dh, NULL), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
+    linear_mu = mu;
+    assert_int_equal(lpi_set_state(sys, x, 8), LPI_OK);
+    assert_int_equal(lpi_step(sys, t, 1), LPI_OK);
+    assert_int_equal(lpi_get_state(sys, y, 8), LPI_OK);
+    lpi_destroy(sys);
+}
+static double largest_relative_difference(const double *a, const double *b) {
+    double worst = 0.0;
+    for (int e = 0; e < 8; ++e)
+        if (a[e] != b[e]) worst = fmax(worst, fabs(a[e] - b[e]) / fmax(fabs(a[e]), fabs(b[e])));
+    return worst;
+}
+static void test_product_piece_depends_on_mu_t(void **state) {
+    (void)state;
+    const double x[8] = {1.0, 0.3, 2.0, 3.0, 0.3, 2.02, 0.6, 12.0};
+    double reference[8], y[8];
+    product_step(x, 1.0, 0.5, reference);
+    const double scales[][2] = {{1e-200, 5e199}, {1e-160, 5e159}, {1e160, 5e-161}};
+    for (int n = 0; n < 3; ++n) {
+        product_step(x, scales[n][0], scales[n][1], y);
+        const double d = largest_relative_difference(y, reference);
+        printf("mu = %g, t = %g: %.1e from mu = 1, t = 0.5\n", scales[n][0], scales[n][1], d);
+        assert_true(d < 1e-14);
+    }
+    const double ab = 1e-8, z[8] = {ab, 1.0, ab, 1.0, 0.5, 2.0, 0.3, 1.0};
+    const double mirror[8] = {ab, -1.0, ab, 1.0, -0.5, 2.0, -0.3, 1.0};
+    double back[8], forth[8];
+    product_step(z, 0.5, -16.0, back);
+    product_step(mirror, 0.5, 16.0, forth);
+    for (int e = 1; e < 8; e += e == 1 ? 3 : 2) forth[e] = -forth[e];
+    const double d = largest_relative_difference(back, forth);
+    printf("t = -16 against the mirror at t = 16: %.1e\n", d);
+    assert_true(d < 1e-13);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_product_piece_product_overflows),
+        cmocka_unit_test(test_product_piece_depends_on_mu_t),
         cmocka_unit_test(test_casimirs_without_bias),
         cmocka_unit_test(test_built_in_casimirs_and_rank),
         cmocka_unit_test(test_casimirs_over_1e5_steps),

@@ -92,8 +92,12 @@ inline void expm1_powers(double s, int largest, double *E) {
 // (scaled_beyond_range). The DiagonalSeries path, the 1x1 plane and the
 // compiled flows share it.
 double scaled_beyond_range(double z, double a);
+// Below it exp(a) is subnormal and keeps fewer significant bits: a huge z
+// contracted past e^-708 took the error of that rounding (2.6e-3 of z
+// e^-740 for z = 1e300).
+constexpr double kSmallestNormalExponent = -708.39641853226408;  // ln DBL_MIN
 inline double scaled_by_exponential(double z, double growth, double a) {
-    if (growth < -0.5) return z * std::exp(a);
+    if (growth < -0.5) return a >= kSmallestNormalExponent ? z * std::exp(a) : scaled_beyond_range(z, a);
     if (growth <= std::numeric_limits<double>::max()) return z + growth * z;
     return scaled_beyond_range(z, a);
 }
@@ -102,7 +106,8 @@ inline double scaled_by_exponential(double z, double growth, double a) {
 // double (and inf times 0 was not).
 inline double times_exponential(double z, double a) {
     const double e = std::exp(a);
-    return e <= std::numeric_limits<double>::max() ? z * e : scaled_beyond_range(z, a);
+    return e <= std::numeric_limits<double>::max() && a >= kSmallestNormalExponent ? z * e
+                                                                                    : scaled_beyond_range(z, a);
 }
 // Whether exp(a) - 1 may fall below -1/2: not for |a| <= 1/2, where it is at
 // least e^-1/2 - 1 > -0.4 however it is rounded, so a flow whose exponents
