@@ -660,10 +660,12 @@ static void test_scalings_beyond_the_normal_range(void **state) {
         assert_int_equal(lpi_set_state(sys, x, 2), LPI_OK);
         assert_int_equal(lpi_step(sys, 1.0, 1), LPI_OK);
         assert_int_equal(lpi_get_state(sys, y, 2), LPI_OK);
-        const long double exact = (long double)cases[n][0] * expl(cases[n][1]);
-        const double error = (double)fabsl((y[1] - exact) / exact);
+        /* e^a as two halves, each in range: a few roundings, not long
+         * double (which valgrind evaluates as double). */
+        const double half = exp(0.5 * cases[n][1]), exact = cases[n][0] * half * half;
+        const double error = fabs((y[1] - exact) / exact);
         printf("x1 = %g scaled by e^%g: %.17g, relative error %.1e\n", cases[n][0], cases[n][1], y[1], error);
-        assert_true(error < 4e-16);
+        assert_true(error < 1e-15);
     }
     lpi_destroy(sys);
 }
