@@ -96,12 +96,20 @@ void test_compiled_flows_match_the_general_plan(void **) {
         for (int32_t j = 0; j < 8; ++j)
             if (mask >> j & 1u) indices.push_back(j);
         if (mask % 3 == 0) std::swap(indices.front(), indices.back());  // any order of the set
-        for (int draw = 0; draw < 3; ++draw) {
+        // Draws 3 .. 8 put zeros of either sign among the moments and the
+        // gradients' terms: the sums of products may then be zeros of
+        // either sign, which must reach no result in either plan.
+        for (int draw = 0; draw < 9; ++draw) {
+            const auto value = [&] {
+                const double v = u(rng);
+                if (draw < 3 || std::fabs(v) > 0.75) return v;
+                return v < 0 ? -0.0 : 0.0;
+            };
             Quadratic h;
-            for (int p = 0; p < 8; ++p) h.alpha[p] = u(rng), h.beta[p] = u(rng);
+            for (int p = 0; p < 8; ++p) h.alpha[p] = value(), h.beta[p] = value();
             double x[8], a[8], b[8];
-            for (double &v : x) v = u(rng);
-            flow_both(indices, h, x, 0.37 * (draw + 1), a, b);
+            for (double &v : x) v = value();
+            flow_both(indices, h, x, draw < 3 ? 0.37 * (draw + 1) : (draw % 2 ? -0.37 : 0.37) * (draw - 2), a, b);
             for (int q = 0; q < 8; ++q)
                 if (std::memcmp(&a[q], &b[q], sizeof(double)) != 0)
                     fail_msg("index set 0x%02x, draw %d: component %d is %.17g compiled, %.17g "
