@@ -366,7 +366,8 @@ LPI_API int lpi_sine_euler_get_stream(const lpi_system *sys, double *psi, size_t
  * 1/2 lambda_n |w_n|^2 + Re(conj(f_n) w_n) of H over the shell (the shells add
  * up to H) and enstrophy[k-1] sums 1/2 |w_n|^2 (adding up to the enstrophy
  * less 1/2 w_0^2), k = 1 .. K, K = floor(M sqrt 2 + 1/2). *shells is set to K;
- * LPI_ERR_SIZE when n < K (the buffers may then be NULL with n = 0). */
+ * with both buffers NULL and n = 0 the call only queries K (LPI_OK), otherwise
+ * n < K gives LPI_ERR_SIZE (*shells still set). */
 LPI_API int lpi_sine_euler_spectrum(const lpi_system *sys, double *energy, double *enstrophy,
                                     size_t n, size_t *shells);
 
@@ -385,7 +386,8 @@ LPI_API int lpi_set_threads(lpi_system *sys, int32_t n);
 /* FFTW wisdom (shared by the whole process; planning is serialised inside the
  * library). Built without FFTW3: LPI_ERR_UNSUPPORTED. export_string writes at
  * most size bytes including the NUL and sets *length to the length without
- * it; LPI_ERR_SIZE when size <= *length (buf may then be NULL with size 0).
+ * it; with buf == NULL and size == 0 it only queries the length (LPI_OK),
+ * otherwise size <= *length gives LPI_ERR_SIZE with buf untouched.
  * A file that cannot be opened, read or written: LPI_ERR_IO (the message
  * gives the path and the reason); text that is not wisdom, or an empty path:
  * LPI_ERR_INVALID. */

@@ -1117,8 +1117,8 @@ contains
         integer :: q
         wisdom = ""
         length = 0
-        st = c_lpi_fftw_wisdom_export_string(c_null_ptr, 0_c_size_t, length)
-        if (st == LPI_ERR_SIZE) then
+        st = c_lpi_fftw_wisdom_export_string(c_null_ptr, 0_c_size_t, length)  ! a query of the length
+        if (st == LPI_OK) then
             allocate (buf(length + 1))
             st = c_lpi_fftw_wisdom_export_string(c_loc(buf), size(buf, kind=c_size_t), length)
             if (st == LPI_OK) then

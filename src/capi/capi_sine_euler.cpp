@@ -198,6 +198,7 @@ LPI_API int lpi_fftw_wisdom_export_string(char *buf, size_t size, size_t *length
         if (size > 0) require(buf, "buf");
         const std::string wisdom = lpi::fftw_wisdom_export_string();
         *length = wisdom.size();
+        if (!buf && size == 0) return;  // a query of the length, not a failure
         if (size <= wisdom.size())
             lpi::fail(LPI_ERR_SIZE, "buffer of " + std::to_string(size) + " bytes is too small; " +
                                         std::to_string(wisdom.size() + 1) + " needed");
@@ -254,8 +255,13 @@ LPI_API int lpi_sine_euler_spectrum(const lpi_system *sys, double *energy, doubl
             require(enstrophy, "enstrophy");
         }
         const std::size_t count = lpi::sine_euler::shell_count(model.truncation());
-        // Set on success, and on LPI_ERR_SIZE to say what is needed; no
-        // other failure touches it.
+        // Set on success (a query with both buffers NULL and n = 0 among
+        // them), and on LPI_ERR_SIZE to say what is needed; no other
+        // failure touches it.
+        if (!energy && !enstrophy && n == 0) {
+            *shells = count;
+            return;
+        }
         if (n < count) {
             *shells = count;
             lpi::fail(LPI_ERR_SIZE, "spectrum buffers of " + std::to_string(n) + " entries are too "

@@ -25,8 +25,7 @@ struct Spectra {
 
 Spectra spectra_of(const lpi_system *sys) {
     size_t shells = 0;
-    const int query = lpi_sine_euler_spectrum(sys, nullptr, nullptr, 0, &shells);
-    if (query != LPI_ERR_SIZE) check(query, sys, "spectrum");
+    check(lpi_sine_euler_spectrum(sys, nullptr, nullptr, 0, &shells), sys, "spectrum");  // a query of K
     Spectra s{std::vector<double>(shells), std::vector<double>(shells)};
     check(lpi_sine_euler_spectrum(sys, s.energy.data(), s.enstrophy.data(), shells, &shells), sys, "spectrum");
     return s;
