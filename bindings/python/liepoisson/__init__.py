@@ -271,6 +271,11 @@ class LiePoissonError(Exception):
         self.message = message
         super().__init__("%s: %s" % (self.status_name, message))
 
+    def __reduce__(self):
+        # Rebuilt from (status, message), so that pickle and copy work: an
+        # error raised in a multiprocessing worker reaches the caller.
+        return (type(self), (self.status, self.message))
+
 
 # Python names and extra base classes per status name; a status the library
 # grows later still raises LiePoissonError with its name and message.
@@ -349,10 +354,9 @@ def _check_free(status):
 # ctypes releases the GIL during a foreign call, and Python's SIGINT handler
 # only sets a flag that the main thread acts on once it is back in Python: a
 # SIGINT during lpi_step is not lost, but waits for the whole call. A step()
-# long enough to matter is therefore observed (lpi_set_observer, when the
-# library has it) about every _OBSERVE_SECONDS; observing does not change the
-# trajectory to the bit, so the cadence may follow the measured speed.
-_HAVE_OBSERVER = "lpi_set_observer" not in _lib.MISSING
+# long enough to matter is therefore observed (lpi_set_observer) about every
+# _OBSERVE_SECONDS; observing does not change the trajectory to the bit, so
+# the cadence may follow the measured speed.
 _OBSERVE_SECONDS = 0.05
 
 
@@ -844,15 +848,18 @@ class System:
         NonFiniteError, CallbackError
             A step failed; the state and time are those before the call.
         UnsupportedError
-            `observer` given, but the loaded library has no lpi_set_observer.
+            The method is isomp or rk4-matrix and the BLAS/LAPACK library
+            cannot be loaded at its first step, or the system runs threads
+            and this is a fork child (lpi_step(3)).
 
         Notes
         -----
-        Ctrl-C (SIGINT) during a long call: with a library that has
-        lpi_set_observer, the run stops within about a twentieth of a second
-        and the SIGINT handler runs there (``KeyboardInterrupt`` by default),
-        the system holding exactly the state of a call of the steps done;
-        otherwise the handler runs when the whole call returns. With an
+        Ctrl-C (SIGINT) during a long call from the main thread: the run
+        stops within about a twentieth of a second and the SIGINT handler
+        runs there (``KeyboardInterrupt`` by default), the system holding
+        exactly the state of a call of the steps done. From another thread
+        the handler runs when the whole call returns (Python runs signal
+        handlers in the main thread only). With an
         observer, Ctrl-C is looked for at a cadence that divides `every` (at
         the observer's own calls when no such cadence is near the wanted one).
         """
@@ -864,8 +871,6 @@ class System:
         if observer is not None:
             if not callable(observer):
                 raise TypeError("observer must be callable, not %s" % type(observer).__name__)
-            if not _HAVE_OBSERVER:
-                _raise(STATUS["LPI_ERR_UNSUPPORTED"], "the loaded library has no lpi_set_observer")
         started = time.perf_counter()
         sigint_every = self._observation_interval(nsteps)
         if observer is None and not sigint_every:
@@ -970,9 +975,9 @@ class System:
 
     def _observation_interval(self, nsteps):
         """Steps between looks for a SIGINT during step(), or 0 for none: the
-        call is short, the library has no observer, this is not the main
-        thread (only it runs signal handlers) or SIGINT has no Python handler."""
-        if not _HAVE_OBSERVER or nsteps < 2 or threading.current_thread() is not threading.main_thread():
+        call is short, this is not the main thread (only it runs signal
+        handlers) or SIGINT has no Python handler."""
+        if nsteps < 2 or threading.current_thread() is not threading.main_thread():
             return 0
         if not callable(signal.getsignal(signal.SIGINT)):
             return 0
@@ -1678,9 +1683,7 @@ class SineEuler(System):
             (energy, enstrophy), K values each; entry k - 1 is shell k.
         """
         shells = c_size_t()
-        status = lib.lpi_sine_euler_spectrum(self._h(), None, None, 0, byref(shells))
-        if status != STATUS["LPI_ERR_SIZE"]:  # the query fails only for its size
-            self._call("lpi_sine_euler_spectrum", None, None, 0, byref(shells))
+        self._call("lpi_sine_euler_spectrum", None, None, 0, byref(shells))  # a query of K
         energy_ptr, energy = _doubles_out(shells.value)
         enstrophy_ptr, enstrophy = _doubles_out(shells.value)
         self._call("lpi_sine_euler_spectrum", energy_ptr, enstrophy_ptr, shells.value, byref(shells))
@@ -1794,9 +1797,7 @@ def fftw_wisdom_export_string() -> str:
         The wisdom, for `fftw_wisdom_import_string`.
     """
     length = c_size_t()
-    status = lib.lpi_fftw_wisdom_export_string(None, 0, byref(length))
-    if status != STATUS["LPI_ERR_SIZE"]:
-        _check_free(status)
+    _check_free(lib.lpi_fftw_wisdom_export_string(None, 0, byref(length)))  # a query of the length
     buf = ctypes.create_string_buffer(length.value + 1)
     _check_free(lib.lpi_fftw_wisdom_export_string(buf, len(buf), byref(length)))
     return buf.value.decode()

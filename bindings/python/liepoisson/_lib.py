@@ -154,5 +154,12 @@ def _declare(lib):
 
 
 lib = _load()
-#: Functions this binding declares that the loaded library lacks (an older library).
-MISSING = _declare(lib)
+# The binding is released with the library and calls every function it
+# declares: a library that lacks one (an older build found first on the
+# path) is refused here, by name, rather than failing later in some call.
+_missing = _declare(lib)
+if _missing:
+    _named = ", ".join(_missing[:4]) + (" and %d more" % (len(_missing) - 4) if len(_missing) > 4 else "")
+    raise ImportError("liepoisson: the library %s lacks %s, which this binding needs (an older "
+                      "libliepoisson?); set LIEPOISSON_LIBRARY to the library built with it"
+                      % (lib._name, _named))

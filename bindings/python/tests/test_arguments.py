@@ -330,19 +330,14 @@ class TestInterrupt(unittest.TestCase):
                 b.step(1e-3, n)
             done = round(b.time / 1e-3)
             self.assertEqual(b.time, 1e-3 * done)
-            if lp._HAVE_OBSERVER:
-                # Stopped early, holding exactly the state of a call of `done` steps.
-                self.assertLess(done, n)
-                with rigid_body() as ref:
-                    ref.step(1e-3, done)
-                    self.assertEqual(as_list(b.state), as_list(ref.state))
-            else:
-                self.assertEqual(done, n)  # the handler ran when the call returned
+            # Stopped early, holding exactly the state of a call of `done` steps.
+            self.assertLess(done, n)
+            with rigid_body() as ref:
+                ref.step(1e-3, done)
+                self.assertEqual(as_list(b.state), as_list(ref.state))
             b.step(1e-3, 10)  # and the handle goes on
 
     def test_observing_keeps_the_bits(self):
-        if not lp._HAVE_OBSERVER:
-            self.skipTest("the library has no lpi_set_observer: Ctrl-C waits for the whole call")
         saved = lp._OBSERVE_SECONDS
         lp._OBSERVE_SECONDS = 1e-9  # observe nearly every step
         self.addCleanup(setattr, lp, "_OBSERVE_SECONDS", saved)
@@ -354,8 +349,6 @@ class TestInterrupt(unittest.TestCase):
             self.assertEqual(a.time, b.time)
 
     def test_a_handler_that_does_not_raise_lets_the_step_finish(self):
-        if not lp._HAVE_OBSERVER:
-            self.skipTest("the library has no lpi_set_observer")
         calls = []
         previous = signal.signal(signal.SIGINT, lambda signum, frame: calls.append(signum))
         self.addCleanup(signal.signal, signal.SIGINT, previous)

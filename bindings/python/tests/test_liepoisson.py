@@ -1,5 +1,6 @@
 """Tests of the Python binding (unittest). Run with LIEPOISSON_LIBRARY set to
 the built library; LIEPOISSON_NO_NUMPY=1 exercises the plain-list paths."""
+import ctypes.util
 import gc
 import math
 import os
@@ -53,6 +54,35 @@ class TestModule(unittest.TestCase):
         self.assertEqual(lp.SizeError.status, -3)
         self.assertEqual(lp.CallbackError.status, lp.STATUS["LPI_ERR_CALLBACK"])
         self.assertEqual(lp.status_name(12345), "LPI_UNKNOWN_STATUS")
+
+    def test_errors_pickle_and_copy(self):
+        # As an error raised in a multiprocessing worker must, to reach the caller.
+        import copy
+        import pickle
+        errors = [lp.LiePoissonError(-3, "m")]
+        for name in lp.STATUS:
+            if lp.STATUS[name] < 0:
+                cls = lp._by_status.get(lp.STATUS[name], lp.LiePoissonError)
+                errors.append(cls(lp.STATUS[name], "the message of " + name))
+        for e in errors:
+            for twin in (pickle.loads(pickle.dumps(e)), copy.copy(e), copy.deepcopy(e)):
+                self.assertIs(type(twin), type(e))
+                self.assertEqual((twin.status, twin.status_name, twin.message, str(twin)),
+                                 (e.status, e.status_name, e.message, str(e)))
+
+    def test_a_library_without_the_bindings_functions_is_refused_at_import(self):
+        import subprocess
+        import sys
+        libm = ctypes.util.find_library("m")
+        if not libm:
+            self.skipTest("no libm to stand for an older library")
+        env = dict(os.environ, LIEPOISSON_LIBRARY=libm)
+        run = subprocess.run([sys.executable, "-c", "import liepoisson"], env=env,
+                             capture_output=True, text=True)
+        self.assertNotEqual(run.returncode, 0)
+        self.assertIn("ImportError", run.stderr)
+        self.assertIn("lacks lpi_", run.stderr)
+        self.assertIn("LIEPOISSON_LIBRARY", run.stderr)
 
     def test_numpy_mode(self):
         if os.environ.get("LIEPOISSON_NO_NUMPY"):
@@ -505,7 +535,9 @@ class TestSineEuler(unittest.TestCase):
         expected = sum(0.5 * sqg[a][b] * abs(modes[a][b]) ** 2 + (f[a][b].conjugate() * modes[a][b]).real
                        for a in range(N) for b in range(N))
         self.assertLess(abs(s.energy() - expected), 1e-13)
+        self.assertEqual(s.last_error, "")
         energy, enstrophy = s.spectrum()
+        self.assertEqual(s.last_error, "")  # its query of the shell count is no failure
         self.assertEqual(len(energy), int(((N - 1) // 2) * 2 ** 0.5 + 0.5))
         self.assertLess(abs(sum(as_list(energy)) - s.energy()), 1e-13)
         self.assertLess(abs(sum(as_list(enstrophy)) + 0.5 * modes[0][0].real ** 2 - s.enstrophy()), 1e-13)

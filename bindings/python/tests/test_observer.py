@@ -29,7 +29,6 @@ def reference_state(steps, method="yoshida-6"):
         return as_list(ref.state), ref.time
 
 
-@unittest.skipIf(not lp._HAVE_OBSERVER, "the library has no lpi_set_observer")
 class TestObserver(unittest.TestCase):
     def test_sees_every_kth_step_with_the_exact_state(self):
         seen = []
@@ -118,7 +117,6 @@ class TestCadence(unittest.TestCase):
         self.assertEqual(lp._dividing_cadence(1000003, 1000), 1000003)  # prime: the observer's own
 
 
-@unittest.skipIf(not lp._HAVE_OBSERVER, "the library has no lpi_set_observer")
 @unittest.skipIf(threading.current_thread() is not threading.main_thread(), "signals need the main thread")
 class TestObserverWithCtrlC(unittest.TestCase):
     def test_ctrl_c_and_the_observer_together(self):

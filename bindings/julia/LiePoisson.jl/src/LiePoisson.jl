@@ -330,7 +330,8 @@ end
 # A callback must be callable: C is handed a trampoline that always exists,
 # so `nothing` or a number would fail only at the first step.
 function _callable(f, what)
-    (f isa Function || !isempty(methods(f))) ||
+    # Base's: this module's own `methods()` (the composition methods) hides it.
+    (f isa Function || !isempty(Base.methods(f))) ||
         throw(ArgumentError("$what must be callable, not $(typeof(f))"))
     f
 end
@@ -462,8 +463,7 @@ end
 """spectrum(sys): (energy, enstrophy) shell sums, entry k for k - 1/2 <= |n| < k + 1/2."""
 function spectrum(sys::System)
     shells = Ref{Csize_t}(0)
-    st = GC.@preserve sys C.lpi_sine_euler_spectrum(_h(sys), C_NULL, C_NULL, 0, shells)
-    st == -3 || _call(h -> C.lpi_sine_euler_spectrum(h, C_NULL, C_NULL, 0, shells), sys)
+    _call(h -> C.lpi_sine_euler_spectrum(h, C_NULL, C_NULL, 0, shells), sys)  # a query of K
     e = Vector{Float64}(undef, shells[]); z = Vector{Float64}(undef, shells[])
     _call(h -> C.lpi_sine_euler_spectrum(h, e, z, length(e), shells), sys)
     (energy = e, enstrophy = z)
@@ -475,8 +475,7 @@ fftw_wisdom_export_file(path::AbstractString) = _check(C.lpi_fftw_wisdom_export_
 fftw_wisdom_import_string(w::AbstractString) = _check(C.lpi_fftw_wisdom_import_string(w))
 function fftw_wisdom_export_string()
     len = Ref{Csize_t}(0)
-    st = C.lpi_fftw_wisdom_export_string(C_NULL, 0, len)
-    st == -3 || _check(st)   # LPI_ERR_SIZE: the length is known
+    _check(C.lpi_fftw_wisdom_export_string(C_NULL, 0, len))  # a query of the length
     buf = Vector{UInt8}(undef, len[] + 1)
     _check(C.lpi_fftw_wisdom_export_string(buf, length(buf), len))
     String(buf[1:len[]])
