@@ -906,10 +906,11 @@ contains
         complex(c_double_complex), intent(in) :: w(:, :)
         integer, intent(out), optional :: status
         real(c_double), allocatable :: buf(:)
-        integer :: a, b, n1, n2, q
+        integer :: a, b
+        integer(c_int64_t) :: n1, n2, q  ! 2 N^2 passes a default integer from N = 32769
         if (shape_refused(sys, shape(w), "lpi_sine_euler_set_modes: w", status)) return
-        n1 = size(w, 1)
-        n2 = size(w, 2)
+        n1 = size(w, 1, kind=c_int64_t)
+        n2 = size(w, 2, kind=c_int64_t)
         allocate (buf(2 * n1 * n2))
         do a = 1, n1
             do b = 1, n2
@@ -927,10 +928,11 @@ contains
         integer, intent(out), optional :: status
         real(c_double), allocatable :: buf(:)
         integer(c_int) :: st
-        integer :: a, b, n1, n2, q
+        integer :: a, b
+        integer(c_int64_t) :: n1, n2, q  ! as in lpi_sine_euler_set_modes
         if (shape_refused(sys, shape(w), "lpi_sine_euler_get_modes: w", status)) return
-        n1 = size(w, 1)
-        n2 = size(w, 2)
+        n1 = size(w, 1, kind=c_int64_t)
+        n2 = size(w, 2, kind=c_int64_t)
         allocate (buf(2 * n1 * n2))
         st = c_lpi_sine_euler_get_modes(sys, buf, size(buf, kind=c_size_t))
         if (st == LPI_OK) then
@@ -1025,7 +1027,8 @@ contains
         integer, intent(out), optional :: status
         real(c_double), allocatable :: t(:, :)
         real(c_double), allocatable, target :: buf(:)
-        integer :: a, b, n2, q
+        integer :: a, b
+        integer(c_int64_t) :: n2, q  ! as in lpi_sine_euler_set_modes
         if (shape_refused(sys, shape(lambda), "lpi_sine_euler_set_hamiltonian: lambda", status)) return
         if (present(f)) then
             if (shape_refused(sys, shape(f), "lpi_sine_euler_set_hamiltonian: f", status)) return
@@ -1037,8 +1040,8 @@ contains
                                                          0_c_size_t), sys, status)
             return
         end if
-        n2 = size(f, 2)
-        allocate (buf(2 * size(f, 1) * n2))
+        n2 = size(f, 2, kind=c_int64_t)
+        allocate (buf(2 * size(f, 1, kind=c_int64_t) * n2))
         do a = 1, size(f, 1)
             do b = 1, n2
                 q = 2 * ((a - 1) * n2 + (b - 1))
