@@ -16,10 +16,10 @@ std::unique_ptr<Model> make_pendulum();
 bool rigid_body_inertia(const Model &model, double inertia[3]);
 
 // The small built-in models keep their state compensated: the working layout
-// is [x, carry], the value is x + carry, and every flow adds an increment with
-// Kahan summation. Round-off in the Casimirs then has no bias and grows like
-// sqrt(steps) times u times the flows' angles, not u (tests/test_invariants.c
-// measures it).
+// is [x, carry], the value is x + carry (a double-double), and every flow adds
+// an increment exactly but for u^2 |x|. Round-off in the Casimirs then has no
+// bias and grows like sqrt(steps) times u times the flows' angles, not u
+// (tests/test_invariants.c measures it).
 void compensated_add(double &x, double &carry, double increment);
 
 // Rotates (x_i, x_j) by angle a: x_i <- cos a x_i + sin a x_j,

@@ -21,7 +21,9 @@ public:
     void flow(std::size_t piece, double t, double *state) override {
         double *carry = state + 3;
         if (piece == 0)
-            compensated_add(state[2], carry[2], -t * (state[0] + carry[0]));
+            // The increment of the double-double x1 + carry formed by parts,
+            // as rotate_pair's are.
+            compensated_add(state[2], carry[2], -t * state[0] + -t * carry[0]);
         else  // dx1 = -x3 x2, dx2 = x3 x1
             rotate_pair(state, carry, 0, 1, -(state[2] + carry[2]) * t);
     }
