@@ -5,10 +5,11 @@
 #  - a plot gnuplot fails to draw (a gnuplot that fails, an image path that
 #    is a directory) fails lpi run, report figure2, sine-euler-long and
 #    rollup naming the file; without gnuplot the plots are skipped, said so;
-#  - a write that fails (RLIMIT_FSIZE, as a full disk) keeps the old CSV and
-#    the old .npy set whole, names the file and the reason, and leaves no
-#    temporary file; a replaced file keeps its mode, a new one gets the
-#    umask's; a FIFO where an output goes is refused, not replaced;
+#  - a write that fails (RLIMIT_FSIZE, as a full disk) keeps the old CSV,
+#    the old .npy set and the old HDF5 file whole, names the file and the
+#    reason, exits 1 (no crash) and leaves no temporary file; a replaced file
+#    keeps its mode, a new one gets the umask's; a FIFO where an output
+#    goes is refused, not replaced;
 #  - --checkpoint that cannot work (moments) or names an output of the run
 #    is refused (2) and one that fails leaves the old CSV; --resume with
 #    another --dt is refused (2); --init refuses a FIFO (1) at once;
@@ -93,6 +94,18 @@ if [ "$have_se" = 1 ]; then
         { cat "$out/stderr"; fail "a .npy set too large to write: exit status $rc"; }
     (cd "$out/set/sine-euler" && md5sum -c --quiet "$out/set.md5") || fail "a failed .npy set mixed new files with old"
     no_temporaries "$out/set/sine-euler"
+    # HDF5 data that cannot be written fails as any file does (HDF5 writing
+    # the file itself crashed at exit then: status 139).
+    if "$lpi" run rigid-body --steps 1 --format h5 --out "$out/probe" >/dev/null 2>&1; then
+        set -- run sine-euler --N 31 --every 1 --snapshots 1 --format h5 --out "$out/h5set"
+        "$lpi" "$@" --steps 4 >/dev/null
+        cp "$out/h5set/sine-euler.h5" "$out/old.h5"
+        rc=0; limited "$@" --steps 10 >/dev/null 2>"$out/stderr" || rc=$?
+        [ "$rc" -eq 1 ] && grep -q "sine-euler.h5.*File too large" "$out/stderr" ||
+            { cat "$out/stderr"; fail "HDF5 data too large to write: exit status $rc, expected 1"; }
+        cmp -s "$out/old.h5" "$out/h5set/sine-euler.h5" || fail "HDF5 data that could not be written lost the old file"
+        no_temporaries "$out/h5set"
+    fi
 fi
 # Modes: a replaced file keeps its own, a new one gets the umask's; a FIFO
 # at an output is refused before the work, and stays a FIFO.

@@ -224,7 +224,8 @@ bool is_hdf5_file(const std::string &path) {
 
 namespace {
 
-// Closes an HDF5 identifier on scope exit.
+// An HDF5 identifier. close() closes it and says whether that worked; the
+// destructor closes one still open, on a path that has failed already.
 class Id {
 public:
     Id(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
@@ -235,6 +236,11 @@ public:
     }
     hid_t get() const { return id_; }
     bool ok() const { return id_ >= 0; }
+    bool close() {
+        const hid_t id = id_;
+        id_ = -1;
+        return id >= 0 && close_(id) >= 0;
+    }
 
 private:
     hid_t id_;
@@ -249,45 +255,53 @@ void quiet_hdf5() {
 
 std::string write_attribute(hid_t file, const Attribute &attr) {
     Id space(H5Screate(H5S_SCALAR), H5Sclose);
+    bool written = false;
     if (attr.is_text) {
         Id type(H5Tcopy(H5T_C_S1), H5Tclose);
-        H5Tset_size(type.get(), H5T_VARIABLE);
-        H5Tset_cset(type.get(), H5T_CSET_UTF8);
-        Id a(H5Acreate2(file, attr.name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+        Id a(type.ok() && H5Tset_size(type.get(), H5T_VARIABLE) >= 0 && H5Tset_cset(type.get(), H5T_CSET_UTF8) >= 0
+                 ? H5Acreate2(file, attr.name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT)
+                 : -1,
+             H5Aclose);
         const char *text = attr.text.c_str();
-        if (!a.ok() || H5Awrite(a.get(), type.get(), &text) < 0) return "attribute " + attr.name;
+        written = a.ok() && H5Awrite(a.get(), type.get(), &text) >= 0 && a.close() && type.close();
     } else if (attr.integer) {
         const std::int64_t whole = static_cast<std::int64_t>(attr.number);
         Id a(H5Acreate2(file, attr.name.c_str(), H5T_STD_I64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-        if (!a.ok() || H5Awrite(a.get(), H5T_NATIVE_INT64, &whole) < 0) return "attribute " + attr.name;
+        written = a.ok() && H5Awrite(a.get(), H5T_NATIVE_INT64, &whole) >= 0 && a.close();
     } else {
         Id a(H5Acreate2(file, attr.name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
              H5Aclose);
-        if (!a.ok() || H5Awrite(a.get(), H5T_NATIVE_DOUBLE, &attr.number) < 0) return "attribute " + attr.name;
+        written = a.ok() && H5Awrite(a.get(), H5T_NATIVE_DOUBLE, &attr.number) >= 0 && a.close();
     }
-    return "";
+    return written && space.close() ? "" : "attribute " + attr.name;
 }
 
 }  // namespace
 
 bool have_hdf5() { return true; }
 
+// The file is built in memory (the core driver, no backing store) and its
+// image written as every other output is: HDF5 writing a file on disk by
+// name leaves, when a write fails (a full disk), a file it cannot close,
+// which its shutdown at exit then crashes on.
 std::string write_hdf5(const std::string &path, const std::vector<Dataset> &datasets,
                        const std::vector<Attribute> &attributes, std::vector<std::uint64_t> *offsets) {
     quiet_hdf5();
-    // HDF5 writes the temporary file by its name.
-    std::unique_ptr<FileReplacement> tmp;
-    std::string why = failure_of([&] {
-        tmp = std::make_unique<FileReplacement>(path);
-        tmp->close_descriptor();
-    });
+    // Probed first, as the other writers do, so that no work is done for a
+    // target that cannot be replaced.
+    std::string why = output_problem(path);
     if (!why.empty()) return why;
+    std::vector<unsigned char> image;
     {
-        Id file(H5Fcreate(tmp->temporary().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
-        if (!file.ok()) return "HDF5 cannot create " + tmp->temporary();
+        Id access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+        if (!access.ok() || H5Pset_fapl_core(access.get(), std::size_t(1) << 20, false) < 0)
+            return "HDF5 cannot make a file in memory";
+        Id file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access.get()), H5Fclose);
+        if (!file.ok()) return "HDF5 cannot create " + path + " in memory";
         // No modification times in the objects: the same run gives the same bytes.
         Id creation(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
-        H5Pset_obj_track_times(creation.get(), false);
+        if (!creation.ok() || H5Pset_obj_track_times(creation.get(), false) < 0)
+            return "HDF5 cannot set up a dataset";
         std::vector<std::unique_ptr<Id>> ids;
         offsets->clear();
         for (const Dataset &d : datasets) {
@@ -298,7 +312,7 @@ std::string write_hdf5(const std::string &path, const std::vector<Dataset> &data
                 H5Dcreate2(file.get(), d.name.c_str(), file_type, space.get(), H5P_DEFAULT, creation.get(), H5P_DEFAULT),
                 H5Dclose));
             const hid_t set = ids.back()->get();
-            if (set < 0) return "HDF5 cannot create dataset " + d.name;
+            if (set < 0 || !space.close()) return "HDF5 cannot create dataset " + d.name;
             herr_t status = 0;
             if (d.array.values.empty()) {
                 // nothing to write: an empty dataset has no raw data
@@ -326,10 +340,19 @@ std::string write_hdf5(const std::string &path, const std::vector<Dataset> &data
             why = write_attribute(file.get(), attr);
             if (!why.empty()) return "HDF5 cannot write " + why;
         }
-        ids.clear();
-        if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0) return "HDF5 cannot flush " + tmp->temporary();
+        for (auto &id : ids)
+            if (!id->close()) return "HDF5 cannot close a dataset of " + path;
+        if (!creation.close()) return "HDF5 cannot close a property list";
+        // The image of the whole file, its superblock flushed (which
+        // H5Fget_file_image alone leaves as it was at creation).
+        if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0) return "HDF5 cannot flush " + path + " in memory";
+        const ssize_t size = H5Fget_file_image(file.get(), nullptr, 0);
+        if (size <= 0) return "HDF5 cannot make the image of " + path;
+        image.resize(static_cast<std::size_t>(size));
+        if (H5Fget_file_image(file.get(), image.data(), image.size()) != size || !file.close() || !access.close())
+            return "HDF5 cannot make the image of " + path;
     }
-    return failure_of([&] { tmp->commit(); });
+    return failure_of([&] { lpi::write_file_atomically(path, image.data(), image.size()); });
 }
 
 std::string read_hdf5(const std::string &path, const std::string &name, Array &a, bool *found) {
@@ -359,6 +382,7 @@ std::string read_hdf5(const std::string &path, const std::string &name, Array &a
     out.values.resize(count);
     if (count > 0 && H5Dread(set.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.values.data()) < 0)
         return "HDF5 cannot read " + name + " (damaged?)";
+    if (!type.close() || !space.close() || !set.close() || !file.close()) return "HDF5 cannot close it";
     a = std::move(out);
     return "";
 }

@@ -54,8 +54,9 @@ bool have_hdf5();
 
 // Writes the datasets (contiguous, so that other programs, gnuplot among
 // them, can read the raw data at a byte offset) and the attributes to one
-// HDF5 file, atomically (output.hpp). `offsets` receives, per dataset, the byte offset of
-// its raw data in the file. Returns "" or the reason it failed.
+// HDF5 file, made in memory and written atomically (output.hpp). `offsets`
+// receives, per dataset, the byte offset of its raw data in the file.
+// Returns "" or the reason it failed.
 std::string write_hdf5(const std::string &path, const std::vector<Dataset> &datasets,
                        const std::vector<Attribute> &attributes, std::vector<std::uint64_t> *offsets);
 

@@ -22,7 +22,7 @@ std::string io_reason(int error);
 void write_file_atomically(const std::string &path, const unsigned char *bytes, std::size_t size);
 
 // The steps of write_file_atomically, for a writer that fills the temporary
-// file itself, by write() or by its name (HDF5, gnuplot), or that replaces
+// file itself, by write() or by its name (gnuplot), or that replaces
 // several files together (sync() each, then commit() each). The constructor
 // checks the target and creates the temporary, empty, beside it; commit()
 // puts it in place; the destructor removes a temporary not committed, so a
