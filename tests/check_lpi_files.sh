@@ -4,7 +4,9 @@
 #  - gnuplot runs without a shell: an --out with quotes and ';' runs nothing;
 #  - a plot gnuplot fails to draw (a gnuplot that fails, an image path that
 #    is a directory) fails lpi run, report figure2, sine-euler-long and
-#    rollup naming the file; without gnuplot the plots are skipped, said so;
+#    rollup naming the file, and so does an image gnuplot leaves empty or
+#    cut short while exiting 0 (the old images kept); without gnuplot the
+#    plots are skipped, said so;
 #  - a write that fails (RLIMIT_FSIZE, as a full disk) keeps the old CSV,
 #    the old .npy set and the old HDF5 file whole, names the file and the
 #    reason, exits 1 (no crash) and leaves no temporary file; a replaced file
@@ -36,14 +38,30 @@ have_se=1
 "$lpi" run sine-euler --N 5 --steps 1 --out "$out/probe" >/dev/null 2>&1 || have_se=0
 [ "$have_se" = 1 ] || echo "not checked: the plots, .npy sets, H(0) = 0 and rollup (no sine-Euler in this build)"
 
-# Fake gnuplots: one that records how it was run, one that fails, none at all.
-mkdir -p "$out/ok-gnuplot" "$out/bad-gnuplot" "$out/no-gnuplot"
-cat > "$out/ok-gnuplot/gnuplot" <<EOF
+# Fake gnuplots: one that records how it was run and draws a minimal PNG or
+# SVG for each "set output" of its script (by the terminal set before it),
+# one that fails, two that exit 0 with the images unfinished as a full disk
+# leaves them (empty; SVGs cut short), none at all.
+mkdir -p "$out/ok-gnuplot" "$out/bad-gnuplot" "$out/empty-gnuplot" "$out/cut-gnuplot" "$out/no-gnuplot"
+cat > "$out/ok-gnuplot/gnuplot" <<'EOF'
 #!/bin/sh
-{ pwd; echo "\$#"; printf '%s\n' "\$@"; } > "$out/gnuplot.log"
+{ pwd; echo "$#"; printf '%s\n' "$@"; } > "$FAKE_LOG"
+sed -n -e "s/^set terminal \([a-z]*\).*/\1/p" -e "s/^set output '\(.*\)'\$/\1/p" "$1" |
+while IFS= read -r terminal && IFS= read -r image; do
+    case ${FAKE_IMAGES:-whole}.$terminal in
+        empty.*) : > "$image" ;;
+        *.pngcairo) printf '\211PNG\r\n\032\n\000\000\000\000IEND\256B`\202' > "$image" ;;
+        cut.svg) printf '<svg>\n' > "$image" ;;
+        *.svg) printf '<svg>\n</svg>\n\n' > "$image" ;;
+    esac
+done
 EOF
 printf '#!/bin/sh\necho "fake gnuplot: cannot draw" >&2\nexit 1\n' > "$out/bad-gnuplot/gnuplot"
-chmod +x "$out/ok-gnuplot/gnuplot" "$out/bad-gnuplot/gnuplot"
+for kind in empty cut; do
+    printf '#!/bin/sh\nFAKE_IMAGES=%s exec "%s" "$@"\n' $kind "$out/ok-gnuplot/gnuplot" > "$out/$kind-gnuplot/gnuplot"
+done
+chmod +x "$out"/*-gnuplot/gnuplot
+export FAKE_LOG="$out/gnuplot.log"
 ok_path="$out/ok-gnuplot:$PATH"; bad_path="$out/bad-gnuplot:$PATH"
 
 if [ "$have_se" = 1 ]; then
@@ -64,6 +82,16 @@ if [ "$have_se" = 1 ]; then
     PATH="$bad_path" expect 1 "figure2.gp.*fake gnuplot" report figure2 --out "$out/p2"
     PATH="$bad_path" expect 1 "sine-euler-long.gp.*fake gnuplot" report sine-euler-long --N 5 --T 5 --out "$out/p3"
     PATH="$bad_path" expect 1 "rollup.gp.*fake gnuplot" run rollup --N 5 --steps 3 --out "$out/p4"
+    # An image gnuplot leaves unfinished (exiting 0 all the same) fails the
+    # command, naming it, and every old image is kept.
+    PATH="$ok_path" "$lpi" run sine-euler --N 5 --steps 2 --out "$out/p8" >/dev/null
+    PATH="$ok_path" "$lpi" run rollup --N 5 --steps 3 --out "$out/p9" >/dev/null
+    (cd "$out" && md5sum p8/*.png p8/*.svg p9/*.png p9/*.svg > "$out/images.md5")
+    PATH="$out/empty-gnuplot:$PATH" expect 1 "vorticity_000000.png (it is empty" run sine-euler --N 5 --steps 2 \
+        --out "$out/p8"
+    PATH="$out/cut-gnuplot:$PATH" expect 1 "rollup.svg (the SVG is cut short" run rollup --N 5 --steps 3 --out "$out/p9"
+    (cd "$out" && md5sum -c --quiet "$out/images.md5") || fail "an unfinished image replaced a good one"
+    no_temporaries "$out/p8"; no_temporaries "$out/p9"
     mkdir -p "$out/p5/figure2.png" "$out/p6/vorticity_000000.png"
     PATH="$ok_path" expect 1 "figure2.png.*directory" report figure2 --out "$out/p5"
     PATH="$ok_path" expect 1 "vorticity_000000.png.*directory" run sine-euler --N 5 --steps 2 --out "$out/p6"

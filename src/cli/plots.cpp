@@ -101,6 +101,30 @@ bool gnuplot_string(const std::string &name, std::string &quoted) {
     return true;
 }
 
+// What is wrong with an image gnuplot drew into `path` (`image` its name,
+// which says its format), or "": gnuplot exits 0 also when it could not
+// write the file (a full disk), so the image itself must be whole. A PNG
+// ends with its IEND chunk, an SVG with </svg> (and white space).
+std::string unfinished(const std::string &path, const std::string &image) {
+    std::string bytes;
+    const std::string unreadable = read_input(path, bytes);
+    if (!unreadable.empty()) return unreadable;
+    if (bytes.empty()) return "it is empty";
+    auto ends_with = [](const std::string &text, const std::string &end) {
+        return text.size() >= end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
+    };
+    if (ends_with(image, ".png")) {
+        if (bytes.compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) != 0) return "it is no PNG";
+        if (!ends_with(bytes, std::string("\0\0\0\0IEND\xae\x42\x60\x82", 12)))
+            return "the PNG is cut short (no IEND chunk at its end)";
+    } else if (ends_with(image, ".svg")) {
+        const std::size_t last = bytes.find_last_not_of(" \t\r\n");
+        if (last == std::string::npos || !ends_with(bytes.substr(0, last + 1), "</svg>"))
+            return "the SVG is cut short (no </svg> at its end)";
+    }
+    return "";
+}
+
 // An image's mark in a script's text until draw() names it.
 std::string mark(std::size_t i) { return "\x01" + std::to_string(i) + "\x01"; }
 
@@ -206,6 +230,13 @@ std::string PlotScript::draw() const {
         replace_all(said, seen_from_dir(run->temporary()), name_);
         for (std::size_t i = 0; i < temporaries.size(); ++i) replace_all(said, temporaries[i], images_[i]);
         return "gnuplot failed on " + script + ": " + said;
+    }
+    // Every image whole before any is put in place: a failure keeps them all.
+    for (std::size_t i = 0; i < drawn.size(); ++i) {
+        const std::string wrong = unfinished(drawn[i]->temporary(), images_[i]);
+        if (!wrong.empty())
+            return "gnuplot did not draw " + dir_ + "/" + images_[i] + " (" + wrong +
+                   "; a full disk?): the old image is kept";
     }
     return failure_of([&] {
         for (auto &image : drawn) image->commit();

@@ -68,8 +68,9 @@ std::string method_label(const std::string &method);
 // gnuplot runs there, without a shell, so every file a script names is a
 // name inside that directory, lpi's own (the directory the user gave never
 // enters a script). The images are drawn into temporary files beside them
-// and put in place (output.hpp) only when gnuplot succeeded: a failure keeps
-// the old images and the command fails, naming the file. The script itself
+// and put in place (output.hpp) only when gnuplot succeeded and every image
+// is whole (gnuplot's exit status does not tell a write that failed): a
+// failure keeps the old images and the command fails, naming the file. The script itself
 // is saved as DIR/NAME, naming the images, to be rerun there by hand.
 class PlotScript {
 public:
