@@ -149,6 +149,23 @@ refused "not a checkpoint of this scene" run rigid-body --resume "$out/pendulum.
 refused "Hamiltonian differs" run rigid-body --inertia 1,1,2 --resume "$out/rigid.lpi" --out "$out/bad"
 refused "not a whole number of steps" run rigid-body --dt 0.03 --resume "$out/rigid.lpi" --out "$out/bad"
 refused "past the run's end" run rigid-body --dt 0.05 --steps 10 --resume "$out/rigid.lpi" --out "$out/bad"
+# --resume reads the interrupted run's CSV back by the rules of the options:
+# a field that is no complete finite decimal number, a row with a field too
+# few or too many, a step that is no whole number in range, another header
+# or a last line cut short fails (1) naming the file and line, the CSV kept.
+cp "$out/r/rigid-body.csv" "$out/r.csv"
+for edit in '2s/^0,0,[^,]*,/0,0,xyz,/' '3s/,[^,]*$//' '3s/$/,1/' '4s/^[0-9]*,/1e300,/' '4s/^[0-9]*,/nan,/' \
+            '4s/^[0-9]*,/2.5,/' '5s/^\([0-9]*\),[^,]*,/\1,0x1p3,/' '6s/,[^,]*,/,inf,/' '7s/,/, /' \
+            '1s/^step/stop/' cut; do
+    if [ "$edit" = cut ]; then head -c -1 "$out/r.csv"; else sed "$edit" "$out/r.csv"; fi > "$out/r/rigid-body.csv"
+    cp "$out/r/rigid-body.csv" "$out/r-bad.csv"
+    rc=0; "$lpi" run rigid-body --dt 0.05 --steps 30 --out "$out/r" --resume "$out/rigid.lpi" >/dev/null \
+        2>"$out.err" || rc=$?
+    [ "$rc" -eq 1 ] && grep -q "rigid-body.csv:[0-9][0-9]*: " "$out.err" ||
+        { echo "--resume, the CSV edited by $edit: exit status $rc, expected 1 naming the line"; cat "$out.err"; exit 1; }
+    cmp -s "$out/r-bad.csv" "$out/r/rigid-body.csv" || { echo "--resume, the CSV edited by $edit: rewritten"; exit 1; }
+done
+cp "$out/r.csv" "$out/r/rigid-body.csv"
 if [ "$have_sine_euler" = 1 ]; then
     "$lpi" run sine-euler --N 5 --dt 0.05 --steps 4 --out "$out/s" --checkpoint "$out/se5.lpi" >/dev/null
     refused "N = 5, not 7" run sine-euler --N 7 --resume "$out/se5.lpi" --out "$out/bad"

@@ -78,11 +78,58 @@ inline std::string make_output_dir(const std::string &dir) {
     return "";
 }
 
+// The number rules of the options (Arguments below), for any text lpi reads
+// as a number, an option's value or a field of a file it reads back. A
+// decimal number is the whole text (no "10x", "", " 5"), decimal (no
+// "0x10"), finite (no "nan", "inf") and within the range of a double (no
+// "1e400"); "" or what is wrong with `text`.
+inline std::string decimal_problem(const std::string &text, double &v) {
+    const char *begin = text.c_str();
+    char *end = nullptr;
+    errno = 0;
+    v = std::strtod(begin, &end);
+    // strtod alone would also read hexadecimal ("0x10"), which the
+    // characters allowed here rule out.
+    if (text.empty() || text.find_first_not_of("0123456789+-.eE") != std::string::npos || end == begin ||
+        *end != '\0')
+        return "'" + text + "' is not a decimal number";
+    if (!std::isfinite(v)) return text + " is not finite";
+    if (errno == ERANGE) return text + " is out of the range of a double";
+    return "";
+}
+
+inline std::string range_text(int64_t lo, int64_t hi) {
+    if (hi == INT64_MAX) return " (at least " + std::to_string(lo) + ")";
+    return " (" + std::to_string(lo) + " to " + std::to_string(hi) + ")";
+}
+
+// A whole number in [lo, hi]: digits, or a decimal number that is whole
+// ("1e6" is, "2.9" is not). "" or what is wrong with `text`.
+inline std::string whole_problem(const std::string &text, int64_t lo, int64_t hi, int64_t &v) {
+    const char *begin = text.c_str();
+    char *end = nullptr;
+    errno = 0;
+    long long n = std::strtoll(begin, &end, 10);
+    const bool digits_only = !text.empty() && !std::isspace(static_cast<unsigned char>(text[0])) &&
+                             end != begin && *end == '\0';
+    if (digits_only && errno == ERANGE) return text + " is out of range" + range_text(lo, hi);
+    if (!digits_only) {
+        double d = 0.0;
+        const std::string why = decimal_problem(text, d);
+        if (!why.empty()) return why;
+        if (d != std::trunc(d)) return "'" + text + "' is not a whole number";
+        if (!(std::fabs(d) < 0x1p63)) return text + " is out of range" + range_text(lo, hi);
+        n = static_cast<long long>(d);
+    }
+    if (n < lo || n > hi) return text + " is out of range" + range_text(lo, hi);
+    v = n;
+    return "";
+}
+
 // One strict reader of a command's arguments, used by every command for every
-// option: a value must be the whole text (no "10x", "", " 5"), numbers must be
-// decimal, finite and in range (no "0x10", "nan", "1e400", 2^64), whole
-// numbers whole ("2.9" is refused, "1e6" accepted), and an option may be
-// given once. Anything else stops the command with a message and exit status 2.
+// option: a value must be the whole text, numbers as decimal_problem and
+// whole_problem say, and an option may be given once. Anything else stops
+// the command with a message and exit status 2.
 class Arguments {
 public:
     Arguments(std::string command, int argc, char **argv)
@@ -164,52 +211,21 @@ public:
     }
 
     int64_t whole_number(const std::string &option, const std::string &text, int64_t lo, int64_t hi) const {
-        const char *begin = text.c_str();
-        char *end = nullptr;
-        errno = 0;
-        long long v = std::strtoll(begin, &end, 10);
-        const bool digits_only = !text.empty() && !std::isspace(static_cast<unsigned char>(text[0])) &&
-                                 end != begin && *end == '\0';
-        if (digits_only && errno == ERANGE) fail(option + ": " + text + " is out of range" + range(lo, hi));
-        if (!digits_only) {
-            // Exponent form, when it names a whole number exactly ("1e6").
-            const double d = real(option, text);
-            if (d != std::trunc(d)) fail(option + ": '" + text + "' is not a whole number");
-            if (!(std::fabs(d) < 0x1p63)) fail(option + ": " + text + " is out of range" + range(lo, hi));
-            v = static_cast<long long>(d);
-        }
-        if (v < lo || v > hi) fail(option + ": " + text + " is out of range" + range(lo, hi));
+        int64_t v = 0;
+        const std::string why = whole_problem(text, lo, hi, v);
+        if (!why.empty()) fail(option + ": " + why);
         return v;
     }
 
     double positive_number(const std::string &option, const std::string &text) const {
-        const double v = real(option, text);
+        double v = 0.0;
+        const std::string why = decimal_problem(text, v);
+        if (!why.empty()) fail(option + ": " + why);
         if (!(v > 0.0)) fail(option + ": " + text + " is not > 0");
         return v;
     }
 
 private:
-    // A finite decimal number that is the whole text, neither overflowing nor
-    // underflowing. strtod alone would also read hexadecimal ("0x10"), which
-    // the characters allowed here rule out.
-    double real(const std::string &option, const std::string &text) const {
-        const char *begin = text.c_str();
-        char *end = nullptr;
-        errno = 0;
-        const double v = std::strtod(begin, &end);
-        if (text.empty() || text.find_first_not_of("0123456789+-.eE") != std::string::npos || end == begin ||
-            *end != '\0')
-            fail(option + ": '" + text + "' is not a decimal number");
-        if (!std::isfinite(v)) fail(option + ": " + text + " is not finite");
-        if (errno == ERANGE) fail(option + ": " + text + " is out of the range of a double");
-        return v;
-    }
-
-    static std::string range(int64_t lo, int64_t hi) {
-        if (hi == INT64_MAX) return " (at least " + std::to_string(lo) + ")";
-        return " (" + std::to_string(lo) + " to " + std::to_string(hi) + ")";
-    }
-
     std::string command_;
     int argc_;
     char **argv_;

@@ -64,27 +64,76 @@ bool whole_steps(double time, double dt, int64_t &steps) {
     return std::fabs(s - static_cast<double>(steps)) <= 1e-9 * std::max(1.0, s);
 }
 
-// The CSV of an interrupted run, up to and including the row of `step`: its
-// lines (the header first). Empty when the file is absent or has no row at
-// `step`; `why` says why a file that is there could not be read.
-std::vector<std::string> csv_up_to(const std::string &path, int64_t step, std::string &why) {
-    std::vector<std::string> lines;
+// A row of the CSV lpi run writes.
+struct CsvRow {
+    int64_t step = 0;
+    double time = 0.0, energy = 0.0;
+    std::vector<double> casimirs;
+};
+
+// The CSV of an interrupted run, read back by the rules of the options
+// (common.hpp): the header lpi run writes for `casimir_count` Casimirs, then
+// rows of as many fields, each a complete finite decimal number, the steps
+// whole, increasing and below 2^62. Its rows up to and including that of
+// `step`; none when the file is absent or has no row at `step`. `why` says
+// what is wrong with a file that is there ("PATH:LINE: ..."): a value read
+// wrongly would be the reference of every energy error after it.
+std::vector<CsvRow> csv_up_to(const std::string &path, int64_t step, std::size_t casimir_count, std::string &why) {
+    std::vector<CsvRow> rows;
     struct stat st;
-    if (stat(path.c_str(), &st) != 0 && errno == ENOENT) return lines;
+    if (stat(path.c_str(), &st) != 0 && errno == ENOENT) return rows;
     std::string text;
     why = read_input(path, text);  // a regular file only: a FIFO is refused, not waited on
+    if (!why.empty()) return rows;
+    std::string columns;
+    for (std::size_t i = 0; i < casimir_count; ++i) columns += format(",casimir_%zu", i);
     bool found = false;
-    for (std::size_t from = 0, end; (end = text.find('\n', from)) != std::string::npos; from = end + 1) {
+    std::size_t line_number = 0;
+    auto bad = [&](const std::string &what) {
+        why = format("%s:%zu: %s", path.c_str(), line_number, what.c_str());
+        rows.clear();
+        return rows;
+    };
+    for (std::size_t from = 0; from < text.size();) {
+        ++line_number;
+        const std::size_t end = text.find('\n', from);
+        if (end == std::string::npos) return bad("the line is cut short (no line end)");
         const std::string line = text.substr(from, end - from);
-        if (!lines.empty()) {
-            const long long row_step = std::strtoll(line.c_str(), nullptr, 10);
-            if (row_step > step) break;
-            found = row_step == step;
+        from = end + 1;
+        if (line_number == 1) {
+            if (line != "step,time,energy,energy_error" + columns &&
+                line != "step,time,energy,absolute_energy_error" + columns)
+                return bad("'" + line + "' is not the header lpi run writes for this scene");
+            continue;
         }
-        lines.push_back(line);
+        std::vector<std::string> fields;
+        for (std::size_t at = 0;;) {
+            const std::size_t comma = line.find(',', at);
+            fields.push_back(line.substr(at, comma - at));
+            if (comma == std::string::npos) break;
+            at = comma + 1;
+        }
+        if (fields.size() != 4 + casimir_count)
+            return bad(format("%zu fields, not %zu", fields.size(), 4 + casimir_count));
+        CsvRow row;
+        std::string wrong = whole_problem(fields[0], 0, (int64_t(1) << 62) - 1, row.step);
+        if (!wrong.empty()) return bad("step: " + wrong);
+        if (!rows.empty() && row.step <= rows.back().step) return bad("the steps do not increase");
+        std::vector<double> values(fields.size());
+        for (std::size_t i = 1; i < fields.size(); ++i) {
+            wrong = decimal_problem(fields[i], values[i]);
+            if (!wrong.empty()) return bad("field " + std::to_string(i + 1) + ": " + wrong);
+        }
+        if (row.step > step) continue;  // replaced by this run; still checked
+        row.time = values[1];
+        row.energy = values[2];
+        row.casimirs.assign(values.begin() + 4, values.end());
+        found = row.step == step;
+        rows.push_back(std::move(row));
     }
-    if (!found) lines.clear();
-    return lines;
+    if (line_number == 0) return bad("the file is empty");
+    if (!found) rows.clear();
+    return rows;
 }
 
 // A path as the file system resolves it: the real path of the file, or of
@@ -320,18 +369,17 @@ int run_command(int argc, char **argv) {
         if (!no_output.empty()) no_output = "lpi run: " + no_output;
     }
     if (const int agreed = agreed_failure(!no_output.empty(), no_output)) return agreed;
-    std::vector<std::string> kept;
+    std::vector<CsvRow> kept;
     if (!o.resume.empty()) {
         std::string why;
-        kept = csv_up_to(csv, start, why);
+        kept = csv_up_to(csv, start, data.casimir_count, why);
         int status = why.empty() ? 0 : 1;
         if (status) why = "lpi run: --resume: " + why;
         // The interrupted run's row at the checkpoint's step holds the
         // checkpoint's time to the bit (both written at the end of the same
         // call): another time there is another --dt (or --every), whose rows
         // would be spliced to this run's.
-        const char *row_time = kept.size() > 1 ? std::strchr(kept.back().c_str(), ',') : nullptr;
-        const double time_then = row_time ? std::strtod(row_time + 1, nullptr) : lpi_time(sys);
+        const double time_then = kept.empty() ? lpi_time(sys) : kept.back().time;
         if (!status && time_then != lpi_time(sys))
             status = 2, why = format("lpi run: --resume: the checkpoint's time %.17g is step %lld of --dt %g, "
                                      "but %s has t = %.17g at that step: resume with the options of the "
@@ -339,8 +387,9 @@ int run_command(int argc, char **argv) {
                                      lpi_time(sys), static_cast<long long>(start), dt, csv.c_str(), time_then);
         if (const int agreed = agreed_failure(status, why)) return agreed;
     }
-    // The references of the errors and drifts: the step-0 row of the CSV
-    // when resuming (to the bit: written with 17 digits), else this state.
+    // The references of the errors and drifts: the first row of the CSV
+    // when resuming (step 0, or the step a new file started at; to the bit:
+    // written with 17 digits), else this state.
     double H0 = energy_of(sys);
     std::vector<double> C0 = casimirs_of(sys);
     const bool spectrum = data.vorticity;
@@ -356,19 +405,8 @@ int run_command(int argc, char **argv) {
         data.casimirs.insert(data.casimirs.end(), c.begin(), c.end());
         data.casimir_drift.push_back(casimir_drift(spectrum, c, C0));
     };
-    for (std::size_t i = 1; i < kept.size(); ++i) {
-        std::vector<double> fields;
-        for (const char *p = kept[i].c_str();; ++p) {
-            char *next = nullptr;
-            fields.push_back(std::strtod(p, &next));
-            p = std::strchr(next, ',');
-            if (!p) break;
-        }
-        if (fields.size() != 4 + data.casimir_count) continue;
-        const std::vector<double> c(fields.begin() + 4, fields.end());
-        if (fields[0] == 0.0) H0 = fields[2], C0 = c;
-        add_row(static_cast<int64_t>(fields[0]), fields[1], fields[2], c);
-    }
+    if (!kept.empty()) H0 = kept.front().energy, C0 = kept.front().casimirs;
+    for (const CsvRow &r : kept) add_row(r.step, r.time, r.energy, r.casimirs);
     if (!o.resume.empty()) {
         const std::string why = keep_snapshots(o, start, lpi_time(sys), data);
         if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;

@@ -156,6 +156,14 @@ std::string keep_snapshots(const RunOptions &o, int64_t start, double start_time
     const std::size_t n = steps.values.size();
     if (why.empty() && (times.values.size() != n || shots.values.size() != n * d.snapshot_size()))
         why = "its snapshot arrays do not match this run";
+    // The steps become 64-bit integers (the images' names, the data's
+    // /snapshot_step): whole, increasing and in range, or none is kept.
+    for (std::size_t k = 0; k < n && why.empty(); ++k) {
+        const double step = steps.values[k], before = k ? steps.values[k - 1] : -1.0;
+        if (!(step >= 0.0 && step < 0x1p62 && step == std::trunc(step) && step > before &&
+              std::isfinite(times.values[k])))
+            why = format("its snapshot %zu has no whole step in order or no finite time", k);
+    }
     if (!why.empty()) {
         std::printf("%s: %s; the data keeps the snapshots from step %lld on\n", data_path(o).c_str(),
                     why.c_str(), static_cast<long long>(start));
