@@ -141,6 +141,7 @@ std::string parse_npy(RegularFileReader &f, Array &a) {
     if (length > 1 << 20) return "header length " + std::to_string(length) + " is absurd";
     std::string header(length, '\0');
     if (f.read(reinterpret_cast<unsigned char *>(&header[0]), length) != length) return "truncated header";
+    const std::size_t data_bytes = f.size() - (major == 1 ? 10 : 12) - length;
     const std::string descr = header_value(header, "descr");
     const std::string order = header_value(header, "fortran_order");
     int item = 0;
@@ -158,6 +159,9 @@ std::string parse_npy(RegularFileReader &f, Array &a) {
     bool too_many = false;
     const std::size_t count = element_count(out.shape, &too_many);
     if (too_many) return "more than 2^28 values";
+    // Compared with the file's size before anything is allocated for it: a
+    // header alone could otherwise make lpi allocate gigabytes.
+    if (count * item > data_bytes) return "truncated: the data is shorter than its shape says";
     std::vector<unsigned char> bytes(count * item);
     if (f.read(bytes.data(), bytes.size()) != bytes.size())
         return "truncated: the data is shorter than its shape says";
@@ -379,10 +383,25 @@ std::string read_hdf5(const std::string &path, const std::string &name, Array &a
     bool too_many = false;
     const std::size_t count = element_count(out.shape, &too_many);
     if (too_many) return name + " has more than 2^28 values";
+    // What the shape claims must be in the file before anything is allocated
+    // for it: at most the file's size, or deflate's greatest ratio (1032:1)
+    // times it for a compressed dataset.
+    const std::size_t item = H5Tget_size(type.get());
+    hsize_t file_size = 0;
+    Id creation(H5Dget_create_plist(set.get()), H5Pclose);
+    const int filters = creation.ok() ? H5Pget_nfilters(creation.get()) : -1;
+    if (item == 0 || filters < 0 || H5Fget_filesize(file.get(), &file_size) < 0)
+        return name + " has an unreadable layout";
+    const double claimed = static_cast<double>(count) * static_cast<double>(item);
+    if (claimed > static_cast<double>(file_size) * (filters > 0 ? 1032.0 : 1.0)) {
+        *found = false;  // a damaged file, not a dataset of another shape
+        return name + " claims more values than the file holds (truncated?)";
+    }
     out.values.resize(count);
     if (count > 0 && H5Dread(set.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.values.data()) < 0)
         return "HDF5 cannot read " + name + " (damaged?)";
-    if (!type.close() || !space.close() || !set.close() || !file.close()) return "HDF5 cannot close it";
+    if (!creation.close() || !type.close() || !space.close() || !set.close() || !file.close())
+        return "HDF5 cannot close it";
     a = std::move(out);
     return "";
 }

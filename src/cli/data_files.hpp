@@ -64,7 +64,8 @@ std::string write_hdf5(const std::string &path, const std::vector<Dataset> &data
 bool is_hdf5_file(const std::string &path);
 
 // Reads the dataset `name` of an HDF5 file as doubles. `found` tells a
-// missing dataset apart from an unreadable file. Returns "" or the reason.
+// missing dataset apart from an unreadable file (one whose dataset claims
+// more values than the file holds is unreadable). Returns "" or the reason.
 std::string read_hdf5(const std::string &path, const std::string &name, Array &a, bool *found);
 
 }  // namespace lpi_cli
