@@ -72,6 +72,13 @@ for option in $(sed -n 's/^  \(--[a-z][a-z-]*\).*/\1/p' "$out/run.help"); do
         { echo "lpi run --help lists $option, which lpi run does not read:"; cat "$out/option.err"; exit 1; }
 done
 
+# A time that is 2^62 steps or more is refused (2) before anything runs:
+# lpi report's --T as lpi run's --until.
+rc=0; timeout 120 "$lpi" report rigid-body sine-euler-long --N 3 --T 1e300 --out "$out/long" >"$out/long.out" \
+    2>"$out/long.err" || rc=$?
+[ "$rc" -eq 2 ] && grep -q -e "--T: 1e+300 / .* is too many steps" "$out/long.err" && ! grep -q "^==" "$out/long.out" ||
+    { echo "lpi report sine-euler-long --T 1e300: exit status $rc, expected 2 before any scene runs"; cat "$out/long.err"; exit 1; }
+
 # Standard output that cannot be written fails the command (exit status 1);
 # an argument after --version or --help is refused (2).
 if [ -w /dev/full ]; then

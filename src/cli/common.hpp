@@ -281,6 +281,18 @@ inline double energy_of(const lpi_system *sys) {
     return h;
 }
 
+// The number of steps of `dt` in `span`, rounded: below 2^62, where a run's
+// step counts and their sums stay exact in 64 bits; past that (a huge time
+// or a tiny step) the command stops with a message and exit status 2.
+inline int64_t step_count(double span, double dt, const std::string &what) {
+    const double steps = span / dt;
+    if (!(steps >= 0.0 && steps < 0x1p62)) {
+        std::fprintf(stderr, "%s: %g / %g is too many steps (%g; at most 2^62)\n", what.c_str(), span, dt, steps);
+        std::exit(2);
+    }
+    return std::llround(steps);
+}
+
 // Drift of a sine-Euler spectrum: the largest change of an eigenvalue of W
 // relative to the largest |eigenvalue|. Relative to each eigenvalue itself,
 // an eigenvalue near zero would turn round-off into an arbitrarily large

@@ -36,7 +36,8 @@ struct LongRow {
 // maxima up to there.
 LongRow long_run(const LongRunScene &scene, const std::string &method, double dt, int samples) {
     const double interval = scene.final_time / samples;
-    const int64_t per_sample = std::max<int64_t>(1, std::llround(interval / dt));
+    // Below 2^62 / samples: the whole run's count stays below 2^62 too.
+    const int64_t per_sample = std::max<int64_t>(1, step_count(interval, dt, "lpi report " + scene.name));
     LongRow row;
     row.method = method;
     row.dt = interval / static_cast<double>(per_sample);

@@ -104,6 +104,11 @@ int report_command(int argc, char **argv) {
                 return std::find(s->options.begin(), s->options.end(), option) != s->options.end();
             }))
             args.fail(option + ": no scene reported takes it (lpi --help lists each scene's options)");
+    // Every run of every scene reported is a count of steps below 2^62 (a
+    // --T of 1e300 is not): checked before any scene runs.
+    for (const Scene *s : chosen)
+        for (double dt : s->steps)
+            step_count(s->final_time, std::min(dt, s->final_time), "lpi report " + s->name + ": --T");
     const std::string no_dir = make_output_dir(options.out_dir);
     if (!no_dir.empty()) {
         std::fprintf(stderr, "lpi report: --out %s\n", no_dir.c_str());

@@ -87,7 +87,7 @@ Reference reference_state(const Scene &scene) {
               "exact solution");
         return reference;
     }
-    const int64_t n = std::max<int64_t>(2, 2 * (std::llround(scene.final_time / scene.reference_step) / 2));
+    const int64_t n = std::max<int64_t>(2, 2 * (step_count(scene.final_time, scene.reference_step, "lpi report " + scene.name) / 2));
     reference.state = reference_run(scene, n);
     reference.own_error = distance(reference.state, reference_run(scene, n / 2));
     return reference;
@@ -125,7 +125,7 @@ Row measure(const Scene &scene, const char *method, int order, double dt,
     Row row;
     row.method = method;
     row.order = order;
-    row.steps = std::max<int64_t>(1, std::llround(scene.final_time / dt));
+    row.steps = std::max<int64_t>(1, step_count(scene.final_time, dt, "lpi report " + scene.name));
     row.dt = scene.final_time / static_cast<double>(row.steps);
     double elapsed = 0.0;
     int repeats = 0;
@@ -277,7 +277,7 @@ bool run_report(const Scene &scene, const ReportOptions &options) {
     // the others (at its stretched step a 35-stage method makes 3 steps to
     // T = 10): the legend gives the stages, a step's cost.
     const double history_dt = scene.steps[scene.steps.size() / 2];
-    const int64_t history_steps = std::max<int64_t>(1, std::llround(scene.final_time / history_dt));
+    const int64_t history_steps = std::max<int64_t>(1, step_count(scene.final_time, history_dt, "lpi report " + scene.name));
     const std::vector<bool> accepted = accepted_methods(scene.create);
     for (int i = 0; i < lpi_method_count(); ++i) {
         const char *method = lpi_method_name(i);
@@ -293,7 +293,7 @@ bool run_report(const Scene &scene, const ReportOptions &options) {
         for (double base_dt : scene.steps) {
             const double dt = std::min(base_dt * stretch, scene.final_time);
             // Stretched steps near T round to the same step count: measure it once.
-            const int64_t steps = std::max<int64_t>(1, std::llround(scene.final_time / dt));
+            const int64_t steps = std::max<int64_t>(1, step_count(scene.final_time, dt, "lpi report " + scene.name));
             if (steps == previous_steps) continue;
             previous_steps = steps;
             const Row r = measure(scene, method, lpi_method_order(i), dt, reference.state, options);

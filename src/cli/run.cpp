@@ -336,12 +336,7 @@ int run_command(int argc, char **argv) {
     }
     int64_t end = o.steps;
     if (end == 0) {
-        const double steps = (o.until > 0.0 ? o.until : it->final_time) / dt;
-        if (!(steps < 0x1p62)) {
-            std::fprintf(stderr, "lpi run: --until / --dt is too many steps (%g)\n", steps);
-            return 2;
-        }
-        end = std::llround(steps);
+        end = step_count(o.until > 0.0 ? o.until : it->final_time, dt, "lpi run: --until / --dt");
         if (end < 1) {
             std::fprintf(stderr, "lpi run: --until %g with --dt %g is less than one step\n",
                          o.until > 0.0 ? o.until : it->final_time, dt);

@@ -150,6 +150,9 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         s.name = long_run.name;
         s.description = long_run.description + ", " + long_run.setting;
         s.options = {"--N", "--T"};
+        // What lpi report checks before any scene runs (a --T too long for its steps).
+        s.final_time = long_run.final_time;
+        for (const LongRunSweep &sweep : long_run.sweeps) s.steps.insert(s.steps.end(), sweep.steps.begin(), sweep.steps.end());
         s.unavailable = sine_euler_spectrum_unavailable;
         s.custom_run = [long_run](const std::string &out_dir) { return run_long_scene(long_run, out_dir); };
         scenes.push_back(s);

@@ -28,7 +28,8 @@ struct Scene {
     std::function<Handle()> create;  // configured system with its initial state (empty: report only)
     double final_time = 1.0;
     double run_step = 0.01;          // lpi run's default --dt
-    std::vector<double> steps;       // the sweep, largest first
+    std::vector<double> steps;       // the sweep, largest first (a custom_run's steps, for the check of
+                                     // final_time / step below 2^62 before any scene runs)
     // Reference: the exact solution when the system has one, otherwise a much
     // finer run of `reference_method` with `reference_step`.
     bool exact_reference = false;
