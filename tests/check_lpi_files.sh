@@ -6,7 +6,8 @@
 #    is a directory) fails lpi run, report figure2, sine-euler-long and
 #    rollup naming the file, and so does an image gnuplot leaves empty or
 #    cut short while exiting 0 (the old images kept); without gnuplot the
-#    plots are skipped, said so;
+#    plots are skipped, said so; lpi report whose CSV cannot be written
+#    fails before its work, not saying where its files are;
 #  - a write that fails (RLIMIT_FSIZE, as a full disk) keeps the old CSV,
 #    the old .npy set and the old HDF5 file whole, names the file and the
 #    reason, exits 1 (no crash) and leaves no temporary file; a replaced file
@@ -92,6 +93,12 @@ if [ "$have_se" = 1 ]; then
     PATH="$out/cut-gnuplot:$PATH" expect 1 "rollup.svg (the SVG is cut short" run rollup --N 5 --steps 3 --out "$out/p9"
     (cd "$out" && md5sum -c --quiet "$out/images.md5") || fail "an unfinished image replaced a good one"
     no_temporaries "$out/p8"; no_temporaries "$out/p9"
+    # lpi report whose CSV cannot be written fails before the work, and says
+    # nothing of files written.
+    mkdir -p "$out/p10/figure2.csv"
+    expect 1 "figure2.csv.*directory" report figure2 --out "$out/p10"
+    ! grep -q -e "^== figure2" -e "files are in" "$out/stdout" ||
+        { cat "$out/stdout"; fail "lpi report with an unwritable CSV ran, or said its files were written"; }
     mkdir -p "$out/p5/figure2.png" "$out/p6/vorticity_000000.png"
     PATH="$ok_path" expect 1 "figure2.png.*directory" report figure2 --out "$out/p5"
     PATH="$ok_path" expect 1 "vorticity_000000.png.*directory" run sine-euler --N 5 --steps 2 --out "$out/p6"

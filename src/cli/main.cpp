@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "output.hpp"
 #include "processes.hpp"
 #include "report.hpp"
 #include "run.hpp"
@@ -114,13 +115,22 @@ int report_command(int argc, char **argv) {
         std::fprintf(stderr, "lpi report: --out %s\n", no_dir.c_str());
         return 1;
     }
+    // Every scene writes DIR/SCENE.csv first: one that cannot be written (a
+    // directory lpi may not write in) fails now, before the work, as lpi run does.
+    for (const Scene *s : chosen) {
+        const std::string why = output_problem(options.out_dir + "/" + s->name + ".csv");
+        if (!why.empty()) {
+            std::fprintf(stderr, "lpi report: %s\n", why.c_str());
+            return 1;
+        }
+    }
     std::printf("liepoisson %s: error against CPU time, one core, measured in this run\n",
                 lpi_version_string());
     // A scene whose files were not written fails the command; the others still run.
     int status = 0;
     for (const Scene *s : chosen)
         if (!run_report(*s, options)) status = 1;
-    std::printf("\nCSV, PNG and SVG files are in %s/\n", options.out_dir.c_str());
+    if (status == 0) std::printf("\nCSV, PNG and SVG files are in %s/\n", options.out_dir.c_str());
     return status;
 }
 
