@@ -1,8 +1,9 @@
 #!/bin/sh
 # The command's help is true: every scene lpi --help lists runs (tiny sizes;
 # a scene the build lacks says so), the commands it names exist, each
-# subcommand's --help describes that subcommand, the scenes and options
-# agree with man1, and help that cannot be written is a failure.
+# subcommand's --help describes that subcommand (lpi report's the options
+# it takes), the scenes and options agree with man1 (-h and help too), and
+# help that cannot be written is a failure.
 set -eu
 lpi="$1"; out="$2"
 rm -rf "$out"; mkdir -p "$out"
@@ -71,6 +72,17 @@ for option in $(sed -n 's/^  \(--[a-z][a-z-]*\).*/\1/p' "$out/run.help"); do
     grep -q -e "$option needs a value" "$out/option.err" ||
         { echo "lpi run --help lists $option, which lpi run does not read:"; cat "$out/option.err"; exit 1; }
 done
+
+# The options lpi report --help gives the scenes in brackets are ones lpi
+# report reads (a missing value, not an unknown option); -h and help, which
+# lpi takes for --help, are in man1.
+for option in $(sed -n '/^scenes:/,$p' "$out/report.help" | grep -o -e '\[--[^]]*\]' | grep -o -e '--[A-Za-z][A-Za-z-]*' | sort -u); do
+    "$lpi" report rigid-body "$option" >/dev/null 2>"$out/option.err" && true
+    grep -q -e "$option needs a value" "$out/option.err" ||
+        { echo "lpi report --help gives scenes $option, which lpi report does not read:"; cat "$out/option.err"; exit 1; }
+done
+"$lpi" -h | cmp -s - "$out/help" && "$lpi" help | cmp -s - "$out/help" || { echo "lpi -h or lpi help is not lpi --help"; exit 1; }
+grep -q '^\.B \\-h$' "$man1" && grep -q '^\.B help$' "$man1" || { echo "man1 does not give -h and help"; exit 1; }
 
 # A time that is 2^62 steps or more is refused (2) before anything runs:
 # lpi report's --T as lpi run's --until.

@@ -20,16 +20,24 @@ using namespace lpi_cli;
 
 namespace {
 
-// Each scene with, in brackets, the options that configure it.
-void print_scenes(FILE *to) {
-    std::fprintf(to, "scenes:\n");
+// The options of lpi report that configure scenes (it takes no other).
+const char *const kReportSceneOptions[] = {"--N", "--T"};
+
+// Each scene with, in brackets, the options that configure it: for lpi
+// report (`report`), those of them report takes only.
+void print_scenes(FILE *to, bool report) {
+    std::fprintf(to, report ? "scenes: [the options of lpi report that configure them]\n"
+                            : "scenes: [the options that configure them; lpi report takes --N and --T only]\n");
     for (const Scene &s : builtin_scenes()) {
         std::string notes;
         if (s.run_own) notes += " (lpi run only)";
         else if (!s.create) notes += " (lpi report only)";
         if (!s.in_default_report && !s.run_own) notes += " (not in the default report)";
         std::string options;
-        for (const std::string &option : s.options) options += (options.empty() ? " [" : " ") + option;
+        for (const std::string &option : s.options)
+            if (!report || std::find(std::begin(kReportSceneOptions), std::end(kReportSceneOptions), option) !=
+                               std::end(kReportSceneOptions))
+                options += (options.empty() ? " [" : " ") + option;
         if (!options.empty()) options += "]";
         std::fprintf(to, "  %-16s %s%s%s\n", s.name.c_str(), s.description.c_str(), options.c_str(),
                      notes.c_str());
@@ -46,10 +54,10 @@ void print_usage(FILE *to) {
                  "           stiff and extreme cases against every applicable method: bounded,\n"
                  "           energy error, Casimir drift and status per case, step and method\n"
                  "       lpi methods   the integration methods: name, order, stages, reference\n"
-                 "       lpi --version | --help\n"
+                 "       lpi --version | --help (-h, help)\n"
                  "exit status: 0 success, 1 a failure, 2 a bad option, 130 (143) interrupted by\n"
                  "SIGINT (SIGTERM) (lpi run)\n");
-    print_scenes(to);
+    print_scenes(to, false);
 }
 
 void print_report_usage(FILE *to) {
@@ -63,7 +71,7 @@ void print_report_usage(FILE *to) {
                  "              the plots there as PNG and SVG (default ./lpi-report)\n"
                  "  --N N       the sine-Euler scenes' N (odd >= 3, default 31)\n"
                  "  --T T       the sine-euler-long scene's final time (default 2000)\n");
-    print_scenes(to);
+    print_scenes(to, true);
 }
 
 int report_command(int argc, char **argv) {
