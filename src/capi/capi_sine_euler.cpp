@@ -39,7 +39,9 @@ void set_converted(lpi_system *sys, const double *data, std::size_t n, const cha
     const auto &model = sine_euler(sys);
     require(data, what);
     lpi::require_length(what, n, per_mode * squared(model.truncation()));
-    std::vector<double> x(squared(model.truncation()));
+    // Allocated on every process before the conversion's collectives.
+    std::vector<double> x;
+    model.agree_on_every_process([&] { x.resize(squared(model.truncation())); });
     convert(model, x.data());
     lpi::require_no_overflow(x.data(), x.size(), [what](std::size_t i) {
         return std::string("coordinate ") + std::to_string(i) + " of the field converted from the " + what;
@@ -100,7 +102,8 @@ LPI_API int lpi_sine_euler_get_grid(const lpi_system *sys, double *w, size_t n) 
         const auto &model = sine_euler(sys);
         require(w, "grid buffer");
         lpi::require_length("grid buffer", n, squared(model.truncation()));
-        std::vector<double> grid(n);
+        std::vector<double> grid;
+        model.agree_on_every_process([&] { grid.resize(n); });  // before the model's collectives
         model.grid(sys->system.working_state().data(), grid.data());
         lpi::require_no_overflow(grid.data(), n, [&](std::size_t i) {
             return entry_name("grid value", i, model.truncation()) + " of this state";
@@ -124,7 +127,8 @@ LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, d
         const auto &model = sine_euler(sys);
         require(out, "out");
         if (kmax < 1) lpi::fail(LPI_ERR_INVALID, "kmax must be >= 1, got " + std::to_string(kmax));
-        std::vector<double> traces(static_cast<std::size_t>(kmax));
+        std::vector<double> traces;
+        model.agree_on_every_process([&] { traces.resize(static_cast<std::size_t>(kmax)); });
         model.casimir_traces(sys->system.working_state().data(), kmax, traces.data());
         lpi::require_no_overflow(traces.data(), traces.size(), [](std::size_t i) {
             return "(1/N) tr W^" + std::to_string(i + 1) + " of this state";
@@ -148,7 +152,13 @@ LPI_API int lpi_sine_euler_fft_floor(lpi_system *sys, int64_t nsteps, double *se
         if (!splitting)
             lpi::fail(LPI_ERR_INVALID, "the FFT floor is defined for splitting methods, not '" +
                                            method.name + "'");
-        sys->system.prepare_threads();
+        // Set up as a step is (System::step): a failure on one process of a
+        // spread system fails the call on all, none left in the timing's
+        // collective.
+        model.agree_on_every_process([&] {
+            sys->system.prepare_threads();
+            model.prepare_step();
+        });
         const lpi::TransformTiming timing = model.time_transforms(sys->system.flows_per_step(), nsteps);
         *seconds_per_step = timing.seconds_per_step;
         *transforms_per_step = timing.transforms_per_step;
@@ -234,10 +244,14 @@ LPI_API int lpi_sine_euler_get_stream(const lpi_system *sys, double *psi, size_t
         require(psi, "stream function buffer");
         const int N = model.truncation();
         lpi::require_length("stream function buffer", n, squared(N));
-        std::vector<double> modes(2 * squared(N)), grid(n);
         const std::vector<double> whole = model.whole_state(sys->system.working_state().data());
-        model.hamiltonian().stream_function(whole.data(), modes.data());
-        lpi::sine_euler::grid_from_modes(N, modes.data(), grid.data());
+        std::vector<double> grid;
+        model.agree_on_every_process([&] {  // one outcome on every process
+            std::vector<double> modes(2 * squared(N));
+            grid.resize(n);
+            model.hamiltonian().stream_function(whole.data(), modes.data());
+            lpi::sine_euler::grid_from_modes(N, modes.data(), grid.data());
+        });
         lpi::require_no_overflow(grid.data(), n, [&](std::size_t i) {
             return entry_name("stream function value", i, N) + " of this state";
         });
@@ -268,9 +282,12 @@ LPI_API int lpi_sine_euler_spectrum(const lpi_system *sys, double *energy, doubl
                                     "small: N = " + std::to_string(model.truncation()) + " has " +
                                     std::to_string(count) + " shells");
         }
-        std::vector<double> e(count), z(count);
         const std::vector<double> whole = model.whole_state(sys->system.working_state().data());
-        lpi::sine_euler::shell_spectra(model.hamiltonian(), whole.data(), e.data(), z.data());
+        std::vector<double> e, z;
+        model.agree_on_every_process([&] {  // one outcome on every process
+            e.resize(count), z.resize(count);
+            lpi::sine_euler::shell_spectra(model.hamiltonian(), whole.data(), e.data(), z.data());
+        });
         lpi::require_no_overflow(e.data(), count, [](std::size_t k) {
             return "the energy of shell " + std::to_string(k + 1) + " of this state";
         });

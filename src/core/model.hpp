@@ -45,6 +45,12 @@ public:
     // baselines (src/baselines) integrate.
     virtual void vector_field(const double *state, double *rate) const = 0;
 
+    // Sets up what the flows of a step need (plans, buffers) before the
+    // first: System::step calls it where a failure on one process of a
+    // spread model is agreed on by every process, while inside a flow it
+    // would leave the others waiting in a collective. Nothing by default.
+    virtual void prepare_step() {}
+
     // Threads used inside one flow. The default integrates on one thread:
     // n = 1 is accepted, n > 1 throws LPI_ERR_UNSUPPORTED.
     virtual void set_threads(int n);

@@ -89,7 +89,9 @@ void System::set_implicit_settings(const ImplicitSettings &settings) {
 
 void System::set_state(const double *x, std::size_t n) {
     require_length("state", n, model_->dim());
-    std::vector<double> next(model_->state_size());
+    // Allocated on every process before the conversion's collectives.
+    std::vector<double> next;
+    model_->agree_on_every_process([&] { next.resize(model_->state_size()); });
     model_->from_public(x, next.data());
     state_.swap(next);
     time_ = 0.0;
@@ -157,7 +159,15 @@ bool System::step(double dt, std::int64_t nsteps) {
         fail(LPI_ERR_OVERFLOW, "dt = " + number_text(dt, 6) + " times the largest flow weight " +
                                    number_text(fraction, 6) + " of method '" + method_.name +
                                    "' overflows a double");
-    prepare_threads();
+    // Everything the step sets up or allocates, before its first flow: on a
+    // model spread over processes, a failure on one of them (its thread
+    // limit, memory for the plans) then fails the call on every process, and
+    // none is left waiting in a flow's exchange.
+    model_->agree_on_every_process([&] {
+        prepare_threads();
+        model_->prepare_step();
+        saved_ = state_;
+    });
 
     StepObserver watch;
     if (observer_) {
@@ -171,7 +181,6 @@ bool System::step(double dt, std::int64_t nsteps) {
             return model_->on_any_process(stop);
         };
     }
-    saved_ = state_;
     const double average_iterations = integrator_->average_iterations();
     const auto roll_back = [&] {
         state_.swap(saved_);
@@ -212,7 +221,8 @@ double System::energy() const {
 
 void System::casimirs(double *out, std::size_t n) const {
     require_length("Casimir buffer", n, model_->casimir_count());
-    std::vector<double> values(n);
+    std::vector<double> values;
+    model_->agree_on_every_process([&] { values.resize(n); });  // before the model's collectives
     model_->casimirs(state_.data(), values.data());
     require_no_overflow(values.data(), n,
                         [](std::size_t i) { return "Casimir " + std::to_string(i) + " of this state"; });

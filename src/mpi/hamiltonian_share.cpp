@@ -149,6 +149,14 @@ void HamiltonianShare::origin_line_riders(const Direction &D, std::size_t index,
     });
 }
 
+void HamiltonianShare::reserve(OriginLineWeights &out) const {
+    const std::size_t n = static_cast<std::size_t>(N_);
+    out.lambda.reserve(n);
+    out.owned.reserve(n);
+    out.f.reserve(f_.empty() ? 0 : 2 * n);
+    rider_start_.reserve(static_cast<std::size_t>(lines_.P) + 1);
+}
+
 void HamiltonianShare::read_origin_line(const Direction &D, std::size_t index, const Riders &riders,
                                         OriginLineWeights &out) const {
     const std::size_t n = static_cast<std::size_t>(N_);
@@ -157,7 +165,8 @@ void HamiltonianShare::read_origin_line(const Direction &D, std::size_t index, c
     out.owned.assign(n, 0);
     out.f.assign(forced ? 2 * n : 0, 0.0);
     // Where each process's values start in riders.gathered.
-    std::vector<std::size_t> next(static_cast<std::size_t>(lines_.P) + 1, 0);
+    std::vector<std::size_t> &next = rider_start_;
+    next.assign(static_cast<std::size_t>(lines_.P) + 1, 0);
     for (int r = 0; r < lines_.P; ++r) next[r + 1] = next[r] + 2 * static_cast<std::size_t>(riders.counts[r]);
     for_each_origin_mode(D, [&](int s, int holder) {
         if (holder < 0) {  // mode (0, b) of line 0: piece 0's, held here

@@ -58,6 +58,9 @@ public:
     // The weights of D's line 0 from the riders gathered by the exchange.
     void read_origin_line(const sine_euler::Direction &D, std::size_t index, const Riders &riders,
                           OriginLineWeights &out) const;
+    // Sizes out and the scratch of read_origin_line, so that it allocates
+    // nothing during a step (LineExchange::reserve).
+    void reserve(OriginLineWeights &out) const;
 
     // The term of H of the mode at complex entry e of a working state in the
     // reference layout (line 0: e = s; line first + i: e = N + s * count + i):
@@ -94,6 +97,7 @@ private:
     std::vector<double> lambda_;        // N (1 + mine) entries: line 0, then the lines held
     std::vector<double> f_;             // 2 N (1 + mine), empty when f = 0
     std::vector<std::uint32_t> owner_;  // piece owning each entry of the lines held
+    mutable std::vector<std::size_t> rider_start_;  // read_origin_line's scratch: P + 1
 };
 
 }  // namespace mpi

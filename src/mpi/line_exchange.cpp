@@ -2,6 +2,7 @@
 // header).
 #include "line_exchange.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <numeric>
 #include <string>
@@ -106,8 +107,12 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
     // Where each mode of the new line 0 comes from: the owner of its old
     // line, or -1 for modes on the old line 0 (at hand here). By owner, in
     // ascending s' within each.
-    std::vector<int> origin_source(static_cast<std::size_t>(N), -1), origin_order;
-    std::vector<int> origin_first(static_cast<std::size_t>(P) + 1, 0);
+    // (In buffers kept between flows: after reserve(), nothing here
+    // allocates, so nothing fails on one process before the collective.)
+    std::vector<int> &origin_source = origin_source_, &origin_order = origin_order_;
+    std::vector<int> &origin_first = origin_first_, &next = next_origin_;
+    origin_source.assign(static_cast<std::size_t>(N), -1);
+    origin_first.assign(static_cast<std::size_t>(P) + 1, 0);
     for (int s = 1; s < N; ++s) {
         const int v = T.line_of_new_origin_line(s);
         if (v != 0) origin_source[s] = L.owner[v <= L.M ? v : N - v];
@@ -115,11 +120,9 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
     }
     std::partial_sum(origin_first.begin(), origin_first.end(), origin_first.begin());
     origin_order.resize(static_cast<std::size_t>(origin_first[P]));
-    {
-        std::vector<int> next(origin_first.begin(), origin_first.end() - 1);
-        for (int s = 1; s < N; ++s)
-            if (origin_source[s] >= 0) origin_order[next[origin_source[s]]++] = s;
-    }
+    next.assign(origin_first.begin(), origin_first.end() - 1);
+    for (int s = 1; s < N; ++s)
+        if (origin_source[s] >= 0) origin_order[next[origin_source[s]]++] = s;
     // The value of the old layout at element u of line v (v != 0).
     auto old_value = [&](int v, int u, double &re, double &im) {
         const bool mirrored = v > L.M;
@@ -201,6 +204,51 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
         });
     }
     state[0] = static_cast<double>(to_index);
+}
+
+// The most modes of one direction's line 0 that this process's lines of
+// another direction hold. Mode s k' lies on line v = c s mod N for a c fixed
+// by the two directions; with g = gcd(c, N), v runs over the multiples of g,
+// each g times: g times the multiples of g among this process's lines d and
+// their mirrors -d, at most over the divisors g of N (for a prime N, 2 per
+// line; at N = 255, 170 for a process of 64 lines holding line 85).
+std::size_t LineExchange::most_line0_modes_held() const {
+    const int N = lines_.N, me = comm_.rank();
+    std::size_t most = 0;
+    for (int g = 1; g < N; ++g) {
+        if (N % g != 0) continue;
+        std::size_t multiples = 0;
+        for (int d = lines_.first[me]; d < lines_.first[me + 1]; ++d) multiples += d % g == 0 ? 1 : 0;
+        most = std::max(most, 2 * static_cast<std::size_t>(g) * multiples);
+    }
+    return std::min(most, static_cast<std::size_t>(N));
+}
+
+// Bounds, per process: `held` modes of the new line 0 (most_line0_modes_held)
+// and as many riders of at most 4 doubles each (the weights of the modes of
+// line 0 held in the reference direction's layout), both sent to every
+// process; the lines send each of their N mine modes once. What is received:
+// the N modes of line 0, riders of at most 2 entries a mode of it, and the N
+// mine modes of the lines.
+void LineExchange::reserve(Riders *riders) {
+    const std::size_t N = static_cast<std::size_t>(lines_.N), P = static_cast<std::size_t>(lines_.P);
+    const std::size_t mine = static_cast<std::size_t>(lines_.count(comm_.rank()));
+    const std::size_t held = held_;
+    send_.reserve(P * (2 * held + 4 * held) + 2 * N * mine);
+    targets_.reserve(N + 2 * N + N * mine);
+    receive_.reserve(2 * (N + 2 * N + N * mine));
+    old_line0_.reserve(2 * N);
+    for (std::vector<int> *v : {&send_counts_, &send_offsets_, &receive_counts_, &receive_offsets_})
+        v->reserve(P);
+    rider_offsets_.reserve(P);
+    origin_source_.reserve(N);
+    origin_order_.reserve(N);
+    origin_first_.reserve(P + 1);
+    next_origin_.reserve(P);
+    if (!riders) return;
+    riders->own.reserve(4 * held);
+    riders->counts.reserve(P);
+    riders->gathered.reserve(4 * N);
 }
 
 void LineExchange::exchange_riders(Riders &riders) {

@@ -74,13 +74,19 @@ struct Riders {
 // with buffers kept between flows.
 class LineExchange {
 public:
-    LineExchange(const Communicator &comm, const LineOwnership &lines) : comm_(comm), lines_(lines) {}
+    LineExchange(const Communicator &comm, const LineOwnership &lines)
+        : comm_(comm), lines_(lines), held_(most_line0_modes_held()) {}
     // state holds the layout of `from`; afterwards that of `to`. With riders,
     // their values travel in the same collective; when from and to are the
     // same direction only they travel.
     void move(const sine_euler::Direction &from, std::size_t from_index,
               const sine_euler::Direction &to, std::size_t to_index, double *state,
               Riders *riders = nullptr);
+    // Sizes every buffer of move (and the riders', when given) for the
+    // largest exchange this process can make, so that a move allocates
+    // nothing: a step reserves before its first flow, where a failure is
+    // agreed on by every process.
+    void reserve(Riders *riders = nullptr);
 
 private:
     void exchange_riders(Riders &riders);       // the riders alone
@@ -93,6 +99,10 @@ private:
     std::vector<std::uint64_t> targets_;  // complex entry of the state for each value received
     std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
     std::vector<std::size_t> rider_offsets_;  // where each process's riders start in receive_
+    std::size_t most_line0_modes_held() const;
+    std::size_t held_;  // most_line0_modes_held()
+    // Where the new line 0's modes come from (see move).
+    std::vector<int> origin_source_, origin_order_, origin_first_, next_origin_;
 };
 
 }  // namespace mpi

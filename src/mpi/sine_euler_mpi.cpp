@@ -116,20 +116,25 @@ public:
     void to_public(const double *state, double *x) const override {
         public_from_state(N_, whole_state(state).data(), x);
     }
+    // The conversions allocate (and a grid plans its FFT), which may fail on
+    // one process alone: each is agreed on before the call goes on to its
+    // next collective.
     void from_public(const double *x, double *state) const override {
         require_same_input(x, dim(), "state");
-        std::vector<double> modes(2 * dim());
-        state_from_public(N_, x, modes.data());
-        const std::vector<double> local = local_state(modes.data(), 0);
-        std::copy(local.begin(), local.end(), state);
+        comm_->agree([&] {
+            std::vector<double> modes(2 * dim());
+            state_from_public(N_, x, modes.data());
+            const std::vector<double> local = local_state(modes.data(), 0);
+            std::copy(local.begin(), local.end(), state);
+        });
     }
     void public_from_modes(const double *modes, double *x) const override {
         require_same_input(modes, 2 * dim(), "modes");
-        sine_euler::public_from_modes(N_, modes, x);
+        comm_->agree([&] { sine_euler::public_from_modes(N_, modes, x); });
     }
     void public_from_grid(const double *grid, double *x) const override {
         require_same_input(grid, dim(), "grid");
-        sine_euler::public_from_grid(N_, grid, x);
+        comm_->agree([&] { sine_euler::public_from_grid(N_, grid, x); });
     }
     // Computed from the whole field on rank 0 and sent to every process, so
     // that every process returns the same bits.
@@ -159,6 +164,13 @@ public:
         fail(LPI_ERR_UNSUPPORTED, "the vector field of a sine-Euler system spread over processes");
     }
 
+    // The plans, and every buffer of the exchange and of line 0's weights
+    // at its largest: a flow then allocates nothing.
+    void prepare_step() override {
+        transforms();
+        exchange_.reserve(&riders_);
+        share_.reserve(origin_);
+    }
     void flow(std::size_t piece, double t, double *state) override;
     TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) override;
 
@@ -211,14 +223,19 @@ LineTransforms &SineEulerMpi::transforms() {
 std::vector<double> SineEulerMpi::whole_state(const double *state) const {
     const Direction &D = dirs_[static_cast<std::size_t>(state[0])];
     const int P = lines_.P;
-    std::vector<int> counts(P), offsets(P);
+    std::vector<int> counts, offsets;
+    std::vector<double> lines, modes;
+    // Allocated, and agreed on, before the collective.
+    comm_->agree([&] {
+        counts.resize(P), offsets.resize(P);
+        lines.resize(2 * static_cast<std::size_t>(N_) * lines_.M);
+        modes.resize(2 * dim());
+    });
     for (int r = 0; r < P; ++r) {
         counts[r] = lines_.count(r) * N_;
         offsets[r] = (lines_.first[r] - 1) * N_;
     }
-    std::vector<double> lines(2 * static_cast<std::size_t>(N_) * lines_.M);
     comm_->allgatherv(state + mpi::slab_entry(N_), mine_ * N_, lines.data(), counts, offsets);
-    std::vector<double> modes(2 * dim());
     const double *line0 = state + mpi::line0_entry();
     for (int s = 0; s < N_; ++s) {
         int a, b;
@@ -282,7 +299,12 @@ double SineEulerMpi::sum_over_field(const double *state, Term &&term) const {
 // H in the layout of the reference direction, where the share of the
 // Hamiltonian is held: a copy of the state is moved there.
 double SineEulerMpi::energy(const double *state) const {
-    std::vector<double> reference(state, state + state_size());
+    // The copy and the exchange's buffers, agreed on before the exchange.
+    std::vector<double> reference;
+    comm_->agree([&] {
+        reference.assign(state, state + state_size());
+        exchange_.reserve();
+    });
     const std::size_t held = static_cast<std::size_t>(state[0]);
     exchange_.move(dirs_[held], held, dirs_[0], 0, reference.data());
     return sum_over_field(reference.data(), [&](std::size_t e, const double *z) { return share_.term(e, z); });
