@@ -138,11 +138,18 @@ LPI_API int lpi_set_observer(lpi_system *sys, int64_t every, lpi_observer_fn fn,
         require(sys, "system");
         if (!fn) return sys->system.set_observer(0, nullptr);
         // While fn runs the handle is Observing: fn may read it, not change it.
-        sys->system.set_observer(every, [sys, fn, user](std::int64_t step, double t) {
-            lpi::capi::ActivityScope observing(sys, lpi::capi::Activity::Observing);
-            return lpi::call_user([&] { return fn(sys, step, t, user); },
-                                  [] { return std::string("the observer callback"); }) != 0;
+        // Made (it allocates) where a failure on one process of a spread
+        // system fails the call on all: a process without the observer would
+        // skip the agreements the others make at each observation.
+        lpi::System::Observer observer;
+        sys->system.model().agree_on_every_process([&] {
+            observer = [sys, fn, user](std::int64_t step, double t) {
+                lpi::capi::ActivityScope observing(sys, lpi::capi::Activity::Observing);
+                return lpi::call_user([&] { return fn(sys, step, t, user); },
+                                      [] { return std::string("the observer callback"); }) != 0;
+            };
         });
+        sys->system.set_observer(every, std::move(observer));
     });
 }
 

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include "../core/methods.hpp"
@@ -232,9 +233,11 @@ LPI_API int lpi_sine_euler_set_hamiltonian(lpi_system *sys, const double *lambda
         const std::size_t modes = squared(model.truncation());
         if (n_lambda == modes) model.require_same_on_every_process(lambda, sizeof(double) * modes, "lambda");
         if (f && n_f == 2 * modes) model.require_same_on_every_process(f, sizeof(double) * n_f, "f");
-        // Validated in full before the model is touched.
-        model.set_hamiltonian(
-            lpi::sine_euler::Hamiltonian(model.truncation(), lambda, n_lambda, f, n_f));
+        // Validated in full before the model is touched, and made (it
+        // allocates) with one outcome on every process.
+        std::optional<lpi::sine_euler::Hamiltonian> H;
+        model.agree_on_every_process([&] { H.emplace(model.truncation(), lambda, n_lambda, f, n_f); });
+        model.set_hamiltonian(std::move(*H));
     });
 }
 

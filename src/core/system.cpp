@@ -47,9 +47,18 @@ System::System(std::unique_ptr<Model> model)
 
 void System::rebuild_integrator() { integrator_ = make_integrator(method_, *model_, implicit_); }
 
+// The setters below make what they change (a method, an integrator) inside
+// agree_on_every_process and only then put it in place: an allocation that
+// fails on one process of a spread model fails the call on every process,
+// and no process is left with another method than the rest.
+
 void System::set_method(const std::string &name) {
-    Method method = find_method(name);
-    auto integrator = make_integrator(method, *model_, implicit_);
+    Method method;
+    std::unique_ptr<Integrator> integrator;
+    model_->agree_on_every_process([&] {
+        method = find_method(name);
+        integrator = make_integrator(method, *model_, implicit_);
+    });
     method_ = std::move(method);
     integrator_ = std::move(integrator);
 }
@@ -57,23 +66,32 @@ void System::set_method(const std::string &name) {
 void System::set_composition(const double *gammas, std::size_t n) {
     require_composition_count(n);
     model_->require_same_on_every_process(gammas, n * sizeof(double), "composition weights");
-    Method method = custom_composition(gammas, n);
-    auto integrator = make_integrator(method, *model_, implicit_);
+    Method method;
+    std::unique_ptr<Integrator> integrator;
+    model_->agree_on_every_process([&] {
+        method = custom_composition(gammas, n);
+        integrator = make_integrator(method, *model_, implicit_);
+    });
     method_ = std::move(method);
     integrator_ = std::move(integrator);
 }
 
 void System::set_split(const std::string &name) {
     const std::string previous = model_->split();
-    model_->set_split(name);  // throws, unchanged, if unknown
+    std::string current;
+    std::unique_ptr<Integrator> integrator;
     try {
-        std::string current = model_->split();
-        rebuild_integrator();
-        split_.swap(current);
+        model_->agree_on_every_process([&] {
+            model_->set_split(name);  // throws, unchanged, if unknown
+            current = model_->split();
+            integrator = make_integrator(method_, *model_, implicit_);
+        });
     } catch (...) {
         model_->set_split(previous);
         throw;
     }
+    integrator_ = std::move(integrator);
+    split_.swap(current);
 }
 
 void System::set_implicit_settings(const ImplicitSettings &settings) {
@@ -82,7 +100,8 @@ void System::set_implicit_settings(const ImplicitSettings &settings) {
     if (settings.max_iterations < 1)
         fail(LPI_ERR_INVALID, "max_iterations must be >= 1, got " +
                                   std::to_string(settings.max_iterations));
-    auto integrator = make_integrator(method_, *model_, settings);
+    std::unique_ptr<Integrator> integrator;
+    model_->agree_on_every_process([&] { integrator = make_integrator(method_, *model_, settings); });
     implicit_ = settings;
     integrator_ = std::move(integrator);
 }

@@ -57,22 +57,28 @@ void HamiltonianShare::read_pieces(const std::function<void(Direction &&)> &keep
         });
 }
 
-void HamiltonianShare::assign(const Hamiltonian &H) {
+HamiltonianShare::Share HamiltonianShare::share_of(const Hamiltonian &H) const {
     const double *lambda = H.weights(), *f = H.forcing();
-    std::vector<double> forcing(f ? lambda_.size() * 2 : 0);
-    std::vector<double> weights(lambda_.size());
-    auto keep = [&](std::size_t e, int a, int b) {
+    Share share;
+    share.f.resize(f ? lambda_.size() * 2 : 0);
+    share.lambda.resize(lambda_.size());
+    auto copy = [&](std::size_t e, int a, int b) {
         const std::size_t m = mode_index(a, b, N_);
-        weights[e] = lambda[m];
-        if (f) forcing[2 * e] = f[2 * m], forcing[2 * e + 1] = f[2 * m + 1];
+        share.lambda[e] = lambda[m];
+        if (f) share.f[2 * e] = f[2 * m], share.f[2 * e + 1] = f[2 * m + 1];
     };
     for (int s = 0; s < N_; ++s) {
-        keep(static_cast<std::size_t>(s), 0, s);
-        for (int d = first_; d < first_ + mine_; ++d) keep(entry(d, s), d, s);
+        copy(static_cast<std::size_t>(s), 0, s);
+        for (int d = first_; d < first_ + mine_; ++d) copy(entry(d, s), d, s);
     }
-    lambda_.swap(weights);
-    f_.swap(forcing);
-    euler_ = H.is_default();
+    share.euler = H.is_default();
+    return share;
+}
+
+void HamiltonianShare::keep(Share &share) noexcept {
+    lambda_.swap(share.lambda);
+    f_.swap(share.f);
+    euler_ = share.euler;
 }
 
 Hamiltonian HamiltonianShare::whole(const Communicator &comm) const {

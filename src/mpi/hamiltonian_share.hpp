@@ -45,8 +45,15 @@ public:
     // ownership table, to keep(), in order. Holds O(N^2 / P + N) meanwhile.
     void read_pieces(const std::function<void(sine_euler::Direction &&)> &keep);
 
-    // Keeps this process's share of H (given whole on every process).
-    void assign(const sine_euler::Hamiltonian &H);
+    // This process's share of H (given whole on every process): made by
+    // share_of, which allocates, and put in place by keep, which cannot fail
+    // (so that a spread model agrees on the first before the second).
+    struct Share {
+        std::vector<double> lambda, f;
+        bool euler = true;
+    };
+    Share share_of(const sine_euler::Hamiltonian &H) const;
+    void keep(Share &share) noexcept;
     bool is_default() const { return euler_; }
     // The whole Hamiltonian on every process (collective; O(N^2) on request).
     sine_euler::Hamiltonian whole(const Communicator &comm) const;

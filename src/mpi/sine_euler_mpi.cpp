@@ -81,9 +81,14 @@ public:
         if (H.truncation() != N_)
             fail(LPI_ERR_INTERNAL, "a Hamiltonian of N = " + std::to_string(H.truncation()) +
                                        " given to a system of N = " + std::to_string(N_));
-        const std::vector<double> p = H.parameters();
+        std::vector<double> p;
+        comm_->agree([&] { p = H.parameters(); });
         require_same_input(p.data(), p.size(), "Hamiltonian (lambda and f)");
-        share_.assign(H);
+        // Made, and agreed on, before it is put in place: no process keeps
+        // another Hamiltonian than the rest when one fails to allocate.
+        HamiltonianShare::Share share;
+        comm_->agree([&] { share = share_.share_of(H); });
+        share_.keep(share);
         origin_piece_ = kNoPiece;
     }
 
@@ -178,8 +183,11 @@ public:
     // rounding of each process's own lines (the phases come from the
     // heuristic's plan on every process).
     void set_planning(FftPlanning planning) override {
-        auto planned = std::make_unique<LineTransforms>(N_, mine_, planning);
-        planned->reserve_threads(static_cast<std::size_t>(threads_));
+        std::unique_ptr<LineTransforms> planned;
+        comm_->agree([&] {  // the new plans in place on every process, or on none
+            planned = std::make_unique<LineTransforms>(N_, mine_, planning);
+            planned->reserve_threads(static_cast<std::size_t>(threads_));
+        });
         transforms_ = std::move(planned);
         planning_ = planning;
     }
