@@ -633,8 +633,26 @@ static void test_product_piece_depends_on_mu_t(void **state) {
     assert_true(d < 1e-13);
 }
 
+/* H'(x1 x3) t beyond the doubles (1e300 * 1e10) with x2 = 0: refused as
+ * such, the state unchanged, where lambda = 4 x2 mu t had been inf * 0 and
+ * the far form had turned a NaN exponent into an integer (undefined). */
+static void test_product_piece_mu_t_overflows(void **state) {
+    (void)state;
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_moments_create(&sys), LPI_OK);
+    assert_int_equal(lpi_moments_add_product_piece(sys, linear_h, linear_dh, NULL), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
+    linear_mu = 1e300;
+    const double x[8] = {1.0, 0.0, -1.0, 3.0, 0.3, 2.02, 0.6, 12.0};
+    assert_int_equal(lpi_set_state(sys, x, 8), LPI_OK);
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 1e10, 1), LPI_ERR_NONFINITE, "lpi_step");
+    assert_non_null(strstr(lpi_last_error(sys), "H'(x1 x3) t = 1.0000000000000001e+300 * 10000000000 overflows"));
+    lpi_destroy(sys);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_product_piece_mu_t_overflows),
         cmocka_unit_test(test_product_piece_product_overflows),
         cmocka_unit_test(test_product_piece_depends_on_mu_t),
         cmocka_unit_test(test_casimirs_without_bias),

@@ -376,6 +376,7 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
 // past e^-708, is the double nearest its product. Beyond |a| = 1500 no
 // nonzero double z gives a finite nonzero product: an overflow, or 0.
 double scaled_beyond_range(double z, double a) {
+    if (a != a) return z + a;  // NaN, as z e^NaN (no integer exponent of it)
     if (z == 0.0) return z;
     if (a > 1500.0) return z * std::numeric_limits<double>::infinity();
     if (a < -1500.0) return z * 0.0;

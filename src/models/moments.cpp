@@ -201,6 +201,11 @@ private:
     void advance(double t_in, double *x) const {
         const double b = x[0], a = x[2];
         const double mu = derivative(product(x)) * t_in, t = 1.0;
+        // An infinite mu t would make lambda = 4 x2 mu t a NaN where x2 = 0
+        // (inf times 0), and the far form would work on NaNs.
+        if (!std::isfinite(mu))
+            fail(LPI_ERR_NONFINITE, label() + ": H'(x1 x3) t = " + number_text(derivative(product(x))) +
+                                        " * " + number_text(t_in) + " overflows");
         const double lambda = 4.0 * x[1] * mu;
         const double delta = 4.0 * mu * mu * (x[1] * x[1] - a * b);
         if (std::fabs(lambda * t) > kFarFromIdentity ||
