@@ -302,7 +302,11 @@ static size_t bytes_held(int N, MPI_Comm comm, const double *x, const double *la
 /* While stepping a process holds O(N^2 / P) bytes: no table of the whole
  * field (lambda, f, the pieces' ownership) is replicated. The same program
  * spread over P processes holds at most 1/P of what one process holds, plus
- * O(N) (the lines through the origin, the transforms' buffers). */
+ * O(N) bytes: per process, the transforms' block of 16 lines, the phase
+ * tables, line 0 with its weights and the exchange's buffers for line 0 and
+ * its riders (about 820 N at N = 255 and P = 4; 1024 N allowed). Measured
+ * in bytes, not as a fraction of what one process holds, which shrank when
+ * the exchange's buffers were sized once instead of grown by doubling. */
 static void test_memory_per_process(void **state) {
     (void)state;
     const int N = 255; /* 3 x 5 x 17 */
@@ -316,10 +320,11 @@ static void test_memory_per_process(void **state) {
     const size_t spread = bytes_held(N, MPI_COMM_WORLD, x, lambda, f);
     free(x), free(lambda), free(f);
     if (alone < 16 * n / 2) LPI_SKIP("the allocator does not report its bytes in use (not glibc's malloc)");
-    const double share = (double)spread / (double)alone, allowed = 1.0 / size_ + 0.06;
-    printf("rank %d: N = %d, one process holds %zu bytes, one of %d holds %zu (%.3f of it; at most %.3f)\n",
-           rank_, N, alone, size_, spread, share, allowed);
-    assert_true(share <= allowed);
+    const size_t allowed = alone / (size_t)size_ + 1024 * (size_t)N;
+    printf("rank %d: N = %d, one process holds %zu bytes, one of %d holds %zu (%.3f of it; at most %zu, "
+           "1/%d of it plus %zu N)\n", rank_, N, alone, size_, spread, (double)spread / (double)alone,
+           allowed, size_, (size_t)1024);
+    assert_true(spread <= allowed);
 }
 
 /* An N whose share would pass a process's physical memory is refused on
