@@ -95,26 +95,17 @@ check-tsan: deps
 	@cmake --build build-tsan -j $(JOBS) $(BUILD_ARGS) --target test_threads
 	@cd build-tsan && TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -R '^test_threads$$'
 
-# The cmocka tests of $(BUILD) under valgrind. VALGRIND_SKIP leaves out the
+# The cmocka tests of $(BUILD) under valgrind, $(JOBS) at a time
+# (tests/check_valgrind.sh). VALGRIND_SKIP leaves out the
 # two slowest (minutes each under valgrind) and test_expm, whose long double
 # references need x87 80-bit arithmetic that valgrind performs in 64 bits
 # (its assertions then fail), and the MPI tests (test_sine_euler_mpi and
 # test_sine_euler_mpi_observer), which run under mpirun (valgrind reports
 # Open MPI's own allocations and its shared-memory transport).
 # `make check-valgrind VALGRIND_SKIP=` runs all.
-# A test that exits 77 had nothing to run in this build (see tests/lpi_test.h).
 VALGRIND_SKIP ?= test_compositions test_sine_euler test_expm test_sine_euler_mpi test_sine_euler_mpi_observer
 check-valgrind: build
-	@set -e; for t in $(BUILD)/tests/test_* $(BUILD)/tests/example_user_system; do \
-	    name=$$(basename $$t); \
-	    [ -x "$$t" ] && [ -f "$$t" ] || continue; \
-	    case " $(VALGRIND_SKIP) " in *" $$name "*) echo "valgrind: $$name skipped"; continue;; esac; \
-	    echo "valgrind: $$name"; \
-	    args=""; [ "$$name" = test_bad_input ] && args="$(CURDIR)/include/liepoisson.h"; \
-	    status=0; (cd $(BUILD)/tests && CMOCKA_MESSAGE_OUTPUT=stdout valgrind -q --leak-check=full \
-	        --errors-for-leak-kinds=definite,indirect --error-exitcode=1 ./$$name $$args >/dev/null) || status=$$?; \
-	    case $$status in 0) ;; 77) echo "valgrind: $$name skipped itself (nothing to run in this build)";; *) exit $$status;; esac; \
-	done; echo "valgrind: no errors, no leaks"
+	@tests/check_valgrind.sh $(BUILD) $(JOBS) $(CURDIR)/include/liepoisson.h $(VALGRIND_SKIP)
 
 # Not in BUILD: a build of its own, configured with cmocka hidden.
 check-build-alone: deps
