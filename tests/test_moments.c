@@ -633,6 +633,42 @@ static void test_product_piece_depends_on_mu_t(void **state) {
     assert_true(d < 1e-13);
 }
 
+/* The flow reads x1, x2, x3 and mu t only through lambda = 4 x2 mu t and
+ * M = 2 mu t (x1, x3): (x1, x2, x3) / k with mu k is the same flow, x1 and x3
+ * divided by k. Formed from mu^2 and x2^2 - x1 x3 apart, delta was inf * 0
+ * at k = 1e200 (taken as 0: the fourth moments 8.5 times off, LPI_OK) and
+ * -inf at k = 1e160 (refused as an overflow); 4 x2 overflowed alone at x2 =
+ * 1e308, mu = 1e-308 (refused). */
+static void test_product_piece_scales_with_x(void **state) {
+    (void)state;
+    const double bases[2][8] = {{1.0, 0.3, 2.0, 3.0, 0.3, 2.02, 0.6, 12.0},
+                                {1.0, 1.6, 2.0, 3.0, 0.3, 2.02, 0.6, 12.0}}; /* elliptic, hyperbolic */
+    const double ks[] = {1e100, 1e160, 1e200, 1e250};
+    for (int b = 0; b < 2; ++b) {
+        double reference[8];
+        product_step(bases[b], 1.0, 0.5, reference);
+        for (int q = 0; q < 4; ++q) {
+            double x[8], y[8];
+            memcpy(x, bases[b], sizeof x);
+            for (int e = 0; e < 3; ++e) x[e] /= ks[q];
+            product_step(x, ks[q], 0.5, y);
+            for (int e = 0; e < 3; ++e) y[e] *= ks[q];
+            const double d = largest_relative_difference(y, reference);
+            printf("x1, x2, x3 / %g, mu %g: %.1e from k = 1\n", ks[q], ks[q], d);
+            assert_true(d < 1e-14);
+        }
+    }
+    const double wide[8] = {1.0, 1e308, 1.0, 3.0, 0.3, 2.02, 0.6, 12.0};
+    const double narrow[8] = {1e-300, 1e8, 1e-300, 3.0, 0.3, 2.02, 0.6, 12.0}; /* wide / 1e300 */
+    double y[8], z[8];
+    product_step(wide, 1e-308, 0.5, y);
+    product_step(narrow, 1e-8, 0.5, z);
+    for (int e = 0; e < 3; ++e) z[e] *= 1e300;
+    const double d = largest_relative_difference(y, z);
+    printf("x2 = 1e308, mu = 1e-308 against x / 1e300, mu 1e300: %.1e\n", d);
+    assert_true(d < 1e-13);
+}
+
 /* H'(x1 x3) t beyond the doubles (1e300 * 1e10) with x2 = 0: refused as
  * such, the state unchanged, where lambda = 4 x2 mu t had been inf * 0 and
  * the far form had turned a NaN exponent into an integer (undefined). */
@@ -653,6 +689,7 @@ static void test_product_piece_mu_t_overflows(void **state) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_product_piece_mu_t_overflows),
+        cmocka_unit_test(test_product_piece_scales_with_x),
         cmocka_unit_test(test_product_piece_product_overflows),
         cmocka_unit_test(test_product_piece_depends_on_mu_t),
         cmocka_unit_test(test_casimirs_without_bias),

@@ -206,15 +206,21 @@ private:
         if (!std::isfinite(mu))
             fail(LPI_ERR_NONFINITE, label() + ": H'(x1 x3) t = " + number_text(derivative(product(x))) +
                                         " * " + number_text(t_in) + " overflows");
-        const double lambda = 4.0 * x[1] * mu;
-        const double delta = 4.0 * mu * mu * (x[1] * x[1] - a * b);
+        // Everything from M's entries, each a rate of the flow: mu^2 and
+        // x2^2 - ab apart under- or overflowed where the flow is ordinary
+        // (x1, x2, x3 ~ 1e-200 with mu t ~ 1e200: delta inf * 0, taken as 0,
+        // and the fourth moments came out 8x off with LPI_OK).
+        const double lambda = 4.0 * (x[1] * mu);
+        const double L = 0.5 * lambda, m01 = 2.0 * (mu * b), m10 = -2.0 * (mu * a);
+        const double delta = L * L + m01 * m10;
         if (std::fabs(lambda * t) > kFarFromIdentity ||
             (delta > 0.0 && std::sqrt(delta) * t > kFarFromIdentity)) {
-            flow_far_from_identity(a, b, mu, lambda, delta, t, x);
+            flow_far_from_identity(lambda, m01, m10, delta, t, x);
             return;
         }
 
-        // exp(tM) = c I + s M with M^2 = delta I, delta = -det M = 4 mu^2 (x2^2 - ab).
+        // exp(tM) = c I + s M with M^2 = delta I, delta = -det M = 4 mu^2 (x2^2 - ab)
+        // = L^2 + m01 m10.
         // Near the identity everything is formed as a difference from it (c
         // - 1 from half-angle formulas, expm1 for the scalings) so that the
         // map is applied as x + increment with errors relative to the
@@ -237,8 +243,8 @@ private:
         // D = F - I, F = diag(e^{lambda t/2}, e^{-lambda t/2}) (c I + s M).
         const double D[2][2] = {
             {grow_minus_1 + (1.0 + grow_minus_1) * (c_minus_1 - 0.5 * s * lambda),
-             (1.0 + grow_minus_1) * s * 2.0 * mu * b},
-            {(1.0 + shrink_minus_1) * s * (-2.0 * mu * a),
+             (1.0 + grow_minus_1) * s * m01},
+            {(1.0 + shrink_minus_1) * s * m10,
              shrink_minus_1 + (1.0 + shrink_minus_1) * (c_minus_1 + 0.5 * s * lambda)}};
         apply_fourth_power(D, x + 3);
         x[0] = b + b * (grow_minus_1 * (2.0 + grow_minus_1));     // e^{lambda t} - 1
@@ -259,15 +265,15 @@ private:
     // through its spectral projectors P+- = (I +- M / r) / 2 where its
     // eigenvalues +-r are real and far apart (their diagonals without
     // cancellation: (r - |L|) / 2r = (r^2 - L^2) / (2r (r + |L|)), r^2 - L^2 =
-    // -4 mu^2 x1 x3).
-    static void flow_far_from_identity(double a, double b, double mu, double lambda, double delta,
-                                       double t, double *x) {
-        const double L = 0.5 * lambda, m01 = 2.0 * mu * b, m10 = -2.0 * mu * a;
+    // m01 m10 = -4 mu^2 x1 x3).
+    static void flow_far_from_identity(double lambda, double m01, double m10, double delta, double t,
+                                       double *x) {
+        const double L = 0.5 * lambda, a = x[2], b = x[0];
         const double r = std::sqrt(std::fabs(delta));
         double E[2][2];
         if (delta > 0.0 && r * t > kFarFromIdentity) {
             const double q = std::fabs(L);
-            const double high = (r + q) / (2.0 * r), low = -4.0 * mu * mu * a * b / (2.0 * r * (r + q));
+            const double high = (r + q) / (2.0 * r), low = m01 * m10 / (2.0 * r * (r + q));
             const double p00 = L >= 0.0 ? low : high, p11 = L >= 0.0 ? high : low;
             const double grow = std::exp(r * t), shrink = std::exp(-r * t), odd = std::sinh(r * t) / r;
             E[0][0] = grow * p00 + shrink * p11;
