@@ -247,17 +247,17 @@ struct Piece {
         bool far = false;
         unroll<0, P.groups>([&](auto q) {
             constexpr Group G = P.group[q];
-            far |= may_contract_by_half(G.largest * (t * (G.base * g[G.parameter])));
+            far |= may_contract_by_half(G.largest * (G.base * s[G.parameter]));
         });
         unroll<0, P.scalings>([&](auto d) {
             constexpr Scaling S = P.scaling[d];
             if constexpr (S.group < 0) far |= may_contract_by_half(S.coefficient * s[S.parameter]);
         });
-        return far ? flow_in<true>(g, t, s, x) : flow_in<false>(g, t, s, x);
+        return far ? flow_in<true>(s, x) : flow_in<false>(s, x);
     }
 
     template <bool Far>
-    static long flow_in(const double *g, double t, const double *s, double *x) {
+    static long flow_in(const double *s, double *x) {
         constexpr int depth = P.depth;
         // For exp(tD): E_k = exp(k s) - 1 of each group by powers of
         // expm1(+-s) (expm1_powers, shared with SparseExponential); first,
@@ -265,7 +265,7 @@ struct Piece {
         double growths[P.groups > 0 ? P.groups : 1][2 * kMaxMultiple + 1];
         unroll<0, P.groups>([&](auto q) {
             constexpr Group G = P.group[q];
-            expm1_powers(t * (G.base * g[G.parameter]), G.largest, growths[q] + kMaxMultiple);
+            expm1_powers(G.base * s[G.parameter], G.largest, growths[q] + kMaxMultiple);
         });
         // c[v][k] = ((tN)^k x / k!)_v, written for k <= level(v) and read
         // only there (the general sweep's lanes above are exact zeros).
@@ -317,7 +317,7 @@ struct Piece {
                 growth = std::expm1(exponent);
             } else {
                 constexpr Group G = P.group[S.group];
-                exponent = S.multiple * (t * (G.base * g[G.parameter]));
+                exponent = S.multiple * (G.base * s[G.parameter]);
                 growth = growths[S.group][kMaxMultiple + S.multiple];
             }
             if constexpr (Far)

@@ -293,7 +293,7 @@ private:
     template <std::size_t Lanes>
     bool sweep(double *x);
     bool sweep(double *x);                // in lanes_ lanes
-    void apply_scalings(const double *g, double t, double *x);  // DiagonalSeries: exp(tD) after N
+    void apply_scalings(double *x);  // DiagonalSeries: exp(tD) after N, from times_
     bool shear(double *x);  // depth 1, x untouched on failure
     void apply_plane(double t, double *x);  // a block of order 1 or 2
     void apply_shears(const double A[4], double x0, double x1, double *x);  // the plane's elliptic flows
