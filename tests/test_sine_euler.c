@@ -679,6 +679,14 @@ static void test_wisdom(void **state) {
     LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_file(path), LPI_ERR_IO, "lpi_fftw_wisdom_import_file");
     assert_non_null(strstr(lpi_last_error(NULL), "not a regular file"));
     assert_int_equal(unlink(path), 0);
+    /* A regular file that reports 0 bytes and reads on for gigabytes is
+     * refused after the 64 MiB that wisdom can take, not read to its end. */
+    struct stat proc;
+    if (stat("/proc/self/pagemap", &proc) == 0 && S_ISREG(proc.st_mode)) {
+        LPI_ASSERT_FAILS(NULL, lpi_fftw_wisdom_import_file("/proc/self/pagemap"), LPI_ERR_INVALID,
+                         "lpi_fftw_wisdom_import_file");
+        assert_non_null(strstr(lpi_last_error(NULL), "more than"));
+    }
     /* Export is atomic: a write that fails (EFBIG past a file-size limit)
      * keeps the wisdom file that was there. */
     assert_int_equal(lpi_fftw_wisdom_export_file(path), LPI_OK);

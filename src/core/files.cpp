@@ -196,13 +196,13 @@ std::size_t RegularFileReader::read(unsigned char *data, std::size_t n) {
     return done;
 }
 
-std::string RegularFileReader::read_rest() {
+std::string RegularFileReader::read_rest(std::size_t limit) {
     std::string text;
     unsigned char chunk[65536];
     for (;;) {
         const std::size_t got = read(chunk, sizeof chunk);
         text.append(reinterpret_cast<const char *>(chunk), got);
-        if (got < sizeof chunk) return text;
+        if (got < sizeof chunk || text.size() > limit) return text;
     }
 }
 

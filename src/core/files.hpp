@@ -73,8 +73,10 @@ public:
     std::size_t size() const { return size_; }
     // Reads up to n bytes; fewer only at the end of the file.
     std::size_t read(unsigned char *data, std::size_t n);
-    // The whole rest of the file.
-    std::string read_rest();
+    // The rest of the file, read in whole chunks until it ends or more than
+    // limit bytes are read (then the file is longer than limit: size() can
+    // understate it, a file of /proc reports 0 and may never end).
+    std::string read_rest(std::size_t limit = static_cast<std::size_t>(-1) - 1);
 
 private:
     std::string path_;

@@ -210,7 +210,12 @@ void fftw_wisdom_import_file(const char *path) {
     if (file.size() > kMaxWisdomBytes)
         fail(LPI_ERR_INVALID, quoted(path) + " is not FFTW wisdom: " +
                                   std::to_string(file.size()) + " bytes, more than wisdom takes");
-    const std::string text = file.read_rest();
+    // Bounded by what is read, not by the size the file reports: a file of
+    // /proc reports 0 bytes and may not end (/proc/self/pagemap).
+    const std::string text = file.read_rest(kMaxWisdomBytes);
+    if (text.size() > kMaxWisdomBytes)
+        fail(LPI_ERR_INVALID, quoted(path) + " is not FFTW wisdom: more than " +
+                                  std::to_string(kMaxWisdomBytes) + " bytes, more than wisdom takes");
     std::lock_guard<std::mutex> lock(fftw_planner_mutex());
     if (text.find('\0') != std::string::npos || !fftw_import_wisdom_from_string(text.c_str()))
         fail(LPI_ERR_INVALID, quoted(path) + " is not FFTW wisdom");
