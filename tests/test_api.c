@@ -354,6 +354,37 @@ static void test_wrong_kind_is_unsupported(void **state) {
     }
 }
 
+/* A value whose sum of terms passes DBL_MAX but whose half does not is no
+ * overflow: the energies and the enstrophy are halved term by term. */
+static void test_energy_near_the_largest_double(void **state) {
+    (void)state;
+    lpi_system *sys = NULL;
+    double e = 0.0, c = 0.0;
+    assert_int_equal(lpi_rigid_body_create(&sys, 1.0, 1.0, 1.0), LPI_OK);
+    const double m[3] = {1e154, 1e154, 0.0};
+    assert_int_equal(lpi_set_state(sys, m, 3), LPI_OK);
+    assert_int_equal(lpi_energy(sys, &e), LPI_OK);
+    assert_true(e == 0.5 * m[0] * m[0] + 0.5 * m[1] * m[1]);
+    LPI_ASSERT_FAILS(sys, lpi_casimirs(sys, &c, 1), LPI_ERR_OVERFLOW, "lpi_casimirs"); /* 2e308 */
+    lpi_destroy(sys);
+    if (lpi_sine_euler_create(&sys, 5) != LPI_OK) return; /* built without FFTW */
+    /* Public coordinates: Re w_(0,1) = Re w_(0,2) = 1e154 (and conjugates). */
+    double x[25] = {0}, shell_energy[3], shell_enstrophy[3];
+    size_t shells = 0;
+    x[1] = 1e154;
+    assert_int_equal(lpi_set_state(sys, x, 25), LPI_OK);
+    assert_int_equal(lpi_sine_euler_enstrophy(sys, &e), LPI_OK); /* 1e308 */
+    assert_true(e == 1e308);
+    assert_int_equal(lpi_sine_euler_spectrum(sys, shell_energy, shell_enstrophy, 3, &shells), LPI_OK);
+    assert_true(shell_enstrophy[0] == 1e308);
+    x[3] = 1e154;
+    assert_int_equal(lpi_set_state(sys, x, 25), LPI_OK);
+    assert_int_equal(lpi_energy(sys, &e), LPI_OK); /* (1 + 1/4) 1e308 */
+    assert_true(fabs(e - 1.25e308) <= 1e-15 * 1.25e308);
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_enstrophy(sys, &e), LPI_ERR_OVERFLOW, "lpi_sine_euler_enstrophy");
+    lpi_destroy(sys);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_version_and_status_names),
@@ -365,6 +396,7 @@ int main(void) {
         cmocka_unit_test(test_successful_calls),
         cmocka_unit_test(test_getters),
         cmocka_unit_test(test_wrong_kind_is_unsupported),
+        cmocka_unit_test(test_energy_near_the_largest_double),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -129,8 +129,9 @@ public:
     double energy(const double *state) const override { return hamiltonian_.energy(state); }
     double enstrophy(const double *state) const override {
         double sum = 0.0;
-        for (std::size_t i = 0; i < 2 * dim(); ++i) sum += state[i] * state[i];
-        return 0.5 * sum;
+        // Halved term by term, as the energy (Hamiltonian::energy).
+        for (std::size_t i = 0; i < 2 * dim(); ++i) sum += 0.5 * state[i] * state[i];
+        return sum;
     }
     std::size_t casimir_count() const override { return static_cast<std::size_t>(N_); }
     void casimirs(const double *state, double *out) const override {
