@@ -385,6 +385,23 @@ static void test_energy_near_the_largest_double(void **state) {
     lpi_destroy(sys);
 }
 
+/* A refused number is named in the message, with its value. */
+static void test_messages_give_the_value(void **state) {
+    (void)state;
+    lpi_system *sys = NULL;
+    double out[3];
+    assert_int_equal(lpi_rigid_body_create(&sys, 1.0, 2.0, 3.0), LPI_OK);
+    LPI_ASSERT_FAILS(sys, lpi_set_implicit_options(sys, -0.5, 10), LPI_ERR_INVALID, "lpi_set_implicit_options");
+    assert_non_null(strstr(lpi_last_error(sys), "tolerance must be finite and > 0, got -0.5"));
+    LPI_ASSERT_FAILS(sys, lpi_set_implicit_options(sys, INFINITY, 10), LPI_ERR_INVALID, "lpi_set_implicit_options");
+    assert_non_null(strstr(lpi_last_error(sys), "got inf"));
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, -INFINITY, 1), LPI_ERR_NONFINITE, "lpi_step");
+    assert_non_null(strstr(lpi_last_error(sys), "dt = -inf is not finite"));
+    LPI_ASSERT_FAILS(sys, lpi_rigid_body_exact(sys, INFINITY, out), LPI_ERR_NONFINITE, "lpi_rigid_body_exact");
+    assert_non_null(strstr(lpi_last_error(sys), "t = inf is not finite"));
+    lpi_destroy(sys);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_version_and_status_names),
@@ -397,6 +414,7 @@ int main(void) {
         cmocka_unit_test(test_getters),
         cmocka_unit_test(test_wrong_kind_is_unsupported),
         cmocka_unit_test(test_energy_near_the_largest_double),
+        cmocka_unit_test(test_messages_give_the_value),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

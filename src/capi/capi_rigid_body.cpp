@@ -4,6 +4,7 @@
 
 #include "../models/models.hpp"
 #include "../baselines/rigid_body_exact.hpp"
+#include "../core/text.hpp"
 #include "handle.hpp"
 
 using lpi::capi::guarded;
@@ -16,7 +17,7 @@ LPI_API int lpi_rigid_body_exact(const lpi_system *sys, double t, double *out) {
     return guarded_local_read(sys, "lpi_rigid_body_exact", [&] {
         require(sys, "system");
         require(out, "out");
-        if (!std::isfinite(t)) lpi::fail(LPI_ERR_NONFINITE, "t is not finite");
+        if (!std::isfinite(t)) lpi::fail(LPI_ERR_NONFINITE, "t = " + lpi::number_text(t) + " is not finite");
         double inertia[3], m0[3], m[3];
         if (!lpi::rigid_body_inertia(sys->system.model(), inertia))
             lpi::fail(LPI_ERR_UNSUPPORTED, std::string("the exact solution is defined for the "

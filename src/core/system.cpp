@@ -96,7 +96,7 @@ void System::set_split(const std::string &name) {
 
 void System::set_implicit_settings(const ImplicitSettings &settings) {
     if (!(settings.tolerance > 0.0) || !std::isfinite(settings.tolerance))
-        fail(LPI_ERR_INVALID, "tolerance must be finite and > 0");
+        fail(LPI_ERR_INVALID, "tolerance must be finite and > 0, got " + number_text(settings.tolerance));
     if (settings.max_iterations < 1)
         fail(LPI_ERR_INVALID, "max_iterations must be >= 1, got " +
                                   std::to_string(settings.max_iterations));
@@ -158,7 +158,7 @@ void System::set_observer(std::int64_t every, Observer observer) {
 }
 
 bool System::step(double dt, std::int64_t nsteps) {
-    if (!std::isfinite(dt)) fail(LPI_ERR_NONFINITE, "dt is not finite");
+    if (!std::isfinite(dt)) fail(LPI_ERR_NONFINITE, "dt = " + number_text(dt) + " is not finite");
     if (dt == 0.0) fail(LPI_ERR_INVALID, "dt must be nonzero");
     if (nsteps < 0) fail(LPI_ERR_INVALID, "nsteps must be >= 0, got " + std::to_string(nsteps));
     if (nsteps == 0) return true;
