@@ -382,6 +382,16 @@ static void test_energy_near_the_largest_double(void **state) {
     assert_int_equal(lpi_energy(sys, &e), LPI_OK); /* (1 + 1/4) 1e308 */
     assert_true(fabs(e - 1.25e308) <= 1e-15 * 1.25e308);
     LPI_ASSERT_FAILS(sys, lpi_sine_euler_enstrophy(sys, &e), LPI_ERR_OVERFLOW, "lpi_sine_euler_enstrophy");
+    /* w_(1,1) = 1e154 (1 + i), lambda = 1/2: |w|^2 = 2e308 overflows, but
+     * each mode's term lambda/2 |w|^2 is 5e307, and H = 1e308. */
+    memset(x, 0, sizeof x);
+    x[11] = x[12] = 1e154;
+    assert_int_equal(lpi_set_state(sys, x, 25), LPI_OK);
+    assert_int_equal(lpi_energy(sys, &e), LPI_OK);
+    assert_true(fabs(e - 1e308) <= 1e-15 * 1e308);
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_spectrum(sys, shell_energy, shell_enstrophy, 3, &shells),
+                     LPI_ERR_OVERFLOW, "lpi_sine_euler_spectrum"); /* the enstrophy shell, 2e308 */
+    assert_null(strstr(lpi_last_error(sys), "energy"));
     lpi_destroy(sys);
 }
 

@@ -73,7 +73,7 @@ public:
     // reference layout (line 0: e = s; line first + i: e = N + s * count + i):
     // 1/2 lambda |z|^2 + Re(conj(f) z).
     double term(std::size_t e, const double *z) const {
-        double h = 0.5 * lambda_[e] * (z[0] * z[0] + z[1] * z[1]);
+        double h = sine_euler::half_weighted_norm2(lambda_[e], z);
         if (!f_.empty()) h += f_[2 * e] * z[0] + f_[2 * e + 1] * z[1];
         return h;
     }

@@ -111,7 +111,7 @@ bool Hamiltonian::is_default() const {
 
 double Hamiltonian::mode_energy(std::size_t index, const double *modes) const {
     const double *z = modes + 2 * index;
-    double e = 0.5 * lambda_[index] * (z[0] * z[0] + z[1] * z[1]);
+    double e = half_weighted_norm2(lambda_[index], z);
     if (const double *f = forcing()) e += f[2 * index] * z[0] + f[2 * index + 1] * z[1];
     return e;
 }
@@ -123,7 +123,7 @@ double Hamiltonian::energy(const double *modes) const {
         const double *z = modes + 2 * i;
         // Halved term by term (the same bits as halving the sum): a sum
         // beyond DBL_MAX whose half is not is no overflow of the energy.
-        quadratic += 0.5 * lambda_[i] * (z[0] * z[0] + z[1] * z[1]);
+        quadratic += half_weighted_norm2(lambda_[i], z);
     }
     if (const double *f = forcing())
         for (std::size_t i = 2; i < 2 * n; ++i) linear += f[i] * modes[i];

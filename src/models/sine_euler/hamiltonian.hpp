@@ -9,11 +9,21 @@
 // (J_0 = I commutes with everything): its lambda_0 and f_0 are stored as 0.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
 namespace lpi {
 namespace sine_euler {
+
+// 1/2 lambda |z|^2 of a mode z (re, im), as (lambda / 2) (re^2 + im^2); where
+// |z|^2 overflows but the term need not (|z| > 1.3e154, lambda / 2 < 1),
+// multiplied by lambda / 2 before the squares are added.
+inline double half_weighted_norm2(double lambda, const double *z) {
+    const double norm2 = z[0] * z[0] + z[1] * z[1];
+    if (std::isfinite(norm2)) return 0.5 * lambda * norm2;
+    return 0.5 * lambda * z[0] * z[0] + 0.5 * lambda * z[1] * z[1];
+}
 
 class Hamiltonian {
 public:
