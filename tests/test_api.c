@@ -354,9 +354,10 @@ static void test_wrong_kind_is_unsupported(void **state) {
     }
 }
 
-/* A value whose sum of terms passes DBL_MAX but whose half does not is no
- * overflow: the energies and the enstrophy are halved term by term. */
-static void test_energy_near_the_largest_double(void **state) {
+/* A value whose sum of terms passes DBL_MAX but whose half (or mean) does
+ * not is no overflow: energies, enstrophies and traces are scaled before
+ * they are summed where the sum overflows. */
+static void test_values_near_the_largest_double(void **state) {
     (void)state;
     lpi_system *sys = NULL;
     double e = 0.0, c = 0.0;
@@ -392,6 +393,17 @@ static void test_energy_near_the_largest_double(void **state) {
     LPI_ASSERT_FAILS(sys, lpi_sine_euler_spectrum(sys, shell_energy, shell_enstrophy, 3, &shells),
                      LPI_ERR_OVERFLOW, "lpi_sine_euler_spectrum"); /* the enstrophy shell, 2e308 */
     assert_null(strstr(lpi_last_error(sys), "energy"));
+    /* W = w_0 I, w_0 = 1e308: the trace N w_0 overflows, (1/N) tr W = w_0
+     * does not; (1/N) tr W^2 = 1e616 does. */
+    double traces[2] = {0.0, 0.0};
+    memset(x, 0, sizeof x);
+    x[0] = 1e308;
+    assert_int_equal(lpi_set_state(sys, x, 25), LPI_OK);
+    assert_int_equal(lpi_sine_euler_casimir_traces(sys, 1, traces), LPI_OK);
+    assert_true(fabs(traces[0] - 1e308) <= 1e-15 * 1e308);
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_casimir_traces(sys, 2, traces), LPI_ERR_OVERFLOW,
+                     "lpi_sine_euler_casimir_traces");
+    assert_non_null(strstr(lpi_last_error(sys), "tr W^2"));
     lpi_destroy(sys);
 }
 
@@ -423,7 +435,7 @@ int main(void) {
         cmocka_unit_test(test_successful_calls),
         cmocka_unit_test(test_getters),
         cmocka_unit_test(test_wrong_kind_is_unsupported),
-        cmocka_unit_test(test_energy_near_the_largest_double),
+        cmocka_unit_test(test_values_near_the_largest_double),
         cmocka_unit_test(test_messages_give_the_value),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

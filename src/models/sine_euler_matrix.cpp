@@ -85,7 +85,13 @@ void sine_euler_traces(int N, const double *modes, int kmax, double *out) {
         }
         double trace = 0.0;
         for (int i = 0; i < N; ++i) trace += power[at(i, i, N)].real();
-        out[k - 1] = trace / N;
+        if (std::isfinite(trace)) {
+            out[k - 1] = trace / N;
+        } else {  // the sum overflows, the mean need not (W = w_0 I, w_0 = 1e308)
+            double mean = 0.0;
+            for (int i = 0; i < N; ++i) mean += power[at(i, i, N)].real() / N;
+            out[k - 1] = mean;
+        }
     }
 }
 
