@@ -357,12 +357,10 @@ void SineEulerMpi::move_block(const Direction &D, int block, double *x, double *
     transforms_->forward(count, x);
     apply_phase(N_, d0, count, transforms_->phase(), -D.sigma, x);
     transforms_->backward(count, x);
-    double kappa[kBlock];  // the one-process model's norm corrections, to the bit
-    norm_corrections(N_, count, slab + 2 * i0, row, x, kappa);
     for (int s = 0; s < N_; ++s) {
         double *z = slab + s * row + 2 * i0;
         const double *increment = x + 2 * static_cast<std::size_t>(s) * count;
-        for (int i = 0; i < 2 * count; ++i) z[i] = corrected_sum(z[i], increment[i], kappa[i / 2]);
+        for (int i = 0; i < 2 * count; ++i) z[i] = z[i] + increment[i];
     }
 }
 

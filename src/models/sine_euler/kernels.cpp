@@ -1,12 +1,7 @@
 // Gather, phase and scatter of a block of lines (see the header).
-// Vector types are passed between inlined functions only (see below).
-#if defined(__GNUC__)
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
 #include "kernels.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -115,12 +110,6 @@ inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
     });
 }
 
-// The sum of a mode and its increment; corrected_sum's with kappa.
-template <class V>
-inline V add(const V &z, const V &x, const double *kappa, const V &k) {
-    return kappa ? corrected_sum(z, x, k) : z + x;
-}
-
 // Adds n increments to positions p0 .. p0+n-1 (p0 + n <= N) of a lane and
 // writes the conjugates of the sums at positions -(p0 + r) mod N of the
 // mirror lane, in one pass (the sums are not stored twice). In a row the
@@ -128,13 +117,12 @@ inline V add(const V &z, const V &x, const double *kappa, const V &k) {
 // stored at once, reversed and conjugated (exact) for the mirror.
 template <bool Rows>
 inline void put_run(int N, int p0, int n, const double *__restrict increment, double *lane,
-                    double *mirror, const double *kappa) {
+                    double *mirror) {
     if (n <= 0) return;
     const std::size_t step = Rows ? 1 : N;
-    auto k1 = [&](int r) { return kappa ? Complex1{kappa[r], kappa[r]} : Complex1{}; };
     int r = 0;
     if (p0 == 0) {  // position 0 is its own mirror position
-        const Complex1 sum = add(load<Complex1>(lane), load<Complex1>(increment), kappa, k1(0));
+        const Complex1 sum = load<Complex1>(lane) + load<Complex1>(increment);
         store(lane, sum);
         store(mirror, sum * Complex1{1.0, -1.0});
         r = 1;
@@ -142,15 +130,14 @@ inline void put_run(int N, int p0, int n, const double *__restrict increment, do
     if (Rows) {
         for (; r + 2 <= n; r += 2) {
             double *z = lane + 2 * (p0 + r), *m = mirror + 2 * (N - p0 - r - 1);
-            const Complex2 k = kappa ? Complex2{kappa[r], kappa[r], kappa[r + 1], kappa[r + 1]} : Complex2{};
-            const Complex2 sum = add(load<Complex2>(z), load<Complex2>(increment + 2 * r), kappa, k);
+            const Complex2 sum = load<Complex2>(z) + load<Complex2>(increment + 2 * r);
             store(z, sum);
             store(m, reversed(sum) * Complex2{1.0, -1.0, 1.0, -1.0});
         }
     }
     for (; r < n; ++r) {
         double *z = lane + 2 * step * (p0 + r), *m = mirror + 2 * step * (N - p0 - r);
-        const Complex1 sum = add(load<Complex1>(z), load<Complex1>(increment + 2 * r), kappa, k1(r));
+        const Complex1 sum = load<Complex1>(z) + load<Complex1>(increment + 2 * r);
         store(z, sum);
         store(m, sum * Complex1{1.0, -1.0});
     }
@@ -158,18 +145,18 @@ inline void put_run(int N, int p0, int n, const double *__restrict increment, do
 
 template <bool Rows, int Count>
 inline void scatter_runs(int N, int slope, int d0, int count, int first_lane,
-                         const double *__restrict x, double *w, const double *kappa) {
+                         const double *__restrict x, double *w) {
     const std::size_t lane = Rows ? N : 1;
     const int n = Count > 0 ? Count : count;
     for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
         const double *src = x + 2 * static_cast<std::size_t>(s) * n;
         double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
         if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
-            put_run<Rows>(N, o, n, src, dst, mirror, kappa);
+            put_run<Rows>(N, o, n, src, dst, mirror);
         } else {
             const int first = std::min(n, N - o);
-            put_run<Rows>(N, o, first, src, dst, mirror, kappa);
-            put_run<Rows>(N, 0, n - first, src + 2 * first, dst, mirror, kappa ? kappa + first : nullptr);
+            put_run<Rows>(N, o, first, src, dst, mirror);
+            put_run<Rows>(N, 0, n - first, src + 2 * first, dst, mirror);
         }
     });
 }
@@ -211,12 +198,9 @@ inline void gather_general(const Direction &D, int N, int d0, int count, const d
     });
 }
 
-inline void scatter_general(const Direction &D, int N, int d0, int count, const double *x, double *w,
-                            const double *kappa) {
-    const std::size_t lines = static_cast<std::size_t>(count);
+inline void scatter_general(const Direction &D, int N, int d0, int count, const double *x, double *w) {
     for_each_block_mode(D, N, d0, count, [&](std::size_t e, std::size_t mode, std::size_t mirror) {
-        const double k = kappa ? kappa[e % lines] : 0.0;
-        const Complex1 sum = add(load<Complex1>(w + 2 * mode), load<Complex1>(x + 2 * e), kappa, Complex1{k, k});
+        const Complex1 sum = load<Complex1>(w + 2 * mode) + load<Complex1>(x + 2 * e);
         store(w + 2 * mode, sum);
         store(w + 2 * mirror, sum * Complex1{1.0, -1.0});
     });
@@ -224,9 +208,8 @@ inline void scatter_general(const Direction &D, int N, int d0, int count, const 
 
 }  // namespace
 
-// These move numbers, negate and add one increment per mode (with kappa,
-// corrected_sum's IEEE operations, no fused ones): every clone gives the same
-// bits.
+// These move numbers, negate and add one increment per mode: every clone
+// gives the same bits.
 LPI_SIMD_CLONES
 void gather_block(const Direction &D, int N, int d0, int count, int first_lane, const double *w,
                   double *x) {
@@ -245,43 +228,17 @@ void gather_block(const Direction &D, int N, int d0, int count, int first_lane, 
 
 LPI_SIMD_CLONES
 void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
-                   double *w, const double *kappa) {
+                   double *w) {
     switch (D.layout) {
         case Direction::Row:
-            if (count == kBlock) scatter_runs<true, kBlock>(N, D.k2, d0, count, first_lane, x, w, kappa);
-            else scatter_runs<true, 0>(N, D.k2, d0, count, first_lane, x, w, kappa);
+            if (count == kBlock) scatter_runs<true, kBlock>(N, D.k2, d0, count, first_lane, x, w);
+            else scatter_runs<true, 0>(N, D.k2, d0, count, first_lane, x, w);
             break;
         case Direction::Column:
-            if (count == kBlock) scatter_runs<false, kBlock>(N, D.k1, d0, count, first_lane, x, w, kappa);
-            else scatter_runs<false, 0>(N, D.k1, d0, count, first_lane, x, w, kappa);
+            if (count == kBlock) scatter_runs<false, kBlock>(N, D.k1, d0, count, first_lane, x, w);
+            else scatter_runs<false, 0>(N, D.k1, d0, count, first_lane, x, w);
             break;
-        case Direction::General: scatter_general(D, N, d0, count, x, w, kappa); break;
-    }
-}
-
-// Sums per line in the order of s, whatever the block: the same bits for
-// every block split, thread count and process count.
-void norm_corrections(int N, int count, const double *z, std::size_t z_stride, const double *x,
-                      double *kappa) {
-    // |z + x|^2 - |z|^2 = 2 Re<z, x> + |x|^2, each part summed on its own:
-    // rounding (2z + x) x, or 2 z x + x^2, drops the low bits of the small x
-    // (x^2) against the large z (z x), an error of one sign.
-    double cross[kBlock] = {}, square[kBlock] = {}, norm[kBlock] = {};
-    const std::size_t n = static_cast<std::size_t>(count);
-    for (std::size_t s = 0; s < static_cast<std::size_t>(N); ++s) {
-        const double *zs = z + s * z_stride, *xs = x + 2 * s * n;
-        for (std::size_t i = 0; i < n; ++i) {
-            const double zr = zs[2 * i], zi = zs[2 * i + 1], xr = xs[2 * i], xi = xs[2 * i + 1];
-            cross[i] += zr * xr + zi * xi;
-            square[i] += xr * xr + xi * xi;
-            const double sr = zr + xr, si = zi + xi;
-            norm[i] += sr * sr + si * si;
-        }
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-        const double change = 2.0 * cross[i] + square[i];
-        kappa[i] = norm[i] > 0.0 ? change / (2.0 * norm[i]) : 0.0;
-        if (!std::isfinite(kappa[i])) kappa[i] = 0.0;
+        case Direction::General: scatter_general(D, N, d0, count, x, w); break;
     }
 }
 

@@ -20,37 +20,9 @@ void gather_block(const Direction &D, int N, int d0, int count, int first_lane, 
                   double *x);
 // Adds the increments x (as gathered) to those lines of w, in place, and
 // writes the conjugates of the sums to the mirror lines -d (which no block
-// gathers), so every mode is written once. With kappa (one per line of the
-// block; norm_corrections), each sum is corrected_sum's.
+// gathers), so every mode is written once.
 void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
-                   double *w, const double *kappa = nullptr);
-// The norm corrections of a transformed-back block of lines, whose norms the
-// exact flow keeps. An FFTW round trip rescales what it transforms by some
-// 1 + tau of one sign for a plan (measured -3e-17 at N = 31, -1e-16 at 61,
-// +1.8e-16 at 127, depending on the spectrum too), so the increments D come
-// back as (1 + tau) D and every flow changes |z|^2 by tau |D|^2: a drift of
-// every Casimir linear in time (-3.4e-13 of C2 over 8000 leapfrog steps of
-// 0.5 at N = 31, every field negative). With z the lines as gathered
-// (element s of line i at z[s * z_stride + 2 i]) and x the increments
-// (x[s * count + i], complex), kappa[i] = Re<2z + x, x> / (2 |z + x|^2) for
-// line i: (1 - kappa)(z + x) has the norm of z to second order in kappa
-// (~1e-17). A line whose sums are zero or not finite gets 0.
-void norm_corrections(int N, int count, const double *z, std::size_t z_stride, const double *x,
-                      double *kappa);
-// (1 - kappa)(z + x), rounded once: kappa (z + x) is far below an ulp of
-// z + x, and subtracted from z + x or from x after their rounding it would be
-// lost to it; added to the exact rounding error of z + x (Knuth's TwoSum) it
-// tips the rounding in the right proportion, so that the norm is kept on
-// average and rounding of either sign is what remains. kappa = 0 gives
-// z + x to the bit. Every operation is elementwise: a vector of parts gives
-// the bits of the parts one by one.
-template <class V>
-inline V corrected_sum(const V &z, const V &x, const V &kappa) {
-    const V sum = z + x, x_part = sum - z;
-    const V error = (z - (sum - x_part)) + (x - x_part);
-    return sum + (error - kappa * sum);
-}
-
+                   double *w);
 // The phase tables of one flow: kPhaseArrays arrays of 2N doubles, array a
 // at tables + 2 N a, written by write_phase and read by apply_phase.
 constexpr int kPhaseArrays = 6;

@@ -20,18 +20,18 @@
 // -c are the conjugates of lines c, so M = (N-1)/2 lines are integrated.
 // Every flow is exactly unitary, and it is applied as an increment,
 //     z <- z + F^-1 ((exp(t Lambda) - 1) F z) / N,
-// added to the modes as they are scattered back. An FFTW forward/backward
-// pair rescales what it transforms by some 1 + tau (a property of each plan
-// and input: measured -3e-17 per round trip at N = 31, -1e-16 at 61,
-// +1.8e-16 at 127): applied to the whole line it rescaled every mode in every
-// flow, a drift of the Casimirs linear in time. On the increment D = (U - I) z
-// it changes |z|^2 by 2 tau Re<z + D, D> = tau |D|^2 only (U unitary:
-// 2 Re<z, D> = -|D|^2), and that is removed by restoring each line's norm in
-// the one rounding of the sum (norm_corrections, corrected_sum): what
-// remains is rounding of either sign, and the Casimirs wander like the
-// square root of the number of steps. The factors exp(i phi) - 1 come from
-// v_l = u_l - 1 = (-2 sin^2(phi_l/2), sin phi_l) without cancellation, so the
-// increment's own rounding scales with the angles, not with the field.
+// added to the modes as they are scattered back. Round-off then has no bias:
+// an FFTW forward/backward pair rescales what it transforms by some 1 + tau
+// (a property of each plan: measured -6e-17 per round trip at N = 31, -1e-16
+// at 61, +3.4e-16 at 127), and applied to the whole line it rescaled every
+// mode by 1 + tau in every flow, a drift of the Casimirs linear in time. On
+// the increment D = (U - I) z it changes |z|^2 by 2 tau Re<z + D, D> =
+// tau |D|^2 only (U unitary: 2 Re<z, D> = -|D|^2), second order in t Lambda;
+// what remains is the rounding of the final sum z + D, to nearest, of either
+// sign: the Casimirs wander like the square root of the number of steps. The
+// factors exp(i phi) - 1 come from v_l = u_l - 1 = (-2 sin^2(phi_l/2),
+// sin phi_l) without cancellation, so the increment's own rounding scales
+// with the angles, not with the field.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -147,7 +147,7 @@ public:
     TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) override;
 
     void set_planning(FftPlanning planning) override {
-        auto planned = std::make_unique<LineTransforms>(N_, blocks_.M, planning, true);
+        auto planned = std::make_unique<LineTransforms>(N_, blocks_.M, planning);
         planned->reserve_threads(static_cast<std::size_t>(threads_));
         transforms_ = std::move(planned);
         planning_ = planning;
@@ -171,7 +171,7 @@ private:
 };
 
 LineTransforms &SineEuler::transforms() {
-    if (!transforms_) transforms_ = std::make_unique<LineTransforms>(N_, blocks_.M, planning_, true);
+    if (!transforms_) transforms_ = std::make_unique<LineTransforms>(N_, blocks_.M, planning_);
     transforms_->reserve_threads(static_cast<std::size_t>(threads_));
     return *transforms_;
 }
@@ -186,21 +186,16 @@ bool SineEuler::line_spectrum(const Direction &D, const double *w) {
 
 // Lines d = d0 .. d0+count-1 of direction D: gather z_s = w_{d j + s k} into
 // x[s * count + (d - d0)], transform along s, multiply by the line's
-// (exp(t Lambda_l) - 1) / N, transform back, restore each line's norm, add
-// the increments to the modes and write the conjugates of the sums to the
-// lines -d.
+// (exp(t Lambda_l) - 1) / N, transform back, add the increments to the modes
+// and write the conjugates of the sums to the lines -d.
 void SineEuler::move_block(const Direction &D, int block, double *x, double *w) {
     const int d0 = blocks_.first_line(block), count = blocks_.lines(block);
     const int first_lane = blocks_.first_lane(block);
     gather_block(D, N_, d0, count, first_lane, w, x);
-    double *gathered = x + 2 * static_cast<std::size_t>(N_) * kBlock;  // the buffer's second half
-    std::memcpy(gathered, x, sizeof(double) * 2 * static_cast<std::size_t>(N_) * count);
     transforms_->forward(count, x);
     apply_phase(N_, d0, count, transforms_->phase(), -D.sigma, x);
     transforms_->backward(count, x);
-    double kappa[kBlock];
-    norm_corrections(N_, count, gathered, 2 * static_cast<std::size_t>(count), x, kappa);
-    scatter_block(D, N_, d0, count, first_lane, x, w, kappa);
+    scatter_block(D, N_, d0, count, first_lane, x, w);
 }
 
 void SineEuler::flow(std::size_t piece, double t, double *state) {

@@ -64,8 +64,8 @@ struct LineTransforms::Plans {
     fftw_plan backward[2] = {nullptr, nullptr};
 };
 
-LineTransforms::LineTransforms(int N, int lines, FftPlanning planning, bool keep_gathered)
-    : N_(N), lines_(lines), keep_gathered_(keep_gathered), plans_(new Plans) {
+LineTransforms::LineTransforms(int N, int lines, FftPlanning planning)
+    : N_(N), lines_(lines), plans_(new Plans) {
     try {
         spectrum_ = reinterpret_cast<double *>(fftw_alloc_complex(N));
         phase_ = static_cast<double *>(fftw_malloc(sizeof(double) * phase_table_doubles(N)));
@@ -121,7 +121,7 @@ void LineTransforms::reserve_threads(std::size_t threads) {
     // would leave the buffer owned by nothing.
     if (blocks_.capacity() < threads) blocks_.reserve(threads);
     while (blocks_.size() < threads) {
-        fftw_complex *x = fftw_alloc_complex((keep_gathered_ ? 2 : 1) * static_cast<std::size_t>(N_) * kBlock);
+        fftw_complex *x = fftw_alloc_complex(static_cast<std::size_t>(N_) * kBlock);
         if (!x) throw std::bad_alloc();
         blocks_.push_back(reinterpret_cast<double *>(x));
     }

@@ -23,16 +23,12 @@ public:
     // Plans at the given rigor and buffers for `lines` lines of length N (the
     // (N - 1) / 2 integrated lines of a direction, or one process's share of
     // them), with one block buffer.
-    // With keep_gathered, each block buffer has a second half of the same
-    // size, for the lines as gathered (the one-process model's
-    // norm_corrections; the MPI model reads them from its slab).
-    LineTransforms(int N, int lines, FftPlanning planning, bool keep_gathered = false);
+    LineTransforms(int N, int lines, FftPlanning planning);
     ~LineTransforms();
     LineTransforms(const LineTransforms &) = delete;
     LineTransforms &operator=(const LineTransforms &) = delete;
 
-    // One block buffer per thread: N * kBlock complex (twice that with
-    // keep_gathered).
+    // One block buffer per thread (N * kBlock complex each).
     void reserve_threads(std::size_t threads);
     // The line spectrum b: N complex (interleaved), transformed in place.
     double *spectrum() { return spectrum_; }
@@ -49,7 +45,6 @@ private:
     struct Plans;
     void release();
     int N_, lines_;
-    bool keep_gathered_;
     std::unique_ptr<Plans> plans_;
     double *spectrum_ = nullptr, *phase_ = nullptr;
     std::vector<double *> blocks_;
