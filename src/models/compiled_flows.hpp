@@ -20,6 +20,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <type_traits>
 #include <utility>
 
@@ -225,6 +226,17 @@ inline void unroll(F &&f) {
     unroll<First>(std::make_integer_sequence<int, Last - First>{}, f);
 }
 
+// v[0] + .. + v[Count - 1], in pairs (a tree of depth log2 Count, not a
+// chain of Count additions).
+template <int Count>
+inline double pairwise_sum(const double *v) {
+    if constexpr (Count <= 1)
+        return Count == 1 ? v[0] : 0.0;
+    else
+        return pairwise_sum<Count / 2>(v) + pairwise_sum<Count - Count / 2>(v + Count / 2);
+}
+inline bool within_range(double v) { return std::fabs(v) <= std::numeric_limits<double>::max(); }
+
 template <class Algebra, unsigned Mask>
 struct Piece {
     static constexpr Plan P = plan<Algebra>(Mask);
@@ -303,11 +315,16 @@ struct Piece {
         double y[Algebra::dim];  // exp(tN) x
         unroll<0, Algebra::dim>([&](auto v) { y[v] = x[v]; });
         unroll<0, P.nodes>([&](auto n) { y[P.order[n]] = c[P.order[n]][0] + increment[P.order[n]]; });
-        // 0 z is 0 for a finite z and NaN otherwise: one test for all, of
-        // the new values (x + a finite increment may overflow).
-        double probe = 0.0;
-        unroll<0, P.nodes>([&](auto n) { probe += 0.0 * y[P.order[n]]; });
-        if (probe != probe) return first_nonfinite(y);
+        // One test for all the new values (x + a finite increment may
+        // overflow): their sum, in pairs, is finite unless one of them is
+        // not or the sum itself overflows, which the test of each then tells
+        // apart.
+        double moved[P.nodes > 0 ? P.nodes : 1];
+        unroll<0, P.nodes>([&](auto n) { moved[n] = y[P.order[n]]; });
+        if (!within_range(pairwise_sum<P.nodes>(moved))) {
+            const long failed = first_nonfinite(y);
+            if (failed >= 0) return failed;
+        }
         double scaled[P.scalings > 0 ? P.scalings : 1];
         unroll<0, P.scalings>([&](auto d) {
             constexpr Scaling S = P.scaling[d];
@@ -324,11 +341,12 @@ struct Piece {
                 scaled[d] = scaled_by_exponential(y[S.index], growth, exponent);
             else
                 scaled[d] = y[S.index] + growth * y[S.index];
-            probe += 0.0 * scaled[d];
         });
-        if (probe != probe) {
-            for (int d = 0; d < P.scalings; ++d)
-                if (!std::isfinite(scaled[d])) return P.scaling[d].index;
+        if constexpr (P.scalings > 0) {
+            if (!within_range(pairwise_sum<P.scalings>(scaled))) {
+                for (int d = 0; d < P.scalings; ++d)
+                    if (!std::isfinite(scaled[d])) return P.scaling[d].index;
+            }
         }
         unroll<0, P.scalings>([&](auto d) { y[P.scaling[d].index] = scaled[d]; });
         unroll<0, P.nodes>([&](auto n) { x[P.order[n]] = y[P.order[n]]; });
