@@ -96,7 +96,10 @@ std::mutex &fftw_planner_mutex();
 // other half is its conjugate and the inert mode w_0 does not move.
 void sine_euler_matrix_vector_field(const sine_euler::Hamiltonian &H, const double *modes,
                                     double *rate);
-// (1/N) tr W^k, k = 1 .. kmax.
+// (1/N) tr W^k, k = 1 .. kmax. At the first k whose trace is not finite it
+// stops, that trace written and the later ones left as they were: its
+// callers refuse the whole call there, so the later powers (each N^3
+// operations) would be work for nothing.
 void sine_euler_traces(int N, const double *modes, int kmax, double *out);
 // Sorted eigenvalues of the Hermitian W (LAPACK zheevd); LPI_ERR_OVERFLOW
 // when W has overflowed, LPI_ERR_UNSUPPORTED naming LAPACK when built

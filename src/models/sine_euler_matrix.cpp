@@ -91,6 +91,7 @@ void sine_euler_traces(int N, const double *modes, int kmax, double *out) {
             double mean = 0.0;
             for (int i = 0; i < N; ++i) mean += power[at(i, i, N)].real() / N;
             out[k - 1] = mean;
+            if (!std::isfinite(mean)) return;
         }
     }
 }
