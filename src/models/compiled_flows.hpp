@@ -265,11 +265,16 @@ struct Piece {
             constexpr Scaling S = P.scaling[d];
             if constexpr (S.group < 0) far |= may_contract_by_half(S.coefficient * s[S.parameter]);
         });
-        return far ? flow_in<true>(s, x) : flow_in<false>(s, x);
+        if (far) return far_flow(s, x);
+        return flow_in<false>(s, x);
     }
 
+    // The far case out of line, so that the near one is inlined in flow
+    // (s then stays in registers).
+    [[gnu::noinline]] static long far_flow(const double *s, double *x) { return flow_in<true>(s, x); }
+
     template <bool Far>
-    static long flow_in(const double *s, double *x) {
+    [[gnu::always_inline]] static inline long flow_in(const double *s, double *x) {
         constexpr int depth = P.depth;
         // For exp(tD): E_k = exp(k s) - 1 of each group by powers of
         // expm1(+-s) (expm1_powers, shared with SparseExponential); first,
