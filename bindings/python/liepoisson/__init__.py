@@ -514,14 +514,51 @@ class Trajectory:
                                                  ", casimirs" if self.casimirs is not None else "")
 
 
-def _destroy(handle):
-    # A system's finalizer: it holds the handle only. The ctypes callbacks stay
-    # on the system (_keep), so that a cycle through them and the user's
-    # callables (a bound method of the system's owner) is collectable; the
-    # finalizer's weakref callback runs before gc clears any object of the
-    # cycle, and the library calls callbacks only inside a call made through
-    # the live system, so none is freed while the handle could call it.
-    return lib.lpi_destroy(handle)
+def _destroy(handle, lock):
+    # A system's finalizer: it holds the handle and the lock only. The ctypes
+    # callbacks stay on the system (_keep), so that a cycle through them and
+    # the user's callables (a bound method of the system's owner) is
+    # collectable; the finalizer's weakref callback runs before gc clears any
+    # object of the cycle, and the library calls callbacks only inside a call
+    # made through the live system, so none is freed while the handle could
+    # call it. The lock is held by another thread only at interpreter exit,
+    # with a daemon thread still inside a call: the handle is left to the
+    # process's end rather than freed under that call.
+    if not lock.acquire(blocking=False):
+        return _BUSY
+    try:
+        return lib.lpi_destroy(handle)
+    finally:
+        lock.release()
+
+
+_BUSY = STATUS.get("LPI_ERR_BUSY", -13)
+_OTHER_THREAD = ("the system is in use by another thread (a system is used by one thread at a "
+                 "time: share it under a lock of your own); nothing was changed")
+
+
+class _Claim:
+    """Holds a system for this thread through one call, or a sequence of calls
+    that belong together (a step with its observer, a query then a fill).
+
+    ctypes releases the GIL during a call, so two threads could otherwise be
+    inside the library on one handle at once, which it does not allow: the
+    second thread gets BusyError instead. The lock is re-entrant, so a call
+    from the system's own callback (same thread) still reaches the library,
+    which refuses it with its own message."""
+
+    __slots__ = ("_lock",)
+
+    def __init__(self, system):
+        self._lock = system._lock
+
+    def __enter__(self):
+        if not self._lock.acquire(blocking=False):
+            _raise(_BUSY, _OTHER_THREAD)
+
+    def __exit__(self, *exc):
+        self._lock.release()
+        return False
 
 
 class System:
@@ -552,7 +589,8 @@ class System:
         self._pending = []     # exception raised inside a callback during the current call
         self._threads = 1
         self._seconds_per_step = None  # measured by step(), for the SIGINT observer
-        self._finalizer = weakref.finalize(self, _destroy, handle)  # not _keep: see _destroy
+        self._lock = threading.RLock()  # held by the thread inside a call (_Claim)
+        self._finalizer = weakref.finalize(self, _destroy, handle, self._lock)  # not _keep: see _destroy
 
     # lifetime
     def close(self) -> None:
@@ -562,16 +600,20 @@ class System:
         ------
         BusyError
             When called from one of this system's own callbacks (a piece, a
-            Casimir or an observer): the system stays open and unchanged.
+            Casimir or an observer), or while another thread is inside a call
+            on it: the system stays open and unchanged.
         """
         if not self._finalizer.alive:
             return
-        self._finalizer.detach()
-        status = _destroy(self._handle)
-        if status != 0:  # BUSY: the handle and its callbacks stay as they were
-            self._finalizer = weakref.finalize(self, _destroy, self._handle)
-            _raise(status, _text(lib.lpi_last_error(self._handle)))
-        del self._keep[:]  # nothing can call them now
+        with _Claim(self):
+            if not self._finalizer.alive:
+                return
+            self._finalizer.detach()
+            status = _destroy(self._handle, self._lock)
+            if status != 0:  # BUSY: the handle and its callbacks stay as they were
+                self._finalizer = weakref.finalize(self, _destroy, self._handle, self._lock)
+                _raise(status, _text(lib.lpi_last_error(self._handle)))
+            del self._keep[:]  # nothing can call them now
 
     @property
     def closed(self) -> bool:
@@ -599,15 +641,23 @@ class System:
     def _call(self, name, *args):
         """Calls lpi_<name>(handle, *args), raises on a failed (negative)
         status and returns the status otherwise (LPI_OK, LPI_STOPPED)."""
-        del self._pending[:]
-        status = getattr(lib, name)(self._h(), *args)
-        if status < 0:
-            cause = self._pending[0] if self._pending else None
+        with _Claim(self):
             del self._pending[:]
-            if cause is not None and not isinstance(cause, Exception):
-                raise cause  # KeyboardInterrupt, SystemExit: not ours to wrap
-            _raise(status, _text(lib.lpi_last_error(self._handle)), cause)
-        return status
+            status = getattr(lib, name)(self._h(), *args)
+            if status < 0:
+                cause = self._pending[0] if self._pending else None
+                del self._pending[:]
+                if cause is not None and not isinstance(cause, Exception):
+                    raise cause  # KeyboardInterrupt, SystemExit: not ours to wrap
+                _raise(status, _text(lib.lpi_last_error(self._handle)), cause)
+            return status
+
+    def _query(self, function, *args):
+        """function(handle, *args) for a function that returns no status (a
+        name, the time, a size); the string a name points to belongs to the
+        handle, so it is read under the claim too."""
+        with _Claim(self):
+            return function(self._h(), *args)
 
     @property
     def last_error(self) -> str:
@@ -618,7 +668,7 @@ class System:
         str
             The message, ``""`` if no call failed.
         """
-        return _text(lib.lpi_last_error(self._h()))
+        return self._query(lambda h: _text(lib.lpi_last_error(h)))
 
     @property
     def kind(self) -> str:
@@ -630,7 +680,7 @@ class System:
             ``"rigid-body"``, ``"pendulum"``, ``"generic"``, ``"moments"`` or
             ``"sine-euler"``.
         """
-        return _text(lib.lpi_kind(self._h()))
+        return self._query(lambda h: _text(lib.lpi_kind(h)))
 
     # method and split
     @property
@@ -644,7 +694,7 @@ class System:
             an alias is reported by its name. A system from `load` reports
             the saved method.
         """
-        return _text(lib.lpi_get_method(self._h()))
+        return self._query(lambda h: _text(lib.lpi_get_method(h)))
 
     @method.setter
     def method(self, name: str) -> None:
@@ -675,7 +725,7 @@ class System:
         str
             The name set, or the system's default split.
         """
-        return _text(lib.lpi_get_split(self._h()))
+        return self._query(lambda h: _text(lib.lpi_get_split(h)))
 
     @split.setter
     def split(self, name: str) -> None:
@@ -760,7 +810,7 @@ class System:
         int
             The number of state entries.
         """
-        return lib.lpi_dim(self._h())
+        return self._query(lib.lpi_dim)
 
     def __len__(self):
         return self.dim
@@ -812,7 +862,7 @@ class System:
         float
             The time reached; `set_state` resets it to 0.
         """
-        return lib.lpi_time(self._h())
+        return self._query(lib.lpi_time)
 
     def step(self, dt: float, nsteps: int = 1, *, observer: Optional[Observer] = None,
              every: int = 1) -> int:
@@ -872,12 +922,13 @@ class System:
             if not callable(observer):
                 raise TypeError("observer must be callable, not %s" % type(observer).__name__)
         started = time.perf_counter()
-        sigint_every = self._observation_interval(nsteps)
-        if observer is None and not sigint_every:
-            self._call("lpi_step", dt, nsteps)
-            done = nsteps
-        else:
-            done = self._step_observed(dt, nsteps, observer, every, sigint_every)
+        with _Claim(self):  # the observer set, the step and its removal, as one
+            sigint_every = self._observation_interval(nsteps)
+            if observer is None and not sigint_every:
+                self._call("lpi_step", dt, nsteps)
+                done = nsteps
+            else:
+                done = self._step_observed(dt, nsteps, observer, every, sigint_every)
         if done > 0:
             self._seconds_per_step = (time.perf_counter() - started) / done
         return done
@@ -934,6 +985,10 @@ class System:
         if not math.isfinite(dt) or dt == 0.0:
             raise ValueError("dt must be finite and nonzero, not %r" % dt)
         times = _reals(t_eval, "t_eval")
+        with _Claim(self):  # the time the steps are counted from is the one stepped from
+            return self._integrate(times, dt, energy, casimirs)
+
+    def _integrate(self, times, dt, energy, casimirs):
         start = self.time
         counts, previous = [], 0
         for t in times:
@@ -986,7 +1041,7 @@ class System:
             # Not measured yet: 1e-7 s per flow and state entry, more than any
             # system takes (an overestimate only makes the looks more frequent).
             flows = c_size_t(1)
-            if lib.lpi_flows_per_step(self._h(), byref(flows)) != 0:
+            if self._query(lib.lpi_flows_per_step, byref(flows)) != 0:
                 flows.value = 1
             seconds = 1e-7 * max(flows.value, 1) * max(self.dim, 1)
         if seconds * nsteps < _OBSERVE_SECONDS:
@@ -1064,7 +1119,7 @@ class System:
         int
             The count.
         """
-        return lib.lpi_casimir_count(self._h())
+        return self._query(lib.lpi_casimir_count)
 
     def casimirs(self, out: Optional[ArrayOut] = None) -> ArrayOut:
         """The Casimirs of the current state.
@@ -1111,12 +1166,13 @@ class System:
             What `load_bytes` restores.
         """
         size = c_size_t()
-        del self._pending[:]
-        status = lib.lpi_save_buffer(self._h(), None, 0, byref(size))
-        if status != 0:
-            _raise(status, _text(lib.lpi_last_error(self._handle)))
-        buf = ctypes.create_string_buffer(size.value)
-        self._call("lpi_save_buffer", buf, size.value, byref(size))
+        with _Claim(self):  # the size queried is the size filled
+            del self._pending[:]
+            status = lib.lpi_save_buffer(self._h(), None, 0, byref(size))
+            if status != 0:
+                _raise(status, _text(lib.lpi_last_error(self._handle)))
+            buf = ctypes.create_string_buffer(size.value)
+            self._call("lpi_save_buffer", buf, size.value, byref(size))
         return buf.raw[:size.value]
 
     @classmethod
@@ -1171,7 +1227,10 @@ class System:
     def __repr__(self):
         if self.closed:
             return "<%s (closed)>" % type(self).__name__
-        return "<%s dim=%d method=%r t=%g>" % (type(self).__name__, self.dim, self.method, self.time)
+        try:
+            return "<%s dim=%d method=%r t=%g>" % (type(self).__name__, self.dim, self.method, self.time)
+        except BusyError:  # noqa: F821 - made by _scan_statuses
+            return "<%s (in use by another thread)>" % type(self).__name__
 
 
 class RigidBody(System):

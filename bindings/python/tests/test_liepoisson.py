@@ -6,6 +6,7 @@ import math
 import os
 import random
 import tempfile
+import threading
 import unittest
 import unittest.mock
 import weakref
@@ -231,6 +232,44 @@ class TestRigidBody(unittest.TestCase):
         fin = lp.Pendulum()._finalizer
         gc.collect()
         self.assertFalse(fin.alive)  # the finaliser released the handle
+
+    def test_another_thread_is_refused_while_a_call_runs(self):
+        # ctypes lets go of the GIL during a call: without the binding's own
+        # claim a second thread reached the library on the same handle (two
+        # threads alternating set_method and step crashed the interpreter).
+        # Held inside an observer, so the first thread is surely mid-call.
+        b = lp.RigidBody(*INERTIA)
+        b.state = [1.0, 0.5, -0.3]
+        ref = lp.RigidBody(*INERTIA)
+        ref.state = [1.0, 0.5, -0.3]
+        ref.step(0.1, 4)
+        inside, go = threading.Event(), threading.Event()
+
+        def observer(system, step, t):
+            inside.set()
+            go.wait(10)
+
+        worker = threading.Thread(target=b.step, args=(0.1, 4), kwargs={"observer": observer, "every": 2})
+        worker.start()
+        try:
+            self.assertTrue(inside.wait(10))
+            attempts = [lambda: b.set_method("yoshida-6"), lambda: b.set_state([0.0, 1.0, 0.0]),
+                        lambda: b.step(0.1), b.close, lambda: b.time, lambda: b.method,
+                        lambda: b.get_state(), b.energy, b.save_bytes, lambda: b.integrate([1.0], 0.1)]
+            for attempt in attempts:
+                with self.assertRaises(lp.BusyError) as caught:
+                    attempt()
+                self.assertIn("another thread", str(caught.exception))
+            self.assertIn("in use by another thread", repr(b))
+        finally:
+            go.set()
+            worker.join(10)
+        self.assertFalse(b.closed)
+        self.assertEqual(b.method, "leapfrog")
+        self.assertEqual(b.time, ref.time)
+        self.assertEqual(as_list(b.state), as_list(ref.state))
+        b.close()
+        ref.close()
 
     def test_system_in_a_cycle_through_its_callbacks_is_freed(self):
         class Model:
