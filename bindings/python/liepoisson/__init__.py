@@ -992,8 +992,12 @@ class System:
         start = self.time
         counts, previous = [], 0
         for t in times:
+            # Said first: NaN passes every comparison below.
+            if not math.isfinite(t):
+                raise ValueError("t_eval entry %r is not finite" % t)
+            # An infinite count (a time too far for dt) is ahead or behind by its sign.
             exact = (t - start) / dt
-            n = round(exact) if math.isfinite(exact) else -1
+            n = round(exact) if math.isfinite(exact) else exact
             if abs(exact - n) > max(1e-6, 8 * sys.float_info.epsilon * abs(exact)):
                 raise ValueError("t_eval entry %r is %.6g steps of %r from the time %r: not a whole number"
                                  % (t, exact, dt, start))

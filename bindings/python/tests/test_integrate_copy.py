@@ -65,6 +65,15 @@ class TestIntegrate(unittest.TestCase):
                 with self.assertRaises(ValueError, msg=repr(bad)):
                     b.integrate(bad, dt)
                 self.assertEqual(b.time, 0.0)  # nothing stepped
+            # And the message says why (NaN and a count past a double were
+            # reported as times lying behind).
+            for bad, dt, why in (([float("nan")], DT, "not finite"), ([float("-inf")], -DT, "not finite"),
+                                 ([1e300], 1e-10, "more than a step count holds"),
+                                 ([-1e300], 1e-10, "lies behind the current time")):
+                with self.assertRaises(ValueError, msg=repr(bad)) as caught:
+                    b.integrate(bad, dt)
+                self.assertIn(why, str(caught.exception))
+                self.assertEqual(b.time, 0.0)
             for dt in (0.0, float("nan")):
                 with self.assertRaises(ValueError):
                     b.integrate([1.0], dt)
