@@ -433,12 +433,21 @@ def _real_array(values, what, kinds="iuf"):
     return a
 
 
+def _unmasked(values, what):
+    """values itself, unless it is a numpy masked array with masked entries:
+    ValueError then. Its data is an ndarray, which would otherwise reach C
+    with whatever lies under the mask."""
+    if isinstance(values, np.ma.MaskedArray) and np.ma.is_masked(values):
+        raise ValueError("%s has masked entries (missing values); fill them or pass the data" % what)
+    return values
+
+
 def _doubles_in(values, what="values"):
     """(pointer, length, keep-alive) for a flat sequence of real numbers. A
     C-contiguous float64 numpy vector is passed as it is (no copy); any other
     real array (float32, integers, a strided view) is copied."""
     if np is not None:
-        a = values
+        a = _unmasked(values, what)
         if not (isinstance(a, np.ndarray) and a.ndim == 1 and a.dtype == np.float64 and a.flags.c_contiguous):
             a = _real_array(values, what)
             if a.ndim != 1:
@@ -1525,7 +1534,7 @@ class SineEuler(System):
         C-contiguous float64 (complex128) numpy array is passed as it is."""
         if np is not None:
             dtype = np.complex128 if complex_ else np.float64
-            a = values
+            a = _unmasked(values, what)
             if not (isinstance(a, np.ndarray) and a.ndim == 2 and a.dtype == dtype
                     and a.flags.c_contiguous):
                 a = np.ascontiguousarray(_real_array(values, what, "iufc" if complex_ else "iuf"), dtype=dtype)

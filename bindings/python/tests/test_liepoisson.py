@@ -624,6 +624,30 @@ class TestNumpy(unittest.TestCase):
             b.state = np.array([1.0, 0.0, 2.0, 0.0, 3.0])[::2]  # strided: copied
             self.assertEqual(b.state.tolist(), [1.0, 2.0, 3.0])
 
+    def test_masked_entries_are_refused(self):
+        # A masked array is an ndarray: its entries under the mask reached C.
+        with lp.RigidBody(*INERTIA) as b:
+            b.state = [1.0, 0.5, -0.3]
+            b.step(0.1, 3)
+            before, t = b.state.tolist(), b.time
+            with self.assertRaises(ValueError) as caught:
+                b.state = np.ma.array([1.0, 2.0, 3.0], mask=[0, 1, 0])
+            self.assertIn("masked", str(caught.exception))
+            with self.assertRaises(ValueError):
+                b.set_composition(np.ma.array([0.5, 0.5], mask=[1, 0]))
+            self.assertEqual((b.state.tolist(), b.time, b.method), (before, t, "leapfrog"))
+            b.state = np.ma.array([1.0, 2.0, 3.0], mask=[0, 0, 0])  # nothing masked: its data
+            self.assertEqual(b.state.tolist(), [1.0, 2.0, 3.0])
+        try:
+            se = lp.SineEuler(3)
+        except lp.UnsupportedError:
+            return
+        with se:
+            grid = np.ma.array(np.ones((3, 3)), mask=np.eye(3))
+            with self.assertRaises(ValueError):
+                se.grid = grid
+            self.assertEqual(se.grid.tolist(), np.zeros((3, 3)).tolist())
+
     def test_callbacks_get_arrays(self):
         seen = []
         g = lp.Generic(3, SO3)
