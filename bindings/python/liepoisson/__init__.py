@@ -576,7 +576,9 @@ class System:
     Create one through a subclass (`RigidBody`, `Pendulum`, `Generic`,
     `Moments`, `SineEuler`) or `load`; ``close()``, a ``with`` block or garbage
     collection releases it. ``copy.copy``, ``copy.deepcopy`` and pickle give
-    independent systems through a checkpoint.
+    independent systems through a checkpoint. A system is used by one thread
+    at a time: a call while another thread is inside one on it raises
+    `BusyError` and changes nothing.
 
     Parameters
     ----------
