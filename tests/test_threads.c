@@ -355,6 +355,125 @@ static void test_thread_count_bound(void **state) {
     lpi_destroy(sys);
 }
 
+/* ---- one handle, two threads: the second is refused ------------------------ */
+
+/* The observer holds the first thread inside lpi_step until the second has
+ * made its calls. */
+typedef struct {
+    pthread_mutex_t lock;
+    pthread_cond_t changed;
+    int inside, intruded;
+    lpi_system *sys;
+    int statuses[4];
+    int another_thread_named, handle_message_kept;
+} handoff;
+
+static int holding_observer(const lpi_system *sys, int64_t step, double t, void *user) {
+    (void)sys; (void)step; (void)t;
+    handoff *h = user;
+    pthread_mutex_lock(&h->lock);
+    if (!h->inside) {
+        h->inside = 1;
+        pthread_cond_broadcast(&h->changed);
+        while (!h->intruded) pthread_cond_wait(&h->changed, &h->lock);
+    }
+    pthread_mutex_unlock(&h->lock);
+    return 0;
+}
+
+static void *intruder(void *arg) {
+    handoff *h = arg;
+    pthread_mutex_lock(&h->lock);
+    while (!h->inside) pthread_cond_wait(&h->changed, &h->lock);
+    pthread_mutex_unlock(&h->lock);
+    const double x[3] = {5.0, 5.0, 5.0};
+    double e;
+    /* A change, a read (which the observer itself may make) and a destroy. */
+    h->statuses[0] = lpi_set_state(h->sys, x, 3);
+    h->statuses[1] = lpi_energy(h->sys, &e);
+    h->statuses[2] = lpi_step(h->sys, 0.1, 1);
+    h->statuses[3] = lpi_destroy(h->sys);
+    h->another_thread_named = strstr(lpi_last_error(NULL), "another thread") != NULL;
+    pthread_mutex_lock(&h->lock);
+    h->intruded = 1;
+    pthread_cond_broadcast(&h->changed);
+    pthread_mutex_unlock(&h->lock);
+    return NULL;
+}
+
+/* A call on a handle while another thread is inside a call on it is refused
+ * with LPI_ERR_BUSY, whatever that call is doing (here: its observer, which
+ * could itself read the handle), changes nothing, and leaves its message to
+ * the calling thread (lpi_last_error(NULL)): the handle's own is the other
+ * thread's to write. */
+static void test_another_thread_is_refused(void **state) {
+    (void)state;
+    handoff h = {PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER, 0, 0, NULL, {0}, 0, 0};
+    const double m0[3] = {0.3, 1.1, -0.7};
+    lpi_system *reference = NULL;
+    assert_int_equal(lpi_rigid_body_create(&h.sys, 1.0, 2.0, 3.0), LPI_OK);
+    assert_int_equal(lpi_rigid_body_create(&reference, 1.0, 2.0, 3.0), LPI_OK);
+    assert_int_equal(lpi_set_state(h.sys, m0, 3), LPI_OK);
+    assert_int_equal(lpi_set_state(reference, m0, 3), LPI_OK);
+    assert_int_equal(lpi_set_observer(h.sys, 1, holding_observer, &h), LPI_OK);
+    pthread_t other;
+    assert_int_equal(pthread_create(&other, NULL, intruder, &h), 0);
+    assert_int_equal(lpi_step(h.sys, 0.01, 5), LPI_OK);
+    assert_int_equal(pthread_join(other, NULL), 0);
+    for (int i = 0; i < 4; ++i) assert_int_equal(h.statuses[i], LPI_ERR_BUSY);
+    assert_true(h.another_thread_named);
+    assert_string_equal(lpi_last_error(h.sys), "");
+    assert_int_equal(lpi_step(reference, 0.01, 5), LPI_OK);
+    double a[3], b[3];
+    assert_int_equal(lpi_get_state(h.sys, a, 3), LPI_OK);
+    assert_int_equal(lpi_get_state(reference, b, 3), LPI_OK);
+    assert_memory_equal(a, b, sizeof a);
+    lpi_destroy(reference);
+    assert_int_equal(lpi_destroy(h.sys), LPI_OK);
+}
+
+/* Two threads calling lpi_step on one handle at once, as fast as they can:
+ * each call runs alone or is refused, and the time is the steps that ran. */
+typedef struct {
+    lpi_system *sys;
+    pthread_barrier_t *start;
+    int ran, refused, other;
+} racer;
+
+static void *race(void *arg) {
+    racer *r = arg;
+    pthread_barrier_wait(r->start);
+    for (int i = 0; i < 400; ++i) {
+        const int status = lpi_step(r->sys, 0.25, 20);
+        if (status == LPI_OK) r->ran++;
+        else if (status == LPI_ERR_BUSY) r->refused++;
+        else r->other++;
+    }
+    return NULL;
+}
+
+static void test_two_threads_at_once(void **state) {
+    (void)state;
+    lpi_system *sys = NULL;
+    const double m0[3] = {0.3, 1.1, -0.7};
+    assert_int_equal(lpi_rigid_body_create(&sys, 1.0, 2.0, 3.0), LPI_OK);
+    assert_int_equal(lpi_set_state(sys, m0, 3), LPI_OK);
+    pthread_barrier_t start;
+    assert_int_equal(pthread_barrier_init(&start, NULL, 2), 0);
+    racer r[2] = {{sys, &start, 0, 0, 0}, {sys, &start, 0, 0, 0}};
+    pthread_t t[2];
+    for (int i = 0; i < 2; ++i) assert_int_equal(pthread_create(&t[i], NULL, race, &r[i]), 0);
+    for (int i = 0; i < 2; ++i) assert_int_equal(pthread_join(t[i], NULL), 0);
+    pthread_barrier_destroy(&start);
+    assert_int_equal(r[0].other + r[1].other, 0);
+    assert_int_equal(r[0].ran + r[0].refused, 400);
+    /* Calls of 20 steps of 0.25 from 0: every partial time is exact. */
+    assert_true(lpi_time(sys) == 5.0 * (r[0].ran + r[1].ran));
+    print_message("two threads, 800 calls: %d ran, %d refused\n", r[0].ran + r[1].ran,
+                  r[0].refused + r[1].refused);
+    assert_int_equal(lpi_destroy(sys), LPI_OK);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_refused_threads_give_a_status),
@@ -362,6 +481,8 @@ int main(void) {
         cmocka_unit_test(test_thread_count_bound),
         cmocka_unit_test(test_steps_inside_a_host_parallel_region),
         cmocka_unit_test(test_fork_after_threads),
+        cmocka_unit_test(test_another_thread_is_refused),
+        cmocka_unit_test(test_two_threads_at_once),
     };
     return lpi_run_tests(tests);
 }

@@ -65,10 +65,12 @@ LPI_API int lpi_pendulum_create(lpi_system **out) {
 LPI_API int lpi_destroy(lpi_system *sys) {
     // Freeing the handle under a call in progress on it would leave that
     // call working on freed memory.
-    if (const char *why = lpi::capi::refusal(sys, true)) {
-        lpi::capi::record(sys, "lpi_destroy", why);
+    lpi::capi::Claim claim(sys, true);
+    if (const char *why = claim.refused()) {
+        lpi::capi::record(claim.by_another_thread() ? nullptr : sys, "lpi_destroy", why);
         return LPI_ERR_BUSY;
     }
+    claim.release_with_handle();
     delete sys;
     return LPI_OK;
 }

@@ -3,12 +3,14 @@
 // its body inside guarded().
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <utility>
 
@@ -18,9 +20,10 @@
 
 namespace lpi::capi {
 
-// What a handle is doing. A call on a handle that is not Idle can only come
-// from a user callback that the library runs inside a call on that handle
-// (one handle is used by one thread at a time).
+// What a handle is doing. A call that finds a handle not Idle comes from a
+// user callback that the library runs inside a call on that handle (the
+// owner's thread), or from another thread, which is refused whatever the
+// handle is doing (one handle is used by one thread at a time).
 enum class Activity : unsigned char {
     Idle,       // no call in progress
     Busy,       // inside a call: every further call on the handle is refused
@@ -33,7 +36,12 @@ struct lpi_system {
     explicit lpi_system(std::unique_ptr<lpi::Model> model) : system(std::move(model)) {}
     lpi::System system;
     mutable std::string last_error;
-    mutable lpi::capi::Activity activity = lpi::capi::Activity::Idle;
+    // A call claims an Idle handle by one compare-and-swap, so that of two
+    // threads calling at once one is refused, reliably (a plain test and set
+    // let both in). Only the owner's thread changes it from then until the
+    // call releases it (its callbacks' nested calls, the observer).
+    mutable std::atomic<lpi::capi::Activity> activity{lpi::capi::Activity::Idle};
+    mutable std::atomic<std::thread::id> owner{};
 };
 
 namespace lpi::capi {
@@ -56,15 +64,16 @@ inline void record(const lpi_system *sys, const char *function, const char *what
     }
 }
 
-// Sets a handle's activity for the lifetime of the scope, then restores it.
+// Sets the activity of a handle its thread holds for the lifetime of the
+// scope, then restores it (the observer, a callback's nested call).
 class ActivityScope {
 public:
     ActivityScope(const lpi_system *sys, Activity activity)
-        : sys_(sys), previous_(sys ? sys->activity : Activity::Idle) {
-        if (sys_) sys_->activity = activity;
+        : sys_(sys), previous_(sys ? sys->activity.load(std::memory_order_relaxed) : Activity::Idle) {
+        if (sys_) sys_->activity.store(activity, std::memory_order_relaxed);
     }
     ~ActivityScope() {
-        if (sys_) sys_->activity = previous_;
+        if (sys_) sys_->activity.store(previous_, std::memory_order_relaxed);
     }
     ActivityScope(const ActivityScope &) = delete;
     ActivityScope &operator=(const ActivityScope &) = delete;
@@ -74,19 +83,63 @@ private:
     Activity previous_;
 };
 
-// Why a call on sys must be refused now (nullptr when it may run). Functions
-// that take a const handle only read it: they may run inside the observer.
-inline const char *refusal(const lpi_system *sys, bool mutates) {
-    if (!sys || sys->activity == Activity::Idle) return nullptr;
-    if (sys->activity == Activity::Observing && !mutates) return nullptr;
-    return sys->activity == Activity::Observing
-               ? "called from this handle's observer, which may only read the handle (functions "
-                 "taking a const lpi_system *); nothing was changed"
-               : "the handle is inside a call already: called from a callback that the library "
-                 "is running in it (a piece, Casimir or product-piece callback), where no call on "
-                 "the handle is allowed, or from another thread (a handle is used by one thread at "
-                 "a time); nothing was changed";
-}
+// A call's hold on its handle: claims an Idle handle for this thread, or
+// enters a held one from a callback of the owner's thread where that
+// activity allows it; otherwise refused() says why (nothing is changed).
+class Claim {
+public:
+    Claim(const lpi_system *sys, bool mutates) : sys_(sys) {
+        if (!sys) return;
+        Activity found = Activity::Idle;
+        if (sys->activity.compare_exchange_strong(found, Activity::Busy, std::memory_order_acquire,
+                                                  std::memory_order_relaxed)) {
+            sys->owner.store(std::this_thread::get_id(), std::memory_order_relaxed);
+            claimed_ = true;
+            return;
+        }
+        // Another thread may be anywhere in its call, writing the handle's
+        // message too: only the owner's thread is told through the handle.
+        if (sys->owner.load(std::memory_order_relaxed) != std::this_thread::get_id()) {
+            refused_ = "another thread is inside a call on this handle (a handle is used by one "
+                       "thread at a time: share it under a lock of your own); nothing was changed";
+            other_thread_ = true;
+            return;
+        }
+        if (found == Activity::Observing && !mutates) {
+            nested_ = found;
+            sys->activity.store(Activity::Busy, std::memory_order_relaxed);
+            return;
+        }
+        refused_ = found == Activity::Observing
+                       ? "called from this handle's observer, which may only read the handle "
+                         "(functions taking a const lpi_system *); nothing was changed"
+                       : "the handle is inside a call already: called from a callback that the "
+                         "library is running in it (a piece, Casimir or product-piece callback), "
+                         "where no call on the handle is allowed; nothing was changed";
+    }
+    ~Claim() {
+        if (claimed_) {
+            sys_->owner.store(std::thread::id(), std::memory_order_relaxed);
+            sys_->activity.store(Activity::Idle, std::memory_order_release);
+        } else if (nested_ != Activity::Idle) {
+            sys_->activity.store(nested_, std::memory_order_relaxed);
+        }
+    }
+    Claim(const Claim &) = delete;
+    Claim &operator=(const Claim &) = delete;
+
+    const char *refused() const { return refused_; }
+    // The handle is about to be freed with its claim (lpi_destroy).
+    void release_with_handle() { claimed_ = false, nested_ = Activity::Idle; }
+    // The refusal's message goes to the calling thread's slot, not the handle's.
+    bool by_another_thread() const { return other_thread_; }
+
+private:
+    const lpi_system *sys_;
+    bool claimed_ = false, other_thread_ = false;
+    Activity nested_ = Activity::Idle;  // the activity a nested call restores
+    const char *refused_ = nullptr;
+};
 
 // A string argument compared by its contents (other pointers are compared
 // by whether they are NULL).
@@ -138,18 +191,18 @@ private:
     std::uint64_t hash_ = 1469598103934665603ull;
 };
 
-// Runs body() with sys marked Busy; maps lpi::Error to its status,
+// Runs body() with sys claimed (Claim); maps lpi::Error to its status,
 // std::bad_alloc and std::length_error to LPI_ERR_NO_MEMORY and anything else
 // to LPI_ERR_INTERNAL, recording the message on sys (or the thread when sys
 // is NULL). A body may return a status of its own (LPI_STOPPED).
 template <class Body>
 int run_guarded(const lpi_system *sys, bool mutates, const char *function, const Arguments *arguments,
                 Body &&body) noexcept {
-    if (const char *why = refusal(sys, mutates)) {
-        record(sys, function, why);
+    Claim claim(sys, mutates);
+    if (const char *why = claim.refused()) {
+        record(claim.by_another_thread() ? nullptr : sys, function, why);
         return LPI_ERR_BUSY;
     }
-    ActivityScope scope(sys, Activity::Busy);
     try {
         if (sys && arguments) {
             const std::uint64_t fingerprint = arguments->fingerprint();
