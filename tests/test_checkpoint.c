@@ -45,6 +45,8 @@ typedef struct {
     uint64_t n_state;     /* the stored count */
     size_t state_values;  /* the values that follow it */
     const double *state;
+    uint32_t version;  /* 0: the current one, 2 (1: no time carry) */
+    double time_carry;
 } crafted;
 
 typedef struct {
@@ -70,7 +72,8 @@ static unsigned char *craft(const crafted *c, size_t *size) {
     const unsigned char magic[8] = {0x89, 'L', 'P', 'I', 0x0D, 0x0A, 0x1A, 0x0A};
     put(&b, magic, 8);
     put_u32(&b, 0x01020304u);
-    put_u32(&b, 1);
+    const uint32_t version = c->version ? c->version : 2;
+    put_u32(&b, version);
     const uint64_t total_placeholder = 0;
     put(&b, &total_placeholder, 8);
     put_string(&b, c->kind, strlen(c->kind));
@@ -83,6 +86,7 @@ static unsigned char *craft(const crafted *c, size_t *size) {
     put(&b, &c->tolerance, 8);
     put(&b, &c->iterations, 4);
     put(&b, &c->time, 8);
+    if (version >= 2) put(&b, &c->time_carry, 8);
     put(&b, &c->n_state, 8);
     put(&b, c->state, 8 * c->state_values);
     put_u32(&b, 0); /* the checksum, sealed below */
@@ -101,7 +105,7 @@ static crafted rigid_crafted(void) {
     const double m[6] = {0.3, 1.1, -0.7, 0.0, 0x1p-54, 0.0};
     memcpy(rigid_state, m, sizeof m);
     const crafted c = {"rigid-body", 3, kInertia, "casimir-shift", "leapfrog", 0, NULL,
-                       1e-13, 100, 0.25, 6, 6, rigid_state};
+                       1e-13, 100, 0.25, 6, 6, rigid_state, 0, 0.0};
     return c;
 }
 
@@ -392,7 +396,7 @@ static void test_foreign_newer_other_order(void **state) {
     assert_refused(copy, 28, "magic");
 
     memcpy(copy, buf, size);
-    const uint32_t future = 2;
+    const uint32_t future = 3;
     memcpy(copy + 12, &future, 4);
     reseal(copy, size);
     assert_refused(copy, size, "newer");
@@ -472,6 +476,57 @@ static void test_layout_and_round_trip(void **state) {
     free(mine), free(real);
     lpi_destroy(copy);
     lpi_destroy(sys);
+}
+
+/* The time is kept with its carry (format version 2): a copy made after
+ * many one-step calls continues with the original's times to the bit. A
+ * version 1 checkpoint (no carry) loads with none, and a carry that is not
+ * below half a unit of the time's last place is refused. */
+static void test_time_carry(void **state) {
+    (void)state;
+    lpi_system *sys = pendulum();
+    for (int i = 0; i < 1000; ++i) assert_int_equal(lpi_step(sys, 0.1, 1), LPI_OK);
+    size_t size;
+    unsigned char *buf = save(sys, &size);
+    lpi_system *copy = load(buf, size);
+    for (int i = 0; i < 1000; ++i) {
+        assert_int_equal(lpi_step(sys, 0.1, 1), LPI_OK);
+        assert_int_equal(lpi_step(copy, 0.1, 1), LPI_OK);
+        assert_true(lpi_time(copy) == lpi_time(sys));
+    }
+    assert_true(lpi_time(sys) == 200.0);
+    free(buf);
+    lpi_destroy(copy);
+    lpi_destroy(sys);
+
+    crafted c = rigid_crafted();
+    const double gammas[1] = {1.0};
+    c.n_gammas = 1, c.gammas = gammas, c.version = 1;
+    unsigned char *mine = craft(&c, &size);
+    copy = load(mine, size);
+    assert_true(lpi_time(copy) == 0.25);
+    unsigned char *again = save(copy, &size);
+    c.version = 2, c.time_carry = 0.0;
+    free(mine);
+    size_t crafted_size;
+    mine = craft(&c, &crafted_size);
+    assert_int_equal(size, crafted_size);
+    assert_memory_equal(again, mine, size); /* re-saved as version 2, carry 0 */
+    free(mine), free(again);
+    lpi_destroy(copy);
+
+    c.time_carry = 0x1p-56; /* a quarter unit of 0.25 in its last place: kept */
+    mine = craft(&c, &size);
+    copy = load(mine, size);
+    again = save(copy, &crafted_size);
+    assert_memory_equal(again, mine, size);
+    free(mine), free(again);
+    lpi_destroy(copy);
+    const double refused[] = {0x1p-54, -0x1p-53, 1e-3, NAN, INFINITY};
+    for (size_t i = 0; i < sizeof refused / sizeof refused[0]; ++i) {
+        c.time_carry = refused[i];
+        assert_crafted_refused(&c, LPI_ERR_FORMAT, "carry");
+    }
 }
 
 /* Everything a setter refuses, a checkpoint may not carry either: the
@@ -603,7 +658,7 @@ static void test_sine_euler_payloads(void **state) {
     }
     const double N = 3.0, gammas[1] = {1.0};
     crafted c = {"sine-euler", 1, &N, "directions", "leapfrog", 1, gammas, 1e-13, 100, 0.0,
-                 18, 18, modes};
+                 18, 18, modes, 0, 0.0};
     size_t size;
     unsigned char *buf = craft(&c, &size);
     lpi_system *probe = NULL;
@@ -679,7 +734,7 @@ static void test_sine_euler_payloads(void **state) {
     const double large = 33.0;
     static double still[2 * 33 * 33];
     c = (crafted){"sine-euler", 1, &large, "directions", "direct-eq5", 0, NULL, 1e-13, 100, 0.0,
-                  2 * 33 * 33, 2 * 33 * 33, still};
+                  2 * 33 * 33, 2 * 33 * 33, still, 0, 0.0};
     assert_crafted_refused(&c, LPI_ERR_FORMAT, "accepts N <= 31");
     c.method = "leapfrog", c.n_gammas = 1, c.gammas = gammas;
     buf = craft(&c, &size);
@@ -1065,6 +1120,7 @@ int main(void) {
         cmocka_unit_test(test_truncated_and_flipped),
         cmocka_unit_test(test_foreign_newer_other_order),
         cmocka_unit_test(test_layout_and_round_trip),
+        cmocka_unit_test(test_time_carry),
         cmocka_unit_test(test_impossible_payloads),
         cmocka_unit_test(test_sine_euler_payloads),
         cmocka_unit_test(test_baselines_after_splitting),

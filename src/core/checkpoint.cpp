@@ -241,6 +241,7 @@ std::vector<unsigned char> encode_checkpoint(const System &system) {
     w.put(system.implicit_settings().tolerance);
     w.put(static_cast<std::int32_t>(system.implicit_settings().max_iterations));
     w.put(system.time());
+    w.put(system.time_carry());
     // A model spread over processes stores its whole state, as one process
     // holding it would: the file loads either way.
     const std::vector<double> state = model.whole_state(system.working_state().data());
@@ -271,6 +272,7 @@ Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size) {
     cp.implicit.tolerance = r.get<double>("implicit tolerance");
     cp.implicit.max_iterations = r.get<std::int32_t>("implicit iteration limit");
     cp.time = r.get<double>("time");
+    if (load_u32(data + 12) >= 2) cp.time_carry = r.get<double>("time carry");
     cp.state = r.get_doubles(r.get<std::uint64_t>("state length"), "state");
     if (r.left() != 0)
         fail(LPI_ERR_FORMAT, std::to_string(r.left()) + " unread bytes at the end of the payload");
@@ -287,6 +289,10 @@ Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size) {
                                  kind + " system of these parameters has " +
                                  std::to_string(cp.model->state_size()));
     if (!std::isfinite(cp.time)) fail(LPI_ERR_FORMAT, "the time is not finite");
+    // The carry a save writes is below half a unit of the time's last place.
+    if (!std::isfinite(cp.time_carry) || cp.time + cp.time_carry != cp.time)
+        fail(LPI_ERR_FORMAT, "the time's carry " + number_text(cp.time_carry) +
+                                 " is not below half a unit in the last place of the time");
     check_working_state(entry, *cp.model, cp.state);
     return cp;
 }
@@ -299,7 +305,7 @@ void restore_checkpoint(System &system, const Checkpoint &cp) {
         } else {
             system.set_method(cp.method);
         }
-        system.restore_working_state(cp.state, cp.time);
+        system.restore_working_state(cp.state, cp.time, cp.time_carry);
     } catch (const MethodNotApplicable &e) {
         // A method that can never run on this system: no save writes that.
         fail(LPI_ERR_FORMAT, e.what());

@@ -1,7 +1,7 @@
 // Checkpoints: a System written to bytes (or a file) and read back so that
 // stepping continues the same trajectory to the bit.
 //
-// Format, version 1. Every number is in the writer's byte order, announced by
+// Format, version 2. Every number is in the writer's byte order, announced by
 // the marker; IEEE 754 doubles are stored as their 8 bytes.
 //   offset  0  magic        8 bytes  89 'L' 'P' 'I' 0D 0A 1A 0A (PNG-style:
 //                                    catches text-mode and 7-bit transfers)
@@ -17,6 +17,8 @@
 //              tolerance    f64      implicit settings
 //              iterations   i32
 //              time         f64
+//              time carry   f64      (version 2 on) time + carry is the time
+//                                    exactly (System::Time); version 1: 0
 //              state        u64 n, n x f64   (the working layout, including
 //                                              the compensated carry)
 //   size-4     CRC-32       u32      of every byte before it (IEEE 802.3)
@@ -34,7 +36,7 @@
 
 namespace lpi {
 
-constexpr std::uint32_t kCheckpointVersion = 1;
+constexpr std::uint32_t kCheckpointVersion = 2;
 
 // How a checkpoint brings a model kind back. Each model kind that can be
 // saved (Model::checkpoint_parameters) has one, listed in checkpoint_kinds().
@@ -74,7 +76,7 @@ struct Checkpoint {
     std::string method;
     std::vector<double> gammas;
     ImplicitSettings implicit;
-    double time = 0.0;
+    double time = 0.0, time_carry = 0.0;
     std::vector<double> state;
 };
 

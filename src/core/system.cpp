@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "error.hpp"
+#include "exact_sums.hpp"
 #include "text.hpp"
 #include "threads.hpp"
 
@@ -113,7 +114,7 @@ void System::set_state(const double *x, std::size_t n) {
     model_->agree_on_every_process([&] { next.resize(model_->state_size()); });
     model_->from_public(x, next.data());
     state_.swap(next);
-    time_ = 0.0;
+    time_ = Time{};
 }
 
 void System::get_state(double *x, std::size_t n) const {
@@ -121,14 +122,18 @@ void System::get_state(double *x, std::size_t n) const {
     model_->to_public(state_.data(), x);
 }
 
-void System::restore_working_state(std::vector<double> state, double time) {
+void System::restore_working_state(std::vector<double> state, double time, double time_carry) {
     require_length("working state", state.size(), model_->state_size());
     for (std::size_t i = 0; i < state.size(); ++i)
         if (!std::isfinite(state[i]))
             fail(LPI_ERR_NONFINITE, "working state entry " + std::to_string(i) + " is not finite");
     if (!std::isfinite(time)) fail(LPI_ERR_NONFINITE, "time is not finite");
+    if (!std::isfinite(time_carry) || time + time_carry != time)
+        fail(LPI_ERR_INVALID, "the time's carry " + number_text(time_carry) +
+                                  " is not below half a unit in the last place of the time " +
+                                  number_text(time));
     state_.swap(state);
-    time_ = time;
+    time_ = Time{time, time_carry};
 }
 
 void System::set_threads(int n) {
@@ -168,7 +173,8 @@ bool System::step(double dt, std::int64_t nsteps) {
         fail(LPI_ERR_INVALID, std::string("the ") + model_->kind() +
                                   " system has no Hamiltonian pieces yet (add them with "
                                   "lpi_add_piece)");
-    const double start = time_;
+    const Time begun = time_;
+    const double start = begun.value;
     if (!std::isfinite(start + dt * static_cast<double>(nsteps)))
         fail(LPI_ERR_OVERFLOW, "the end time t + dt * nsteps = " + number_text(start, 6) + " + " +
                                    number_text(dt, 6) + " * " + std::to_string(nsteps) +
@@ -192,18 +198,18 @@ bool System::step(double dt, std::int64_t nsteps) {
     if (observer_) {
         watch.every = observe_every_;
         watch.observe = [&](std::int64_t done) {
-            time_ = start + dt * static_cast<double>(done);
+            time_ = begun.advanced(dt, done);
             // An observer that fails (throws) on one process fails the call
             // on every one: none is left waiting in the next collective.
             bool stop = false;
-            model_->agree_on_every_process([&] { stop = observer_(done, time_); });
+            model_->agree_on_every_process([&] { stop = observer_(done, time_.value); });
             return model_->on_any_process(stop);
         };
     }
     const double average_iterations = integrator_->average_iterations();
     const auto roll_back = [&] {
         state_.swap(saved_);
-        time_ = start;
+        time_ = begun;
         integrator_->restore_average_iterations(average_iterations);
     };
     StepsInProgress progress;
@@ -228,8 +234,19 @@ bool System::step(double dt, std::int64_t nsteps) {
                  "; the state is checked every " + std::to_string(kFiniteCheckInterval) +
                  " steps, at each observation and at the end); state rolled back");
     }
-    time_ = start + dt * static_cast<double>(outcome.steps);
+    time_ = begun.advanced(dt, outcome.steps);
     return outcome.end != RunOutcome::Stopped;
+}
+
+System::Time System::Time::advanced(double dt, std::int64_t steps) const {
+    // steps < 2^63 is a double exactly up to 2^53, past which a call's span
+    // rounds once more (a run of 10^16 steps).
+    double span, span_error, sum, sum_error;
+    two_product(dt, static_cast<double>(steps), span, span_error);
+    two_sum(value, span, sum, sum_error);
+    Time next;
+    two_sum(sum, sum_error + (span_error + carry), next.value, next.carry);
+    return next;
 }
 
 double System::energy() const {

@@ -47,7 +47,7 @@ public:
     const std::vector<double> &working_state() const { return state_; }
     // Restores a working state and time exactly (checkpoints): the length
     // must be the model's state_size() and every value finite.
-    void restore_working_state(std::vector<double> state, double time);
+    void restore_working_state(std::vector<double> state, double time, double time_carry = 0.0);
 
     // Called by step() after every `every`-th step with the steps completed
     // in the call and the time; true stops the call there.
@@ -57,7 +57,8 @@ public:
     // Advances nsteps steps; false when the observer stopped it early (the
     // state and time are then those of that many steps).
     bool step(double dt, std::int64_t nsteps);
-    double time() const { return time_; }
+    double time() const { return time_.value; }
+    double time_carry() const { return time_.carry; }  // time() + it: the time, exactly
 
     // Outputs computed from the (finite) state: a value that is not finite
     // overflowed, and throws LPI_ERR_OVERFLOW naming it.
@@ -75,7 +76,16 @@ private:
     std::unique_ptr<Integrator> integrator_;
     std::vector<double> state_;
     std::vector<double> saved_;  // the state before the step in progress
-    double time_ = 0.0;
+    // The time as a double-double, value + carry, each call adding dt times
+    // its steps exactly but for u^2 t: time reported after many short calls
+    // (a program stepping one step at a time) is then the sum of their
+    // spans rounded once, not a rounding a call (0.1 a call: 1.3e-11
+    // relative after 10^6 calls).
+    struct Time {
+        double value = 0.0, carry = 0.0;
+        Time advanced(double dt, std::int64_t steps) const;
+    };
+    Time time_;
     ImplicitSettings implicit_;
     std::string split_;  // the model's split(), as of the last change
     int threads_ = 1;

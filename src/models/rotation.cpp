@@ -3,21 +3,11 @@
 #include <string>
 
 #include "../core/error.hpp"
+#include "../core/exact_sums.hpp"
 #include "../core/text.hpp"
 #include "models.hpp"
 
 namespace lpi {
-
-namespace {
-
-// a + b = sum + error exactly, sum = fl(a + b), whatever their sizes (Knuth).
-inline void two_sum(double a, double b, double &sum, double &error) {
-    sum = a + b;
-    const double b_part = sum - a;
-    error = (a - (sum - b_part)) + (b - b_part);
-}
-
-}  // namespace
 
 void compensated_add(double &x, double &carry, double increment) {
     // x + carry is a double-double: x + increment is split exactly into its
