@@ -11,6 +11,7 @@
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "lpi_test.h"
@@ -1085,6 +1086,46 @@ static void test_save_names_and_failures(void **state) {
     lpi_destroy(sys);
 }
 
+/* A save past RLIMIT_FSIZE with SIGXFSZ at its default action (which ends
+ * the process): the library fails with LPI_ERR_IO, the process lives on,
+ * the old file is intact and no temporary file is left. Run in a child,
+ * which the signal would kill. */
+static void test_save_past_file_size_limit(void **state) {
+    (void)state;
+    char dir[] = "checkpoint_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[64];
+    snprintf(path, sizeof path, "%s/run.lpi", dir);
+    lpi_system *sys = rigid_body();
+    assert_int_equal(lpi_save(sys, path), LPI_OK);
+    size_t size;
+    unsigned char *old = save(sys, &size);
+    assert_int_equal(lpi_step(sys, 0.01, 10), LPI_OK);
+    fflush(NULL);
+    const pid_t child = fork();
+    assert_true(child >= 0);
+    if (child == 0) {
+        signal(SIGXFSZ, SIG_DFL);
+        struct rlimit limit;
+        if (getrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(2);
+        limit.rlim_cur = size / 2;
+        if (setrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(2);
+        const int status = lpi_save(sys, path);
+        _exit(status == LPI_ERR_IO && strstr(lpi_last_error(sys), "File too large") ? 0 : 1);
+    }
+    int status = 0;
+    assert_int_equal(waitpid(child, &status, 0), child);
+    if (WIFSIGNALED(status)) fail_msg("lpi_save past the file-size limit: killed by signal %d", WTERMSIG(status));
+    assert_true(WIFEXITED(status));
+    assert_int_equal(WEXITSTATUS(status), 0);
+    assert_file_holds(path, old, size);
+    assert_int_equal(count_entries(dir), 1); /* no temporary file left */
+    unlink(path);
+    assert_int_equal(rmdir(dir), 0);
+    free(old);
+    lpi_destroy(sys);
+}
+
 static void test_null_and_sizes(void **state) {
     (void)state;
     lpi_system *sys = rigid_body(), *out = (lpi_system *)0x1;
@@ -1130,6 +1171,7 @@ int main(void) {
         cmocka_unit_test(test_save_targets),
         cmocka_unit_test(test_files_read_bounded),
         cmocka_unit_test(test_save_names_and_failures),
+        cmocka_unit_test(test_save_past_file_size_limit),
         cmocka_unit_test(test_null_and_sizes),
     };
     return lpi_run_tests(tests);

@@ -2,6 +2,7 @@
 #include "files.hpp"
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -82,6 +83,19 @@ SaveTarget save_target(const std::string &path) {
     return target;
 }
 
+// Whether `size` more bytes appended to fd stay within RLIMIT_FSIZE. A write
+// past it raises SIGXFSZ, whose default action ends the process and leaves
+// the temporary file behind: such a write is refused beforehand, with the
+// EFBIG the write gives where the signal is ignored.
+bool within_file_size_limit(int fd, std::size_t size) {
+    struct rlimit limit;
+    if (::getrlimit(RLIMIT_FSIZE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return true;
+    struct stat st;
+    if (::fstat(fd, &st) != 0) return true;  // the write itself says what is wrong
+    const auto end = static_cast<std::uint64_t>(st.st_size);
+    return end <= limit.rlim_cur && size <= limit.rlim_cur - end;
+}
+
 }  // namespace
 
 FileReplacement::FileReplacement(const std::string &path) : path_(path) {
@@ -112,6 +126,7 @@ void FileReplacement::abandon(const std::string &what, int error) {
 void FileReplacement::write(const unsigned char *bytes, std::size_t size) {
     if (fd_ < 0) fd_ = ::open(temp_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
     if (fd_ < 0) abandon("cannot write " + quoted(temp_), errno);
+    if (size > 0 && !within_file_size_limit(fd_, size)) abandon("cannot write " + quoted(temp_), EFBIG);
     std::size_t done = 0;
     while (done < size) {
         const ssize_t n = ::write(fd_, bytes + done, size - done);

@@ -17,8 +17,9 @@ std::string io_reason(int error);
 // The target is path, or the file a symbolic link at path names (the link
 // is kept); an existing target keeps its permission bits. LPI_ERR_IO (naming
 // path, with the reason) when the target is a directory, a device, a FIFO or
-// a link to nothing, or on any failure; path then keeps its old contents and
-// no temporary file is left behind.
+// a link to nothing, or on any failure (a write past RLIMIT_FSIZE too: EFBIG,
+// never the SIGXFSZ that would end the process); path then keeps its old
+// contents and no temporary file is left behind.
 void write_file_atomically(const std::string &path, const unsigned char *bytes, std::size_t size);
 
 // The steps of write_file_atomically, for a writer that fills the temporary
