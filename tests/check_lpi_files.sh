@@ -10,7 +10,8 @@
 #    fails before its work, not saying where its files are;
 #  - a write that fails (RLIMIT_FSIZE, as a full disk) keeps the old CSV,
 #    the old .npy set and the old HDF5 file whole, names the file and the
-#    reason, exits 1 (no crash) and leaves no temporary file; a replaced file
+#    reason, exits 1 (no crash, also with SIGXFSZ at its default action, and
+#    so does standard output) and leaves no temporary file; a replaced file
 #    keeps its mode, a new one gets the umask's; a FIFO where an output
 #    goes is refused, not replaced;
 #  - --checkpoint that cannot work (moments) or names an output of the run
@@ -119,6 +120,18 @@ rc=0; limited run rigid-body --steps 5000 --every 1 --format npy --out "$out/ful
     { cat "$out/stderr"; fail "a CSV too large to write: exit status $rc"; }
 cmp -s "$out/old.csv" "$out/full/rigid-body.csv" || fail "a CSV that could not be written lost the old one"
 no_temporaries "$out/full"
+# The same with SIGXFSZ at its default action, which ends a process writing
+# past the limit (exit 153, no message, the temporary file left): lpi's files
+# and its standard output fail as above instead.
+rc=0; (trap - XFSZ; ulimit -f 40; exec "$lpi" run rigid-body --steps 5000 --every 1 --format npy --out "$out/full") \
+    >/dev/null 2>"$out/stderr" || rc=$?
+[ "$rc" -eq 1 ] && grep -q "rigid-body.csv.*File too large" "$out/stderr" ||
+    { cat "$out/stderr"; fail "a CSV past the file-size limit, SIGXFSZ not ignored: exit status $rc, expected 1"; }
+cmp -s "$out/old.csv" "$out/full/rigid-body.csv" || fail "a CSV past the file-size limit lost the old one"
+no_temporaries "$out/full"
+rc=0; (trap - XFSZ; ulimit -f 1; exec "$lpi" methods) >"$out/methods.txt" 2>"$out/stderr" || rc=$?
+[ "$rc" -eq 1 ] && grep -q "standard output.*File too large" "$out/stderr" ||
+    { cat "$out/stderr"; fail "standard output past the file-size limit: exit status $rc, expected 1"; }
 if [ "$have_se" = 1 ]; then
     # The .npy files are replaced as one set: the last one failing keeps them all.
     set -- run sine-euler --N 31 --every 1 --snapshots 1 --format npy --out "$out/set"

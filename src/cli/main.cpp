@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 #include <exception>
 #include <new>
@@ -204,6 +205,10 @@ int lpi_command(int argc, char **argv) {
 // a failure with a message, not an abort, and so is standard output that
 // could not be written (a full disk, a closed pipe).
 int main(int argc, char **argv) {
+    // A write past the file-size limit (ulimit -f) then fails with EFBIG,
+    // which lpi reports, instead of raising SIGXFSZ, which would end it
+    // without a message (standard output redirected to a file, gnuplot's images).
+    std::signal(SIGXFSZ, SIG_IGN);
     start_processes(&argc, &argv);
     int status = 1;
     try {
