@@ -142,13 +142,21 @@ if [ "$have_sine_euler" = 1 ]; then
     done
 fi
 
-# --resume refuses a checkpoint of another scene, N or Hamiltonian.
+# --resume refuses a checkpoint of another scene, N, Hamiltonian or method.
 "$lpi" run pendulum --dt 0.05 --steps 20 --out "$out/p" --checkpoint "$out/pendulum.lpi" >/dev/null
 refused "not a checkpoint of this scene" run rigid-body --resume "$out/pendulum.lpi" --out "$out/bad"
 "$lpi" run rigid-body --dt 0.05 --steps 20 --out "$out/r" --checkpoint "$out/rigid.lpi" >/dev/null
 refused "Hamiltonian differs" run rigid-body --inertia 1,1,2 --resume "$out/rigid.lpi" --out "$out/bad"
 refused "not a whole number of steps" run rigid-body --dt 0.03 --resume "$out/rigid.lpi" --out "$out/bad"
 refused "past the run's end" run rigid-body --dt 0.05 --steps 10 --resume "$out/rigid.lpi" --out "$out/bad"
+# The checkpoint holds the run's method: another --method would splice rows
+# of two methods (the checkpoint's own, by name or alias, resumes).
+refused "--method rk4.*leapfrog" run rigid-body --dt 0.05 --steps 30 --method rk4 --resume "$out/rigid.lpi" \
+    --out "$out/bad"
+for method in leapfrog strang; do
+    "$lpi" run rigid-body --dt 0.05 --steps 22 --method $method --resume "$out/rigid.lpi" --out "$out/m" >/dev/null ||
+        { echo "--resume with the checkpoint's method as --method $method: refused"; exit 1; }
+done
 # --resume reads the interrupted run's CSV back by the rules of the options:
 # a field that is no complete finite decimal number, a row with a field too
 # few or too many, a step that is no whole number in range, another header

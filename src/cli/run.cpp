@@ -298,7 +298,18 @@ int run_command(int argc, char **argv) {
         std::fprintf(stderr, "%s\n", collision.c_str());
         return 2;
     }
-    if (!o.method.empty()) check_option(lpi_set_method(sys, o.method.c_str()), sys, "--method");
+    if (!o.method.empty()) {
+        const std::string resumed = lpi_get_method(sys);
+        check_option(lpi_set_method(sys, o.method.c_str()), sys, "--method");
+        // The checkpoint holds the interrupted run's method (compared by the
+        // name an alias resolves to): another would splice rows of two methods.
+        if (!o.resume.empty() && resumed != lpi_get_method(sys)) {
+            std::fprintf(stderr, "lpi run: --resume: --method %s, but %s holds a run of %s: resume with the "
+                                 "options of the interrupted run\n",
+                         o.method.c_str(), o.resume.c_str(), resumed.c_str());
+            return 2;
+        }
+    }
     if (o.threads != 1) check_option(lpi_set_threads(sys, o.threads), sys, "--threads");
     // Wisdom first, so that any planning (the first step's or --planning's)
     // uses it; measured plans are written back for the next run. A wisdom
