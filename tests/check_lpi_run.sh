@@ -236,6 +236,28 @@ for every in 10 7; do
         { echo "--every $every: the resumed CSV differs:"; diff "$out/whole/pendulum.csv" "$out/parts/pendulum.csv"; exit 1; }
 done
 
+# A run killed before it wrote its data leaves the data of an earlier run
+# there (here of another --inertia and --every): resumed, that data's
+# snapshots are not passed off as this run's, whether it has a row at the
+# checkpoint's step (--every 1; it was refused as another --dt) or not
+# (--every 3; its snapshots were spliced in): only this run's, from the
+# checkpoint's step on, are kept.
+for every in 1 3; do
+    rm -rf "$out/stale" "$out/stale-b"
+    "$lpi" run rigid-body --inertia 1,2,3 --steps 40 --every $every --snapshots 1 --format npy --out "$out/stale" \
+        >/dev/null
+    "$lpi" run rigid-body --inertia 2,3,5 --steps 10 --every 5 --snapshots 1 --format npy --out "$out/stale-b" \
+        --checkpoint "$out/stale.lpi" >/dev/null
+    cp "$out/stale-b/rigid-body.csv" "$out/stale/"
+    "$lpi" run rigid-body --inertia 2,3,5 --steps 20 --every 5 --snapshots 1 --format npy --out "$out/stale" \
+        --resume "$out/stale.lpi" >"$out.out" 2>"$out.err" ||
+        { echo "--resume over the data of another run (--every $every): refused"; cat "$out.err"; exit 1; }
+    grep -q "another run" "$out.out" ||
+        { echo "--resume over the data of another run (--every $every): no note"; cat "$out.out"; exit 1; }
+    head -c 128 "$out/stale/rigid-body/snapshot_step.npy" | grep -q "'shape': (2,)" ||
+        { echo "--resume over the data of another run (--every $every): its snapshots were kept"; exit 1; }
+done
+
 # Ctrl-C: SIGINT stops a long run through the library's observer within a
 # few steps, even inside one long lpi_step call: status 130, a complete last
 # row at the step where it stopped, and the checkpoint of the last row on the

@@ -139,18 +139,40 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
 // The snapshots of the interrupted run up to `start`, from its data; a note
 // on stdout (not an error) when they cannot be read.
 std::string keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunData &d) {
-    // The data's row at the checkpoint's step holds its time, as the CSV's
-    // does (run.cpp): another time there is another --dt.
-    Array row_steps, row_times;
+    Array row_steps, row_times, row_energies;
+    std::string why;  // why the data's snapshots are not this run's
     if (read_data_array(o, "step", row_steps).empty() && read_data_array(o, "time", row_times).empty() &&
-        row_steps.values.size() == row_times.values.size())
-        for (std::size_t i = 0; i < row_steps.values.size(); ++i)
-            if (row_steps.values[i] == static_cast<double>(start) && row_times.values[i] != start_time)
-                return format("lpi run: --resume: the checkpoint's time %.17g is step %lld of this run's --dt, "
-                              "but %s has t = %.17g at that step: resume with the options of the interrupted run",
-                              start_time, static_cast<long long>(start), data_path(o).c_str(), row_times.values[i]);
+        read_data_array(o, "energy", row_energies).empty() && row_steps.values.size() == row_times.values.size() &&
+        row_steps.values.size() == row_energies.values.size()) {
+        for (std::size_t i = 0; i < row_steps.values.size() && why.empty(); ++i) {
+            const double step = row_steps.values[i];
+            if (step > static_cast<double>(start)) continue;
+            if (d.step.empty()) {
+                // No CSV: the data's row at the checkpoint's step holds its
+                // time, as the CSV's does (run.cpp): another time there is
+                // another --dt.
+                if (step == static_cast<double>(start) && row_times.values[i] != start_time)
+                    return format("lpi run: --resume: the checkpoint's time %.17g is step %lld of this run's --dt, "
+                                  "but %s has t = %.17g at that step: resume with the options of the interrupted "
+                                  "run",
+                                  start_time, static_cast<long long>(start), data_path(o).c_str(),
+                                  row_times.values[i]);
+                continue;
+            }
+            // The CSV's rows (in d) are this run's: they hold the checkpoint's
+            // time. Data whose rows at the same steps differ is another run's,
+            // left there by a run killed before it wrote its own data.
+            const auto at = std::lower_bound(d.step.begin(), d.step.end(), step);
+            if (at == d.step.end() || *at != step) continue;
+            const std::size_t row = static_cast<std::size_t>(at - d.step.begin());
+            if (std::memcmp(&d.time[row], &row_times.values[i], sizeof(double)) != 0 ||
+                std::memcmp(&d.energy[row], &row_energies.values[i], sizeof(double)) != 0)
+                why = format("its row at step %lld is not that of the CSV: it is the data of another run",
+                             static_cast<long long>(step));
+        }
+    }
     Array steps, times, shots;
-    std::string why = read_data_array(o, "snapshot_step", steps);
+    if (why.empty()) why = read_data_array(o, "snapshot_step", steps);
     if (why.empty()) why = read_data_array(o, "snapshot_time", times);
     if (why.empty()) why = read_data_array(o, d.vorticity ? "vorticity" : "state", shots);
     const std::size_t n = steps.values.size();

@@ -62,8 +62,10 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
                        SnapshotBytes &bytes);
 
 // The snapshots of the interrupted run up to `start`, from its data; a note
-// on stdout (not an error) when they cannot be read. Returns "", or why the
-// data is not that of this run (its time at `start` is not `start_time`).
+// on stdout (not an error) when they cannot be read or the data's rows are
+// not the CSV's kept in `d` (another run's data). Returns "", or, without a
+// CSV, why the data is not that of this run (its time at `start` is not
+// `start_time`).
 std::string keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunData &d);
 
 // The initial grid of --init into `grid`, checked against the system's N:
