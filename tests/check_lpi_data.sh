@@ -75,6 +75,14 @@ if [ "$have_h5" = 1 ]; then
     refused 1 "HDF5 cannot" sine-euler --init "$out/truncated.h5"
     "$lpi" run rigid-body --steps 2 --format h5 --out "$out/rb" >/dev/null
     refused 2 "no dataset /init or /vorticity" sine-euler --init "$out/rb/rigid-body.h5"
+    # The run's own data as --init: the run would replace the grid it starts
+    # from, and the run that made it.
+    cp "$out/h5/sine-euler.h5" "$out/own.h5"
+    rc=0; "$lpi" run sine-euler --N 9 --init "$out/h5/sine-euler.h5" --steps 1 --out "$out/h5" >/dev/null \
+        2>"$out/err" || rc=$?
+    [ "$rc" -eq 2 ] && grep -q -e "--init .*which this run writes" "$out/err" ||
+        { cat "$out/err"; fail "--init the run's own data: exit status $rc, expected 2"; }
+    cmp -s "$out/own.h5" "$out/h5/sine-euler.h5" || fail "--init the run's own data: the data was replaced"
 fi
 # A command under 1 GB of address space (a subshell); without the limit where
 # lpi runs under AddressSanitizer, which reserves terabytes of it.

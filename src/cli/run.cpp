@@ -161,12 +161,19 @@ bool same_file(const std::string &a, const std::string &b) {
 
 // The files a run writes and the options naming them, checked before
 // anything is written: --checkpoint (and --wisdom, which measured planning
-// writes) may be none of the run's outputs nor the --init grid, for the run
-// would overwrite one with the other. A usage error: "" or the message.
+// writes) may be none of the run's outputs nor the --init grid, and the
+// --init grid none of the outputs, for the run would overwrite one with the
+// other. A usage error: "" or the message.
 std::string colliding_paths(const RunOptions &o, const std::vector<std::string> &outputs) {
     struct Named {
         std::string option, path;
     };
+    // Read before the run, but the data of the run that made it would be lost.
+    if (!o.init.empty())
+        for (const std::string &output : outputs)
+            if (same_file(o.init, output))
+                return "lpi run: --init " + o.init + " is " + output +
+                       ", which this run writes: copy it, or give --out another directory";
     std::vector<Named> written;
     if (!o.checkpoint.empty()) written.push_back({"--checkpoint", o.checkpoint});
     if (!o.wisdom.empty()) written.push_back({"--wisdom", o.wisdom});
