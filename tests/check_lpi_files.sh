@@ -155,6 +155,19 @@ if [ "$have_se" = 1 ]; then
         no_temporaries "$out/h5set"
     fi
 fi
+# A CSV that cannot be written with a checkpoint stops the run (it went on,
+# the checkpoint ahead of the CSV), and the CSV reaches the checkpoint left:
+# resumed, the run's CSV is the uninterrupted run's (no new file started at
+# the checkpoint's step, the rows before it and the energy at step 0 lost).
+set -- run rigid-body --steps 1000 --every 1 --checkpoint-every 1 --format npy
+"$lpi" "$@" --out "$out/ck-whole" >/dev/null
+rc=0; limited "$@" --out "$out/ck-full" --checkpoint "$out/ck-full.lpi" >"$out/stdout" 2>"$out/stderr" || rc=$?
+[ "$rc" -eq 1 ] && grep -q "rigid-body.csv.*File too large" "$out/stderr" && ! grep -q "^done" "$out/stdout" ||
+    { cat "$out/stderr"; fail "a CSV that cannot be written with its checkpoint: exit status $rc, expected 1 at once"; }
+"$lpi" "$@" --out "$out/ck-full" --resume "$out/ck-full.lpi" >"$out/stdout"
+! grep -q "no row at step" "$out/stdout" || { cat "$out/stdout"; fail "the CSV left does not reach the checkpoint"; }
+cmp -s "$out/ck-whole/rigid-body.csv" "$out/ck-full/rigid-body.csv" ||
+    fail "a run stopped by a CSV it could not write, resumed: not the uninterrupted run's CSV"
 # Modes: a replaced file keeps its own, a new one gets the umask's; a FIFO
 # at an output is refused before the work, and stays a FIFO.
 formats=npy

@@ -381,6 +381,12 @@ int run_command(int argc, char **argv) {
         if (stat(parent.c_str(), &dir) == 0 || errno != ENOENT) no_output = output_problem(outputs[i]);
         if (!no_output.empty()) no_output = "lpi run: " + no_output;
     }
+    // The checkpoint too: its first save follows a write of the CSV, which a
+    // checkpoint that cannot be made must not have replaced.
+    if (no_output.empty() && writes_output() && !o.checkpoint.empty()) {
+        no_output = output_problem(o.checkpoint);
+        if (!no_output.empty()) no_output = "lpi run: --checkpoint: " + no_output;
+    }
     if (const int agreed = agreed_failure(!no_output.empty(), no_output)) return agreed;
     std::vector<CsvRow> kept;
     if (!o.resume.empty()) {
@@ -470,18 +476,27 @@ int run_command(int argc, char **argv) {
         data.snapshot_time.push_back(lpi_time(sys));
     };
     // A checkpoint that cannot be written stops the run: going on would lose
-    // it. `status` is lpi_save's (rank 0 alone may save one), agreed by all.
-    // The CSV follows each checkpoint saved.
-    auto checkpoint_saved = [&](int status, const lpi_system *state, int64_t step) {
-        const std::string why = status == LPI_OK ? write_csv()
+    // it; and so does the CSV written with it. The CSV goes first, so that a
+    // run stopped between the two (a failure, a kill) leaves a CSV that
+    // reaches the checkpoint it resumes from (--resume replaces the rows past
+    // it; a CSV without the checkpoint's row would be started anew). The
+    // checkpoint's path is probed before the run. `save_file` runs lpi_save
+    // (rank 0 alone may save one) and names the system saved; each outcome
+    // is agreed by all.
+    auto write_checkpoint = [&](int64_t step, const std::function<int(const lpi_system *&)> &save_file) {
+        const std::string no_csv = write_csv();
+        if (const int agreed = agreed_failure(!no_csv.empty(), no_csv)) std::exit(agreed);
+        const lpi_system *saved = sys;
+        const int status = save_file(saved);
+        const std::string why = status == LPI_OK ? ""
                                                  : format("lpi run: checkpoint not written at step %lld: %s",
-                                                          static_cast<long long>(step), lpi_last_error(state));
+                                                          static_cast<long long>(step), lpi_last_error(saved));
         if (const int agreed = agreed_failure(status != LPI_OK, why)) std::exit(agreed);
     };
     auto save = [&](int64_t step, bool always) {
         if (o.checkpoint.empty()) return;
         if (!always && (o.checkpoint_every <= 0 || row_index(step) % o.checkpoint_every != 0)) return;
-        checkpoint_saved(lpi_save(sys, o.checkpoint.c_str()), sys, step);
+        write_checkpoint(step, [&](const lpi_system *&) { return lpi_save(sys, o.checkpoint.c_str()); });
     };
     const std::vector<Attribute> attributes = {
         {"scene", o.scene, 0.0, true},
@@ -563,13 +578,14 @@ int run_command(int argc, char **argv) {
     progress.finish();
     if (stopped_between_rows && !o.checkpoint.empty()) {
         Handle at_call_start;  // one process's system: rank 0 alone saves it
-        int status = LPI_OK;
-        if (writes_output()) {
-            status = lpi_load_buffer(at_call_start.out(), call_start_checkpoint.data(),
-                                     call_start_checkpoint.size());
+        write_checkpoint(done, [&](const lpi_system *&saved) {
+            if (!writes_output()) return static_cast<int>(LPI_OK);
+            int status = lpi_load_buffer(at_call_start.out(), call_start_checkpoint.data(),
+                                         call_start_checkpoint.size());
+            saved = at_call_start.get();
             if (status == LPI_OK) status = lpi_save(at_call_start.get(), o.checkpoint.c_str());
-        }
-        checkpoint_saved(status, at_call_start.get(), done);
+            return status;
+        });
     } else if (!stopped_between_rows) {
         save(done, true);
     }
