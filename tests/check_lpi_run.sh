@@ -257,6 +257,13 @@ for every in 1 3; do
     head -c 128 "$out/stale/rigid-body/snapshot_step.npy" | grep -q "'shape': (2,)" ||
         { echo "--resume over the data of another run (--every $every): its snapshots were kept"; exit 1; }
 done
+# A CSV replaced since by another run's (another --inertia, the same steps
+# and times): its rows up to the checkpoint are not this run's, and would be
+# spliced in, the energy errors relative to the other run's energy.
+rm -rf "$out/stale"
+"$lpi" run rigid-body --inertia 2,3,5 --steps 10 --every 5 --out "$out/stale" --checkpoint "$out/stale.lpi" >/dev/null
+"$lpi" run rigid-body --inertia 1,2,3 --steps 10 --every 5 --out "$out/stale" >/dev/null
+refused "another run" run rigid-body --inertia 2,3,5 --steps 20 --every 5 --out "$out/stale" --resume "$out/stale.lpi"
 
 # Ctrl-C: SIGINT stops a long run through the library's observer within a
 # few steps, even inside one long lpi_step call: status 130, a complete last

@@ -405,6 +405,17 @@ int run_command(int argc, char **argv) {
                                      "interrupted run",
                                      lpi_time(sys), static_cast<long long>(start), dt, csv.c_str(), time_then);
         if (const int agreed = agreed_failure(status, why)) return agreed;
+        // And its energy (written from the same state, with 17 digits; the
+        // margin for a sum over another number of processes): another energy
+        // there is another run's CSV, whose rows would be spliced in.
+        const double H = energy_of(sys);  // collective
+        const double H_then = kept.empty() ? H : kept.back().energy;
+        if (std::fabs(H_then - H) > 1e-12 * std::max(std::fabs(H_then), std::fabs(H)))
+            status = 2, why = format("lpi run: --resume: %s has the energy %.17g at step %lld, but the checkpoint's "
+                                     "state has %.17g: the CSV is another run's (remove it to start it anew at "
+                                     "that step)",
+                                     csv.c_str(), H_then, static_cast<long long>(start), H);
+        if (const int agreed = agreed_failure(status, why)) return agreed;
     }
     // The references of the errors and drifts: the first row of the CSV
     // when resuming (step 0, or the step a new file started at; to the bit:
