@@ -34,7 +34,14 @@ public:
         put(static_cast<std::uint32_t>(s.size()));
         bytes_.insert(bytes_.end(), s.begin(), s.end());
     }
-    void put_doubles32(const std::vector<double> &v) {
+    void put_doubles32(const std::vector<double> &v, const char *what) {
+        // A count of 2^32 or more would be written modulo 2^32: a file that
+        // saves but never loads (sine-Euler N >= 37838 with its own
+        // Hamiltonian has 1 + 3 N^2 parameters).
+        if (v.size() > std::numeric_limits<std::uint32_t>::max())
+            fail(LPI_ERR_UNSUPPORTED, "cannot checkpoint " + std::to_string(v.size()) + " " + what +
+                                          ": format version " + std::to_string(kCheckpointVersion) +
+                                          " stores at most 2^32 - 1");
         put(static_cast<std::uint32_t>(v.size()));
         for (double x : v) put(x);
     }
@@ -234,10 +241,10 @@ std::vector<unsigned char> encode_checkpoint(const System &system) {
     w.put(kCheckpointVersion);
     w.put(std::uint64_t{0});  // total size, filled in below
     w.put_string(model.kind());
-    w.put_doubles32(parameters);
+    w.put_doubles32(parameters, "parameters");
     w.put_string(model.split());
     w.put_string(system.method().name);
-    w.put_doubles32(system.method().gammas);
+    w.put_doubles32(system.method().gammas, "composition weights");
     w.put(system.implicit_settings().tolerance);
     w.put(static_cast<std::int32_t>(system.implicit_settings().max_iterations));
     w.put(system.time());
