@@ -137,7 +137,7 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
 }
 
 // The snapshots of the interrupted run up to `start`, from its data; a note
-// on stdout (not an error) when they cannot be read.
+// on stdout (not an error) when they cannot be read or are another run's.
 std::string keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunData &d) {
     Array row_steps, row_times, row_energies;
     std::string why;  // why the data's snapshots are not this run's
