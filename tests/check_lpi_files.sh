@@ -14,6 +14,8 @@
 #    so does standard output) and leaves no temporary file; a replaced file
 #    keeps its mode, a new one gets the umask's; a FIFO where an output
 #    goes is refused, not replaced;
+#  - a failure after the run has gathered data (a checkpoint save or the
+#    CSV failing mid-run, the CSV at the end) still writes the data;
 #  - --checkpoint that cannot work (moments) or names an output of the run
 #    is refused (2) and one that fails leaves the old CSV; --resume with
 #    another --dt is refused (2); --init refuses a FIFO (1) at once;
@@ -168,6 +170,43 @@ rc=0; limited "$@" --out "$out/ck-full" --checkpoint "$out/ck-full.lpi" >"$out/s
 ! grep -q "no row at step" "$out/stdout" || { cat "$out/stdout"; fail "the CSV left does not reach the checkpoint"; }
 cmp -s "$out/ck-whole/rigid-body.csv" "$out/ck-full/rigid-body.csv" ||
     fail "a run stopped by a CSV it could not write, resumed: not the uninterrupted run's CSV"
+# Its data too: the stopped run wrote it (it exited without, and the
+# snapshots before the checkpoint, in memory alone, were lost).
+diff -r "$out/ck-whole/rigid-body" "$out/ck-full/rigid-body" >/dev/null ||
+    fail "a run stopped by a CSV it could not write, resumed: not the uninterrupted run's data"
+# A checkpoint save that fails after the first stops the run (exit status 1)
+# with its data written: the snapshots since the start (or the checkpoint
+# resumed from) were in memory alone, and were lost. The checkpoint's
+# directory is moved away once the first save is there (a checkpoint does
+# not grow, so ulimit -f cannot fail a later save alone; root writes
+# through a mode). Resumed, the run is the uninterrupted one, data included.
+rm -rf "$out/ck-dir" "$out/ck-dir.gone" "$out/ck-gone" "$out/ck-ref"; mkdir -p "$out/ck-dir"
+set -- run rigid-body --dt 0.01 --every 100000 --snapshots 1 --checkpoint-every 1 --format npy
+timeout 60 "$lpi" "$@" --steps 1000000000 --out "$out/ck-gone" --checkpoint "$out/ck-dir/run.lpi" \
+    >"$out/stdout" 2>"$out/stderr" &
+pid=$!
+waited=0
+until [ -f "$out/ck-dir/run.lpi" ] || [ $waited -ge 600 ]; do sleep 0.05; waited=$((waited + 1)); done
+mv "$out/ck-dir" "$out/ck-dir.gone"
+rc=0; wait $pid || rc=$?
+[ "$rc" -eq 1 ] && grep -q "checkpoint not written at step" "$out/stderr" ||
+    { cat "$out/stderr"; fail "a checkpoint save that failed mid-run: exit status $rc, expected 1"; }
+[ -f "$out/ck-gone/rigid-body/state.npy" ] || fail "a checkpoint save that failed mid-run: no data written"
+stop=$(tail -n 1 "$out/ck-gone/rigid-body.csv" | cut -d, -f1)
+mv "$out/ck-dir.gone" "$out/ck-dir"
+"$lpi" "$@" --steps $((stop + 300000)) --out "$out/ck-gone" --resume "$out/ck-dir/run.lpi" >/dev/null
+"$lpi" "$@" --steps $((stop + 300000)) --out "$out/ck-ref" >/dev/null
+cmp -s "$out/ck-ref/rigid-body.csv" "$out/ck-gone/rigid-body.csv" &&
+    diff -r "$out/ck-ref/rigid-body" "$out/ck-gone/rigid-body" >/dev/null ||
+    fail "a run stopped by a failed checkpoint save, resumed: not the uninterrupted run"
+# A CSV that cannot be written at the end does not keep the data from being
+# written (it was not tried): the data, where the snapshots are, fits.
+rc=0; limited run rigid-body --steps 1000 --every 1 --format npy --out "$out/csv-only" >/dev/null 2>"$out/stderr" ||
+    rc=$?
+[ "$rc" -eq 1 ] && grep -q "rigid-body.csv.*File too large" "$out/stderr" ||
+    { cat "$out/stderr"; fail "a CSV too large to write at the end: exit status $rc, expected 1"; }
+head -c 128 "$out/csv-only/rigid-body/step.npy" 2>/dev/null | grep -q "'shape': (1001,)" ||
+    fail "a CSV too large to write at the end: the data was not written"
 # Modes: a replaced file keeps its own, a new one gets the umask's; a FIFO
 # at an output is refused before the work, and stays a FIFO.
 formats=npy

@@ -470,45 +470,6 @@ int run_command(int argc, char **argv) {
         const std::string why = write_output(csv, csv_text());
         return why.empty() ? "" : "lpi run: " + why;
     };
-    auto record = [&](int64_t step, double H, const std::vector<double> &c) { add_row(step, lpi_time(sys), H, c); };
-    auto row = [&](int64_t step) {
-        const double H = energy_of(sys);  // collective: every process writes every row
-        record(step, H, casimirs_of(sys));
-    };
-    auto snapshot = [&](int64_t step) {
-        if (o.snapshot_every <= 0 || row_index(step) % o.snapshot_every != 0) return;
-        const std::size_t size = data.snapshot_size(), at = data.snapshots.size();
-        data.snapshots.resize(at + size);
-        if (data.vorticity)
-            check(lpi_sine_euler_get_grid(sys, &data.snapshots[at], size), sys, "get grid");
-        else
-            check(lpi_get_state(sys, &data.snapshots[at], size), sys, "get state");
-        data.snapshot_step.push_back(static_cast<double>(step));
-        data.snapshot_time.push_back(lpi_time(sys));
-    };
-    // A checkpoint that cannot be written stops the run: going on would lose
-    // it; and so does the CSV written with it. The CSV goes first, so that a
-    // run stopped between the two (a failure, a kill) leaves a CSV that
-    // reaches the checkpoint it resumes from (--resume replaces the rows past
-    // it; a CSV without the checkpoint's row would be started anew). The
-    // checkpoint's path is probed before the run. `save_file` runs lpi_save
-    // (rank 0 alone may save one) and names the system saved; each outcome
-    // is agreed by all.
-    auto write_checkpoint = [&](int64_t step, const std::function<int(const lpi_system *&)> &save_file) {
-        const std::string no_csv = write_csv();
-        if (const int agreed = agreed_failure(!no_csv.empty(), no_csv)) std::exit(agreed);
-        const lpi_system *saved = sys;
-        const int status = save_file(saved);
-        const std::string why = status == LPI_OK ? ""
-                                                 : format("lpi run: checkpoint not written at step %lld: %s",
-                                                          static_cast<long long>(step), lpi_last_error(saved));
-        if (const int agreed = agreed_failure(status != LPI_OK, why)) std::exit(agreed);
-    };
-    auto save = [&](int64_t step, bool always) {
-        if (o.checkpoint.empty()) return;
-        if (!always && (o.checkpoint_every <= 0 || row_index(step) % o.checkpoint_every != 0)) return;
-        write_checkpoint(step, [&](const lpi_system *&) { return lpi_save(sys, o.checkpoint.c_str()); });
-    };
     const std::vector<Attribute> attributes = {
         {"scene", o.scene, 0.0, true},
         {"method", method, 0.0, true},
@@ -528,6 +489,76 @@ int run_command(int argc, char **argv) {
         if (why.empty()) return "";
         return format("lpi run: the data %s was not written: %s", data_path(o).c_str(), why.c_str());
     };
+    Progress progress(start, end);
+    // A failure once the run has gathered rows and snapshots stops it with
+    // exit status `status` (its message printed already), but not before
+    // they are written: the data (and, with `with_csv`, the CSV; not where
+    // the CSV is what failed), each as far as it can be, whatever the other
+    // does. Nothing here is collective: rank 0 writes, every process exits.
+    auto stop_keeping_data = [&](int status, int64_t step, bool with_csv) {
+        progress.finish();
+        std::string why = with_csv ? write_csv() : "";
+        const std::string no_data = keep_data();
+        if (!no_data.empty()) why += (why.empty() ? "" : "\n") + no_data;
+        if (!why.empty())
+            std::fprintf(stderr, "%s\n", why.c_str());
+        else if (writes_output())
+            std::fprintf(stderr, "lpi run: the rows and snapshots up to step %lld are in %s\n",
+                         static_cast<long long>(step), data_path(o).c_str());
+        std::exit(status);
+    };
+    // A library call of the run that fails: its message, then as above.
+    auto checked = [&](int status, const char *what, int64_t step) {
+        if (status == LPI_OK) return;
+        std::fprintf(stderr, "lpi run: %s failed at step %lld: %s (%s)\n", what, static_cast<long long>(step),
+                     lpi_last_error(sys), lpi_status_name(status));
+        stop_keeping_data(1, step, true);
+    };
+    auto record = [&](int64_t step, double H, const std::vector<double> &c) { add_row(step, lpi_time(sys), H, c); };
+    auto row = [&](int64_t step) {
+        double H = 0.0;  // collective: every process writes every row
+        checked(lpi_energy(sys, &H), "energy", step);
+        std::vector<double> c(lpi_casimir_count(sys));
+        checked(lpi_casimirs(sys, c.data(), c.size()), "casimirs", step);
+        record(step, H, c);
+    };
+    auto snapshot = [&](int64_t step) {
+        if (o.snapshot_every <= 0 || row_index(step) % o.snapshot_every != 0) return;
+        const std::size_t size = data.snapshot_size(), at = data.snapshots.size();
+        data.snapshots.resize(at + size);
+        const int status = data.vorticity ? lpi_sine_euler_get_grid(sys, &data.snapshots[at], size)
+                                          : lpi_get_state(sys, &data.snapshots[at], size);
+        if (status != LPI_OK) data.snapshots.resize(at);  // the snapshots taken are kept
+        checked(status, data.vorticity ? "get grid" : "get state", step);
+        data.snapshot_step.push_back(static_cast<double>(step));
+        data.snapshot_time.push_back(lpi_time(sys));
+    };
+    // A checkpoint that cannot be written stops the run: going on would lose
+    // it; and so does the CSV written with it. The CSV goes first, so that a
+    // run stopped between the two (a failure, a kill) leaves a CSV that
+    // reaches the checkpoint it resumes from (--resume replaces the rows past
+    // it; a CSV without the checkpoint's row would be started anew). Either
+    // way the data is written before the run exits (stop_keeping_data): the
+    // rows and snapshots gathered since the last checkpoint are only in
+    // memory, and --resume keeps those up to its checkpoint's step. The
+    // checkpoint's path is probed before the run. `save_file` runs lpi_save
+    // (rank 0 alone may save one) and names the system saved; each outcome
+    // is agreed by all.
+    auto write_checkpoint = [&](int64_t step, const std::function<int(const lpi_system *&)> &save_file) {
+        const std::string no_csv = write_csv();
+        if (const int agreed = agreed_failure(!no_csv.empty(), no_csv)) stop_keeping_data(agreed, step, false);
+        const lpi_system *saved = sys;
+        const int status = save_file(saved);
+        const std::string why = status == LPI_OK ? ""
+                                                 : format("lpi run: checkpoint not written at step %lld: %s",
+                                                          static_cast<long long>(step), lpi_last_error(saved));
+        if (const int agreed = agreed_failure(status != LPI_OK, why)) stop_keeping_data(agreed, step, false);
+    };
+    auto save = [&](int64_t step, bool always) {
+        if (o.checkpoint.empty()) return;
+        if (!always && (o.checkpoint_every <= 0 || row_index(step) % o.checkpoint_every != 0)) return;
+        write_checkpoint(step, [&](const lpi_system *&) { return lpi_save(sys, o.checkpoint.c_str()); });
+    };
 
     std::printf("lpi run %s: steps %lld to %lld of %g with %s, output every %lld steps\n", o.scene.c_str(),
                 static_cast<long long>(start), static_cast<long long>(end), dt, method.c_str(),
@@ -541,7 +572,6 @@ int run_command(int argc, char **argv) {
     if (kept.empty()) record(start, H0, C0);
     save(start, true);
     if (o.resume.empty()) snapshot(0);
-    Progress progress(start, end);
     Watch watch;
     watch.progress = &progress;
     check(lpi_set_observer(sys, observation_interval(sys), watch_steps, &watch), sys, "set observer");
@@ -557,9 +587,9 @@ int run_command(int argc, char **argv) {
         const int64_t next = std::min(end, (done / every + 1) * every);
         if (!o.checkpoint.empty()) {
             std::size_t size = 0;
-            check(lpi_save_buffer(sys, nullptr, 0, &size), sys, "checkpoint size");
+            checked(lpi_save_buffer(sys, nullptr, 0, &size), "checkpoint size", done);
             call_start_checkpoint.resize(size);
-            check(lpi_save_buffer(sys, call_start_checkpoint.data(), size, &size), sys, "checkpoint");
+            checked(lpi_save_buffer(sys, call_start_checkpoint.data(), size, &size), "checkpoint", done);
         }
         watch.call_start = done;
         int status = lpi_step(sys, dt, next - done);
@@ -600,9 +630,11 @@ int run_command(int argc, char **argv) {
     } else if (!stopped_between_rows) {
         save(done, true);
     }
-    // Rank 0 alone writes the CSV and the data.
+    // Rank 0 alone writes the CSV and the data: each, whether or not the
+    // other could be (the data holds the snapshots, the CSV does not).
     std::string why = write_csv();
-    if (why.empty()) why = keep_data();
+    const std::string no_data = keep_data();
+    if (!no_data.empty()) why += (why.empty() ? "" : "\n") + no_data;
     if (const int agreed = agreed_failure(!why.empty(), why)) return agreed;
     const double H = energy_of(sys);
     if (interrupted_by) {
