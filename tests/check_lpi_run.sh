@@ -264,6 +264,48 @@ rm -rf "$out/stale"
 "$lpi" run rigid-body --inertia 2,3,5 --steps 10 --every 5 --out "$out/stale" --checkpoint "$out/stale.lpi" >/dev/null
 "$lpi" run rigid-body --inertia 1,2,3 --steps 10 --every 5 --out "$out/stale" >/dev/null
 refused "another run" run rigid-body --inertia 2,3,5 --steps 20 --every 5 --out "$out/stale" --resume "$out/stale.lpi"
+# Data that is there but cannot be read back (cut short, not data at all,
+# or a header claiming more than the readers' cap of 2^28 values) is not
+# replaced by the resumed run, which dropped it with a note and lost the
+# snapshots in it: refused (1) naming the file, every file left as it was.
+rm -rf "$out/unread"
+set -- rigid-body --every 5 --snapshots 1 --format npy --out "$out/unread"
+"$lpi" run "$@" --steps 20 --checkpoint "$out/unread.lpi" >/dev/null
+data="$out/unread/rigid-body"
+cp "$data/state.npy" "$out/state.npy"
+dict="{'descr': '<f8', 'fortran_order': False, 'shape': (100000000, 3), }"
+pad=$((128 - 10 - ${#dict} - 1))
+unreadable() {  # unreadable FILE MESSAGE-PART lpi-run-arguments...: --resume refused, the files kept
+    file=$1 what=$2; shift 2
+    (cd "$out/unread" && find . -type f -exec md5sum {} + > "$out/unread.md5")
+    rc=0; "$lpi" run "$@" --steps 30 --resume "$out/unread.lpi" >/dev/null 2>"$out.err" || rc=$?
+    [ "$rc" -eq 1 ] && grep -q "$file cannot be read back ($what" "$out.err" ||
+        { echo "--resume, $file damaged ($what): exit status $rc, expected 1"; cat "$out.err"; exit 1; }
+    (cd "$out/unread" && md5sum -c --quiet "$out/unread.md5") ||
+        { echo "--resume, $file damaged ($what): a file was replaced"; exit 1; }
+}
+for damage in cut text claim; do
+    case $damage in
+    cut) head -c 100 "$out/state.npy" ;;
+    text) echo "not data" ;;
+    claim) printf '\223NUMPY\001\000\166\000%s%*s\n' "$dict" "$pad" ""; head -c 48 /dev/zero ;;
+    esac > "$data/state.npy"
+    case $damage in cut) what=truncated ;; text) what="not a NumPy" ;; claim) what="more than 2^28 values" ;; esac
+    unreadable "$data" "state.npy: $what" "$@"
+done
+cp "$out/state.npy" "$data/state.npy"
+if "$lpi" run rigid-body --steps 1 --format h5 --out "$out/probe" >/dev/null 2>&1; then
+    rm -rf "$out/unread"
+    set -- rigid-body --every 5 --snapshots 1 --format h5 --out "$out/unread"
+    "$lpi" run "$@" --steps 20 --checkpoint "$out/unread.lpi" >/dev/null
+    head -c 3000 "$out/unread/rigid-body.h5" > "$out/cut.h5"; mv "$out/cut.h5" "$out/unread/rigid-body.h5"
+    unreadable "$out/unread/rigid-body.h5" "HDF5 cannot open" "$@"
+fi
+# Moved aside, the run resumes without them, as it does without data.
+mv "$out/unread/rigid-body.h5" "$out/unread.h5" 2>/dev/null || mv "$data" "$out/unread.npy"
+"$lpi" run "$@" --steps 30 --resume "$out/unread.lpi" >"$out.out" 2>"$out.err" ||
+    { echo "--resume, the damaged data moved aside: refused"; cat "$out.err"; exit 1; }
+grep -q "no data there" "$out.out" || { echo "--resume without data: no note"; cat "$out.out"; exit 1; }
 
 # Ctrl-C: SIGINT stops a long run through the library's observer within a
 # few steps, even inside one long lpi_step call: status 130, a complete last

@@ -438,8 +438,9 @@ int run_command(int argc, char **argv) {
     if (!kept.empty()) H0 = kept.front().energy, C0 = kept.front().casimirs;
     for (const CsvRow &r : kept) add_row(r.step, r.time, r.energy, r.casimirs);
     if (!o.resume.empty()) {
-        const std::string why = keep_snapshots(o, start, lpi_time(sys), data);
-        if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
+        std::string why;
+        const int status = keep_snapshots(o, start, lpi_time(sys), data, why);
+        if (const int agreed = agreed_failure(status, why)) return agreed;
         if (kept.empty())
             std::printf("%s has no row at step %lld: a new file, energy error relative to step %lld\n",
                         csv.c_str(), static_cast<long long>(start), static_cast<long long>(start));

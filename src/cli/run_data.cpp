@@ -68,7 +68,10 @@ std::vector<Dataset> datasets_of(const RunData &d) {
 // One array of a run's earlier data, in this run's format.
 std::string read_data_array(const RunOptions &o, const std::string &name, Array &a) {
     const std::string path = data_path(o);
-    if (o.format == "npy") return read_npy(path + "/" + name + ".npy", a);
+    if (o.format == "npy") {
+        const std::string why = read_npy(path + "/" + name + ".npy", a);
+        return why.empty() ? "" : name + ".npy: " + why;
+    }
     bool found = false;
     return read_hdf5(path, name, a, &found);
 }
@@ -137,65 +140,94 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
 }
 
 // The snapshots of the interrupted run up to `start`, from its data; a note
-// on stdout (not an error) when they cannot be read or are another run's.
-std::string keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunData &d) {
+// on stdout (not an error) when there is no data or it is another run's.
+// Data that is there but cannot be read back is refused (status 1): the run
+// would replace it, and the snapshots in it would be lost.
+int keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunData &d, std::string &refusal) {
+    refusal.clear();
+    // No file of the data there (a run killed before it wrote any): nothing
+    // to keep, and nothing that writing the data replaces.
+    bool there = false;
+    for (const std::string &file : data_files(o, d)) {
+        struct stat st;
+        if (stat(file.c_str(), &st) == 0 || errno != ENOENT) there = true;
+    }
+    auto unreadable = [&](const std::string &why) {
+        refusal = format("lpi run: --resume: the data %s cannot be read back (%s): resumed, the run would "
+                         "replace it, and the snapshots up to step %lld in it would be lost; move it aside (or "
+                         "remove it) to resume without them",
+                         data_path(o).c_str(), why.c_str(), static_cast<long long>(start));
+        return 1;
+    };
+    auto read = [&](const char *name, Array &a) { return there ? read_data_array(o, name, a) : std::string(); };
     Array row_steps, row_times, row_energies;
     std::string why;  // why the data's snapshots are not this run's
-    if (read_data_array(o, "step", row_steps).empty() && read_data_array(o, "time", row_times).empty() &&
-        read_data_array(o, "energy", row_energies).empty() && row_steps.values.size() == row_times.values.size() &&
-        row_steps.values.size() == row_energies.values.size()) {
-        for (std::size_t i = 0; i < row_steps.values.size() && why.empty(); ++i) {
-            const double step = row_steps.values[i];
-            if (step > static_cast<double>(start)) continue;
-            if (d.step.empty()) {
-                // No CSV: the data's row at the checkpoint's step holds its
-                // time, as the CSV's does (run.cpp): another time there is
-                // another --dt.
-                if (step == static_cast<double>(start) && row_times.values[i] != start_time)
-                    return format("lpi run: --resume: the checkpoint's time %.17g is step %lld of this run's --dt, "
-                                  "but %s has t = %.17g at that step: resume with the options of the interrupted "
-                                  "run",
-                                  start_time, static_cast<long long>(start), data_path(o).c_str(),
-                                  row_times.values[i]);
-                continue;
+    for (auto *array : {&row_steps, &row_times, &row_energies}) {
+        const char *name = array == &row_steps ? "step" : array == &row_times ? "time" : "energy";
+        const std::string wrong = read(name, *array);
+        if (!wrong.empty()) return unreadable(wrong);
+    }
+    if (row_steps.values.size() != row_times.values.size() || row_steps.values.size() != row_energies.values.size())
+        return unreadable("its arrays step, time and energy differ in length");
+    for (std::size_t i = 0; i < row_steps.values.size() && why.empty(); ++i) {
+        const double step = row_steps.values[i];
+        if (step > static_cast<double>(start)) continue;
+        if (d.step.empty()) {
+            // No CSV: the data's row at the checkpoint's step holds its
+            // time, as the CSV's does (run.cpp): another time there is
+            // another --dt.
+            if (step == static_cast<double>(start) && row_times.values[i] != start_time) {
+                refusal = format("lpi run: --resume: the checkpoint's time %.17g is step %lld of this run's --dt, "
+                                 "but %s has t = %.17g at that step: resume with the options of the interrupted "
+                                 "run",
+                                 start_time, static_cast<long long>(start), data_path(o).c_str(),
+                                 row_times.values[i]);
+                return 2;
             }
-            // The CSV's rows (in d) are this run's: they hold the checkpoint's
-            // time. Data whose rows at the same steps differ is another run's,
-            // left there by a run killed before it wrote its own data.
-            const auto at = std::lower_bound(d.step.begin(), d.step.end(), step);
-            if (at == d.step.end() || *at != step) continue;
-            const std::size_t row = static_cast<std::size_t>(at - d.step.begin());
-            if (std::memcmp(&d.time[row], &row_times.values[i], sizeof(double)) != 0 ||
-                std::memcmp(&d.energy[row], &row_energies.values[i], sizeof(double)) != 0)
-                why = format("its row at step %lld is not that of the CSV: it is the data of another run",
-                             static_cast<long long>(step));
+            continue;
         }
+        // The CSV's rows (in d) are this run's: they hold the checkpoint's
+        // time. Data whose rows at the same steps differ is another run's,
+        // left there by a run killed before it wrote its own data.
+        const auto at = std::lower_bound(d.step.begin(), d.step.end(), step);
+        if (at == d.step.end() || *at != step) continue;
+        const std::size_t row = static_cast<std::size_t>(at - d.step.begin());
+        if (std::memcmp(&d.time[row], &row_times.values[i], sizeof(double)) != 0 ||
+            std::memcmp(&d.energy[row], &row_energies.values[i], sizeof(double)) != 0)
+            why = format("its row at step %lld is not that of the CSV: it is the data of another run",
+                         static_cast<long long>(step));
     }
     Array steps, times, shots;
-    if (why.empty()) why = read_data_array(o, "snapshot_step", steps);
-    if (why.empty()) why = read_data_array(o, "snapshot_time", times);
-    if (why.empty()) why = read_data_array(o, d.vorticity ? "vorticity" : "state", shots);
+    for (auto *array : {&steps, &times, &shots}) {
+        const char *name = array == &steps ? "snapshot_step" : array == &times ? "snapshot_time"
+                           : d.vorticity                   ? "vorticity"
+                                                           : "state";
+        const std::string wrong = read(name, *array);
+        if (!wrong.empty()) return unreadable(wrong);
+    }
+    if (!there) why = "no data there";
     const std::size_t n = steps.values.size();
     if (why.empty() && (times.values.size() != n || shots.values.size() != n * d.snapshot_size()))
         why = "its snapshot arrays do not match this run";
     // The steps become 64-bit integers (the images' names, the data's
-    // /snapshot_step): whole, increasing and in range, or none is kept.
+    // /snapshot_step): whole, increasing and in range; data lpi wrote has
+    // no others.
     for (std::size_t k = 0; k < n && why.empty(); ++k) {
         const double step = steps.values[k], before = k ? steps.values[k - 1] : -1.0;
         if (!(step >= 0.0 && step < 0x1p62 && step == std::trunc(step) && step > before &&
               std::isfinite(times.values[k])))
-            why = format("its snapshot %zu has no whole step in order or no finite time", k);
+            return unreadable(format("its snapshot %zu has no whole step in order or no finite time", k));
     }
     if (!why.empty()) {
         std::printf("%s: %s; the data keeps the snapshots from step %lld on\n", data_path(o).c_str(),
                     why.c_str(), static_cast<long long>(start));
-        return "";
+        return 0;
     }
     d.snapshot_step = steps.values;
     d.snapshot_time = times.values;
     d.snapshots = shots.values;
     d.keep_up_to(start);
-    return "";
+    return 0;
 }
 
 

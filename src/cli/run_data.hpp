@@ -62,11 +62,13 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
                        SnapshotBytes &bytes);
 
 // The snapshots of the interrupted run up to `start`, from its data; a note
-// on stdout (not an error) when they cannot be read or the data's rows are
-// not the CSV's kept in `d` (another run's data). Returns "", or, without a
-// CSV, why the data is not that of this run (its time at `start` is not
-// `start_time`).
-std::string keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunData &d);
+// on stdout (not an error) when there is no data or its rows are not the
+// CSV's kept in `d` (another run's data). Returns 0, or the exit status with
+// the message in `refusal`: 1 when data is there but cannot be read back
+// (damaged, or over the readers' cap of 2^28 values per array), for the run
+// would replace it and lose its snapshots; 2, without a CSV, when the data
+// is not that of this run (its time at `start` is not `start_time`).
+int keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunData &d, std::string &refusal);
 
 // The initial grid of --init into `grid`, checked against the system's N:
 // 0, or the exit status with the message in `why` (each process reads the
