@@ -300,6 +300,17 @@ if "$lpi" run rigid-body --steps 1 --format h5 --out "$out/probe" >/dev/null 2>&
     "$lpi" run "$@" --steps 20 --checkpoint "$out/unread.lpi" >/dev/null
     head -c 3000 "$out/unread/rigid-body.h5" > "$out/cut.h5"; mv "$out/cut.h5" "$out/unread/rigid-body.h5"
     unreadable "$out/unread/rigid-body.h5" "HDF5 cannot open" "$@"
+    # /state's dimensions (5, 3), and its maximum ones, made (10^8, 3): over the cap.
+    "$lpi" run "$@" --steps 20 --checkpoint "$out/unread.lpi" >/dev/null
+    zeros='\x00\x00\x00\x00\x00\x00\x00'
+    if at=$(LC_ALL=C grep -obUaP "\\x05$zeros\\x03$zeros" "$out/unread/rigid-body.h5" | cut -d: -f1) &&
+        [ -n "$at" ]; then
+        for offset in $at; do
+            printf '\000\341\365\005\000\000\000\000' |
+                dd of="$out/unread/rigid-body.h5" bs=1 seek="$offset" conv=notrunc 2>/dev/null
+        done
+        unreadable "$out/unread/rigid-body.h5" "state has more than 2^28 values" "$@"
+    fi
 fi
 # Moved aside, the run resumes without them, as it does without data.
 mv "$out/unread/rigid-body.h5" "$out/unread.h5" 2>/dev/null || mv "$data" "$out/unread.npy"
