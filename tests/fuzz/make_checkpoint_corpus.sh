@@ -2,7 +2,8 @@
 # Regenerates tests/fuzz/corpus_checkpoint: a small checkpoint of every kind
 # that can be saved, written by the lpi CLI of a build (default ./build), and
 # through the Python binding what the CLI does not set (a custom composition,
-# another split, implicit settings).
+# another split, implicit settings). The files NAME_v1 are kept from format
+# version 1 (no time carry), which the library still reads.
 #   tests/fuzz/make_checkpoint_corpus.sh [BUILD_DIR]
 set -eu
 root="$(cd "$(dirname "$0")/../.." && pwd)"
