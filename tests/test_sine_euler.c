@@ -255,12 +255,9 @@ static void test_one_step_composite_large_factor(void **state) {
 
 /* ---- invariants -------------------------------------------------------- */
 
-/* Sanitizer builds run the long invariant test 5x shorter (same bound). */
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+/* Long enough that a bias of 3e-17 per flow (63 flows a step at N = 31)
+ * would move the spectrum by 8e-12, eight times the bound below. */
 #define LPI_LONG_RUN_STEPS 4000
-#else
-#define LPI_LONG_RUN_STEPS 20000
-#endif
 
 /* Largest change of an eigenvalue of W over `steps` steps of `method`,
  * relative to the largest |eigenvalue|; skips when built without LAPACK. */
@@ -301,9 +298,9 @@ static double spectrum_drift(int N, int64_t steps, double dt, const char *method
 }
 
 /* The flows are unitary and applied without a systematic rescaling, so the
- * Casimirs only wander with round-off of either sign: over 2 x 10^4 leapfrog
+ * Casimirs only wander with round-off of either sign: over 4000 leapfrog
  * steps the spectrum moves by at most 1e-12 (a bias of 3e-17 per flow, 63
- * flows a step, would move it by 4e-11). Prime and composite N. */
+ * flows a step, would move it by 8e-12). Prime and composite N. */
 static void test_spectrum_kept_n31(void **state) {
     (void)state;
     assert_true(spectrum_drift(31, LPI_LONG_RUN_STEPS, 0.05, "leapfrog") <= 1e-12);
