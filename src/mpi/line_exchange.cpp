@@ -32,9 +32,13 @@ std::int64_t cross(std::int64_t x1, std::int64_t x2, std::int64_t y1, std::int64
 }
 
 // The linear map from direction D' = to (d', s') to direction D = from
-// (v, u), and the solutions of gamma s' = c (mod N).
+// (v, u), and the solutions of gamma s' = c (mod N). Per mode it only looks
+// up and adds: the tables (N entries each, in buffers the exchange keeps)
+// are filled once per move, so the enumeration below does no division.
 struct Transition {
-    Transition(const Direction &from, const Direction &to, int n) : N(n) {
+    Transition(const Direction &from, const Direction &to, int n, std::vector<int> &first_solution,
+               std::vector<int> &nu_multiple)
+        : N(n), first_solution_(first_solution.data()), nu_multiple_(nu_multiple.data()) {
         const std::int64_t sigma = from.sigma;
         gamma = modulo(sigma * cross(to.k1, to.k2, from.k1, from.k2), N);
         delta = modulo(sigma * cross(to.j1, to.j2, from.k1, from.k2), N);
@@ -48,20 +52,41 @@ struct Transition {
             const std::int64_t q = r0 / r1, r = r0 - q * r1, t = t0 - q * t1;
             r0 = r1, r1 = r, t0 = t1, t1 = t;
         }
-        inverse = period == 1 ? 0 : modulo(t0, period);
+        const int inverse = period == 1 ? 0 : modulo(t0, period);
+        // first_solution[c] = (c / g) inverse mod period for c a multiple of
+        // g, else -1; nu_multiple[s] = nu s mod N. Both by running sums.
+        std::fill(first_solution_, first_solution_ + N, -1);
+        for (int c = 0, s0 = 0; c < N; c += g) {
+            first_solution_[c] = s0;
+            s0 += inverse;
+            if (s0 >= period) s0 -= period;
+        }
+        for (int s = 0, m = 0; s < N; ++s) {
+            nu_multiple_[s] = m;
+            m += nu;
+            if (m >= N) m -= N;
+        }
     }
-    // Calls f(s') for the s' in 0 .. N-1, ascending, with gamma s' = c (mod N).
+    // Calls f(s') for the s' in 0 .. N-1, ascending, with gamma s' = c (mod
+    // N), for c in 0 .. N-1.
     template <class F>
     void solve(int c, F &&f) const {
-        if (c % g != 0) return;
-        const int s0 = static_cast<int>(static_cast<std::int64_t>(c / g) * inverse % period);
-        for (int s = s0; s < N; s += period) f(s);
+        for (int s = first_solution_[c]; s >= 0 && s < N; s += period) f(s);
     }
     int line_of_new_origin_line(int s) const { return static_cast<int>(static_cast<std::int64_t>(gamma) * s % N); }
-    int element(int d_new, int s_new) const {
-        return static_cast<int>((static_cast<std::int64_t>(mu) * d_new + static_cast<std::int64_t>(nu) * s_new) % N);
+    // Element s' of line d' lies at element (mu d' + nu s') mod N of its
+    // old line: element_base(d') is the first term, element() adds the second.
+    int element_base(int d_new) const { return static_cast<int>(static_cast<std::int64_t>(mu) * d_new % N); }
+    int element(int base, int s_new) const {
+        const int u = base + nu_multiple_[s_new];
+        return u >= N ? u - N : u;
     }
-    int N, gamma, delta, mu, nu, g, period, inverse;
+    // delta d' mod N, the line of D that element 0 of line d' lies on.
+    int line_offset(int d_new) const { return static_cast<int>(static_cast<std::int64_t>(delta) * d_new % N); }
+    int N, gamma, delta, mu, nu, g, period;
+
+private:
+    int *first_solution_, *nu_multiple_;
 };
 
 // Calls f(d', s', d, element, mirrored) for each mode that `source` sends to
@@ -72,11 +97,13 @@ template <class F>
 void for_each_exchanged(const Transition &T, const LineOwnership &L, int target, int source, F &&f) {
     const int N = L.N;
     for (int d_new = L.first[target]; d_new < L.first[target + 1]; ++d_new) {
-        const int delta = static_cast<int>(static_cast<std::int64_t>(T.delta) * d_new % N);
+        const int offset = T.line_offset(d_new), base = T.element_base(d_new);
         for (int d = L.first[source]; d < L.first[source + 1]; ++d) {
-            T.solve(modulo(d - delta, N), [&](int s_new) { f(d_new, s_new, d, T.element(d_new, s_new), false); });
-            T.solve(modulo(N - d - delta, N), [&](int s_new) {
-                const int u = T.element(d_new, s_new);
+            // d - offset and N - d - offset lie in (-N, N): one correction each.
+            const int on_d = d - offset, on_minus_d = N - d - offset;
+            T.solve(on_d < 0 ? on_d + N : on_d, [&](int s_new) { f(d_new, s_new, d, T.element(base, s_new), false); });
+            T.solve(on_minus_d < 0 ? on_minus_d + N : on_minus_d, [&](int s_new) {
+                const int u = T.element(base, s_new);
                 f(d_new, s_new, d, u == 0 ? 0 : N - u, true);
             });
         }
@@ -100,7 +127,8 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
     }
     const LineOwnership &L = lines_;
     const int N = L.N, P = L.P, me = comm_.rank(), mine = L.count(me);
-    const Transition T(from, to, N);
+    check_reserved(riders);
+    const Transition T(from, to, N, first_solution_, nu_multiple_);
     double *line0 = state + line0_entry();
     double *slab = state + slab_entry(N);
 
@@ -133,58 +161,65 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
     };
 
     // Pack: for each process, the new line 0's modes held here, the riders,
-    // then its lines' modes.
-    send_.clear();
+    // then its lines' modes. Written through pointers into buffers sized by
+    // reserve() to the largest exchange (checked above).
+    double *out = send_.data();
+    std::size_t sent = 0;  // complex entries
     send_counts_.assign(P, 0);
     send_offsets_.assign(P, 0);
     for (int q = 0; q < P; ++q) {
-        const std::size_t start = send_.size() / 2;
+        const std::size_t start = sent;
         for (int i = origin_first[me]; i < origin_first[me + 1]; ++i) {
             const int s = origin_order[i];
-            double re, im;
-            old_value(T.line_of_new_origin_line(s), T.element(0, s), re, im);
-            send_.push_back(re);
-            send_.push_back(im);
+            old_value(T.line_of_new_origin_line(s), T.element(0, s), out[2 * sent], out[2 * sent + 1]);
+            ++sent;
         }
-        if (riders) send_.insert(send_.end(), riders->own.begin(), riders->own.end());
+        if (riders) {
+            std::copy(riders->own.begin(), riders->own.end(), out + 2 * sent);
+            sent += riders->own.size() / 2;
+        }
         for_each_exchanged(T, L, q, me, [&](int, int, int d, int e, bool mirrored) {
             const double *z = slab + 2 * (static_cast<std::size_t>(e) * mine + (d - L.first[me]));
-            send_.push_back(z[0]);
-            send_.push_back(mirrored ? -z[1] : z[1]);
+            out[2 * sent] = z[0];
+            out[2 * sent + 1] = mirrored ? -z[1] : z[1];
+            ++sent;
         });
         send_offsets_[q] = as_count(start);
-        send_counts_[q] = as_count(send_.size() / 2 - start);
+        send_counts_[q] = as_count(sent - start);
     }
     // Where each value received goes (complex entries after the index: line
     // 0 at 0 .. N-1, the lines from N).
-    targets_.clear();
+    std::uint64_t *target = targets_.data();
+    std::size_t received = 0;
     receive_counts_.assign(P, 0);
     receive_offsets_.assign(P, 0);
     rider_offsets_.assign(P, 0);
     for (int r = 0; r < P; ++r) {
-        const std::size_t start = targets_.size();
-        for (int i = origin_first[r]; i < origin_first[r + 1]; ++i) targets_.push_back(origin_order[i]);
+        const std::size_t start = received;
+        for (int i = origin_first[r]; i < origin_first[r + 1]; ++i) target[received++] = origin_order[i];
         if (riders) {
-            rider_offsets_[r] = targets_.size();
-            targets_.insert(targets_.end(), static_cast<std::size_t>(riders->counts[r]), kRider);
+            rider_offsets_[r] = received;
+            std::fill_n(target + received, riders->counts[r], kRider);
+            received += static_cast<std::size_t>(riders->counts[r]);
         }
+        const std::uint64_t first_line = N - static_cast<std::uint64_t>(L.first[me]);
         for_each_exchanged(T, L, me, r, [&](int d_new, int s_new, int, int, bool) {
-            targets_.push_back(N + static_cast<std::uint64_t>(s_new) * mine + (d_new - L.first[me]));
+            target[received++] = first_line + static_cast<std::uint64_t>(s_new) * mine + d_new;
         });
         receive_offsets_[r] = as_count(start);
-        receive_counts_[r] = as_count(targets_.size() - start);
+        receive_counts_[r] = as_count(received - start);
     }
-    receive_.resize(2 * targets_.size());
     old_line0_.assign(line0, line0 + 2 * static_cast<std::size_t>(N));
 
     comm_.alltoallv(send_.data(), send_counts_, send_offsets_, receive_.data(), receive_counts_,
                     receive_offsets_);
 
     double *entries = state + line0_entry();
-    for (std::size_t i = 0; i < targets_.size(); ++i) {
-        if (targets_[i] == kRider) continue;
-        entries[2 * targets_[i]] = receive_[2 * i];
-        entries[2 * targets_[i] + 1] = receive_[2 * i + 1];
+    const double *in = receive_.data();
+    for (std::size_t i = 0; i < received; ++i) {
+        if (target[i] == kRider) continue;
+        entries[2 * target[i]] = in[2 * i];
+        entries[2 * target[i] + 1] = in[2 * i + 1];
     }
     if (riders) gather_riders(*riders);
     // Modes on the old line 0: from the copy held here.
@@ -195,9 +230,9 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
             line0[2 * s + 1] = old_line0_[2 * u + 1];
         }
     for (int d_new = L.first[me]; d_new < L.first[me + 1]; ++d_new) {
-        const int delta = static_cast<int>(static_cast<std::int64_t>(T.delta) * d_new % N);
-        T.solve(modulo(-delta, N), [&](int s_new) {
-            const int u = T.element(d_new, s_new);
+        const int base = T.element_base(d_new);
+        T.solve(modulo(-static_cast<std::int64_t>(T.line_offset(d_new)), N), [&](int s_new) {
+            const int u = T.element(base, s_new);
             double *z = slab + 2 * (static_cast<std::size_t>(s_new) * mine + (d_new - L.first[me]));
             z[0] = old_line0_[2 * u];
             z[1] = old_line0_[2 * u + 1];
@@ -229,14 +264,22 @@ std::size_t LineExchange::most_line0_modes_held() const {
 // line 0 held in the reference direction's layout), both sent to every
 // process; the lines send each of their N mine modes once. What is received:
 // the N modes of line 0, riders of at most 2 entries a mode of it, and the N
-// mine modes of the lines.
+// mine modes of the lines. Complex entries.
+std::size_t LineExchange::most_sent() const {
+    const std::size_t N = static_cast<std::size_t>(lines_.N), P = static_cast<std::size_t>(lines_.P);
+    return P * (held_ + 2 * held_) + N * static_cast<std::size_t>(lines_.count(comm_.rank()));
+}
+std::size_t LineExchange::most_received() const {
+    const std::size_t N = static_cast<std::size_t>(lines_.N);
+    return N + 2 * N + N * static_cast<std::size_t>(lines_.count(comm_.rank()));
+}
+
 void LineExchange::reserve(Riders *riders) {
     const std::size_t N = static_cast<std::size_t>(lines_.N), P = static_cast<std::size_t>(lines_.P);
-    const std::size_t mine = static_cast<std::size_t>(lines_.count(comm_.rank()));
     const std::size_t held = held_;
-    send_.reserve(P * (2 * held + 4 * held) + 2 * N * mine);
-    targets_.reserve(N + 2 * N + N * mine);
-    receive_.reserve(2 * (N + 2 * N + N * mine));
+    send_.resize(2 * most_sent());
+    targets_.resize(most_received());
+    receive_.resize(2 * most_received());
     old_line0_.reserve(2 * N);
     for (std::vector<int> *v : {&send_counts_, &send_offsets_, &receive_counts_, &receive_offsets_})
         v->reserve(P);
@@ -251,25 +294,40 @@ void LineExchange::reserve(Riders *riders) {
     riders->gathered.reserve(4 * N);
 }
 
+// The buffers a move writes through pointers have their largest sizes, and
+// the riders fit in them: a move cannot write past them.
+void LineExchange::check_reserved(const Riders *riders) const {
+    if (send_.size() < 2 * most_sent() || targets_.size() < most_received() ||
+        receive_.size() < 2 * most_received())
+        fail(LPI_ERR_INTERNAL, "a line exchange before its buffers were reserved");
+    if (!riders) return;
+    std::size_t received = 0;
+    for (int count : riders->counts) received += static_cast<std::size_t>(count);
+    if (riders->own.size() > 4 * held_ || riders->counts.size() != static_cast<std::size_t>(lines_.P) ||
+        received > 2 * static_cast<std::size_t>(lines_.N))
+        fail(LPI_ERR_INTERNAL, "line exchange riders past their bound");
+}
+
 void LineExchange::exchange_riders(Riders &riders) {
+    check_reserved(&riders);
     const int P = lines_.P;
-    send_.clear();
+    double *out = send_.data();
     send_counts_.assign(P, 0);
     send_offsets_.assign(P, 0);
     receive_counts_.assign(P, 0);
     receive_offsets_.assign(P, 0);
     rider_offsets_.assign(P, 0);
+    const int own = as_count(riders.own.size() / 2);
     std::size_t received = 0;
     for (int q = 0; q < P; ++q) {
-        send_offsets_[q] = as_count(send_.size() / 2);
-        send_.insert(send_.end(), riders.own.begin(), riders.own.end());
-        send_counts_[q] = as_count(riders.own.size() / 2);
+        send_offsets_[q] = as_count(static_cast<std::size_t>(q) * own);
+        std::copy(riders.own.begin(), riders.own.end(), out + 2 * static_cast<std::size_t>(q) * own);
+        send_counts_[q] = own;
         rider_offsets_[q] = received;
         receive_offsets_[q] = as_count(received);
         receive_counts_[q] = riders.counts[q];
         received += static_cast<std::size_t>(riders.counts[q]);
     }
-    receive_.resize(2 * received);
     comm_.alltoallv(send_.data(), send_counts_, send_offsets_, receive_.data(), receive_counts_,
                     receive_offsets_);
     gather_riders(riders);

@@ -75,7 +75,8 @@ struct Riders {
 class LineExchange {
 public:
     LineExchange(const Communicator &comm, const LineOwnership &lines)
-        : comm_(comm), lines_(lines), held_(most_line0_modes_held()) {}
+        : comm_(comm), lines_(lines), held_(most_line0_modes_held()),
+          first_solution_(static_cast<std::size_t>(lines.N)), nu_multiple_(static_cast<std::size_t>(lines.N)) {}
     // state holds the layout of `from`; afterwards that of `to`. With riders,
     // their values travel in the same collective; when from and to are the
     // same direction only they travel.
@@ -100,9 +101,14 @@ private:
     std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
     std::vector<std::size_t> rider_offsets_;  // where each process's riders start in receive_
     std::size_t most_line0_modes_held() const;
+    std::size_t most_sent() const;      // complex entries, all processes together
+    std::size_t most_received() const;  // complex entries
+    void check_reserved(const Riders *riders) const;
     std::size_t held_;  // most_line0_modes_held()
     // Where the new line 0's modes come from (see move).
     std::vector<int> origin_source_, origin_order_, origin_first_, next_origin_;
+    // The transition's tables (N entries each), filled by each move.
+    std::vector<int> first_solution_, nu_multiple_;
 };
 
 }  // namespace mpi
