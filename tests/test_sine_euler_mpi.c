@@ -226,8 +226,8 @@ static void test_hamiltonian(void **state) {
         assert_int_equal(lpi_energy(spread, &h1), LPI_OK);
         assert_int_equal(lpi_energy(single, &h2), LPI_OK);
         assert_true(fabs(h1 - h2) <= 1e-13 * fabs(h2));
-        assert_int_equal(lpi_step(spread, 0.05, 10), LPI_OK);
-        assert_int_equal(lpi_step(single, 0.05, 10), LPI_OK);
+        assert_int_equal(lpi_step(spread, 0.05, 3), LPI_OK);
+        assert_int_equal(lpi_step(single, 0.05, 3), LPI_OK);
         assert_int_equal(lpi_get_state(spread, a, n), LPI_OK);
         assert_int_equal(lpi_get_state(single, b, n), LPI_OK);
         const double scale = max_abs(b, n), gap = max_diff(a, b, n);
@@ -254,8 +254,8 @@ static void test_hamiltonian(void **state) {
         assert_int_equal(lpi_load_mpi(&reloaded, path, MPI_COMM_WORLD), LPI_OK);
         assert_int_equal(lpi_energy(reloaded, &h2), LPI_OK);
         assert_true(h1 == h2);
-        assert_int_equal(lpi_step(spread, 0.05, 5), LPI_OK);
-        assert_int_equal(lpi_step(reloaded, 0.05, 5), LPI_OK);
+        assert_int_equal(lpi_step(spread, 0.05, 2), LPI_OK);
+        assert_int_equal(lpi_step(reloaded, 0.05, 2), LPI_OK);
         assert_int_equal(lpi_get_state(spread, a, n), LPI_OK);
         assert_int_equal(lpi_get_state(reloaded, b, n), LPI_OK);
         assert_memory_equal(a, b, n * sizeof *a);
