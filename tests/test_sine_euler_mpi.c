@@ -170,6 +170,20 @@ static void test_checkpoint(void **state) {
     assert_int_equal(lpi_load_mpi(&none, "no/such/file.lpi", MPI_COMM_WORLD), LPI_ERR_IO);
     assert_int_equal(lpi_load_mpi(&none, "", MPI_COMM_WORLD), LPI_ERR_INVALID);
     assert_null(none);
+    /* A file that is no checkpoint: LPI_ERR_FORMAT naming it, as lpi_load
+     * does (rank 0's check of the header left the path out before). */
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (rank_ == 0) {
+        FILE *f = fopen(path, "w");
+        assert_non_null(f);
+        fputs("not a checkpoint\n", f);
+        assert_int_equal(fclose(f), 0);
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    assert_int_equal(lpi_load_mpi(&none, path, MPI_COMM_WORLD), LPI_ERR_FORMAT);
+    assert_non_null(strstr(lpi_last_error(NULL), path));
+    assert_non_null(strstr(lpi_last_error(NULL), "magic"));
+    assert_null(none);
     /* An intact checkpoint of a baseline's run: a system spread over
      * processes cannot step by it (LPI_ERR_UNSUPPORTED, not a bad file). */
     MPI_Barrier(MPI_COMM_WORLD);

@@ -26,6 +26,18 @@ void require_same_arguments(const lpi::mpi::Communicator &comm, const Arguments 
     comm.require_same(static_cast<long long>(arguments.fingerprint()), "arguments to this call");
 }
 
+// A refused file's path leads the message, as in lpi_load (I/O errors name
+// it already).
+template <class Action>
+void naming_path(const char *path, Action &&action) {
+    try {
+        action();
+    } catch (const lpi::Error &e) {
+        if (e.status() != LPI_ERR_FORMAT && e.status() != LPI_ERR_UNSUPPORTED) throw;
+        lpi::fail(e.status(), lpi::quoted(path) + ": " + e.what());
+    }
+}
+
 }  // namespace
 
 extern "C" {
@@ -52,7 +64,7 @@ LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
         std::vector<unsigned char> bytes;
         double size = 0.0;
         reader.on_root([&] {
-            bytes = lpi::read_checkpoint_file(path);
+            naming_path(path, [&] { bytes = lpi::read_checkpoint_file(path); });
             size = static_cast<double>(bytes.size());
         });
         reader.broadcast(&size, 1);
@@ -62,11 +74,7 @@ LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
         const auto *data = reinterpret_cast<const unsigned char *>(words.data());
         lpi::Checkpoint cp;
         reader.agree([&] {
-            try {
-                cp = lpi::decode_checkpoint(data, static_cast<std::size_t>(size));
-            } catch (const lpi::Error &e) {
-                lpi::fail(e.status(), lpi::quoted(path) + ": " + e.what());
-            }
+            naming_path(path, [&] { cp = lpi::decode_checkpoint(data, static_cast<std::size_t>(size)); });
             if (std::string(cp.model->kind()) != "sine-euler")
                 lpi::fail(LPI_ERR_UNSUPPORTED, lpi::quoted(path) + " holds a " +
                                                    cp.model->kind() +
@@ -80,7 +88,7 @@ LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
         cp.state = lpi::local_state_of_modes(*model, cp.state.data());
         cp.model.reset();  // the whole field is not kept
         auto handle = std::make_unique<lpi_system>(std::move(model));
-        reader.agree([&] { lpi::restore_checkpoint(handle->system, cp); });
+        reader.agree([&] { naming_path(path, [&] { lpi::restore_checkpoint(handle->system, cp); }); });
         *out = handle.release();
     });
 }
