@@ -593,6 +593,65 @@ static void test_failure_on_one_process(void **state) {
     if (refused == 0) LPI_SKIP("an address-space limit refused nothing (a sanitizer's reserve?)");
 }
 
+/* lpi_load_mpi with the last process's address space limited: every buffer
+ * it allocates between its collectives (the file's bytes, the Hamiltonian,
+ * the process's share of the state, the handle) is agreed on, so every
+ * process returns LPI_ERR_NO_MEMORY. Before, the others waited for ever in
+ * the broadcast of the file (or in the next collective after the others). */
+typedef struct {
+    const char *path;
+    lpi_system **out;
+} load_arguments;
+static int load_spread(lpi_system *sys, const void *context) {
+    (void)sys;
+    const load_arguments *load = context;
+    return lpi_load_mpi(load->out, load->path, MPI_COMM_WORLD);
+}
+static void test_load_failure_on_one_process(void **state) {
+    (void)state;
+#if defined(__SANITIZE_ADDRESS__)
+    LPI_SKIP("AddressSanitizer ends the process when a mapping is refused");
+#endif
+    const int N = 301;
+    const size_t n = (size_t)N * N;
+    double *x = malloc(n * sizeof *x), *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+    double *lambda = malloc(n * sizeof *lambda), *f = malloc(2 * n * sizeof *f);
+    assert_true(x && a && b && lambda && f);
+    random_field(x, n, 11);
+    sqg_over_topography(N, lambda, f);
+    char path[64];
+    snprintf(path, sizeof path, "test_sine_euler_mpi_short_%d.lpi", size_);
+    lpi_system *sys, *loaded = NULL;
+    assert_int_equal(lpi_sine_euler_create_mpi(&sys, N, MPI_COMM_WORLD), LPI_OK);
+    assert_int_equal(lpi_set_state(sys, x, n), LPI_OK);
+    assert_int_equal(lpi_sine_euler_set_hamiltonian(sys, lambda, n, f, 2 * n), LPI_OK);
+    assert_int_equal(lpi_save(sys, path), LPI_OK);
+    const load_arguments load = {path, &loaded};
+    const int status = with_last_process_limited(load_spread, NULL, &load);
+    int refused = status != LPI_OK;
+    if (refused) {
+        assert_int_equal(status, LPI_ERR_NO_MEMORY);
+        assert_non_null(strstr(lpi_last_error(NULL), "lpi_load_mpi"));
+        assert_null(loaded);
+    } else {
+        lpi_destroy(loaded);
+    }
+    /* The same status on every process. */
+    int all = 0;
+    MPI_Allreduce(&refused, &all, 1, MPI_INT, MPI_LAND, MPI_COMM_WORLD);
+    assert_int_equal(all, refused);
+    /* And the file loads once the memory is there. */
+    assert_int_equal(lpi_load_mpi(&loaded, path, MPI_COMM_WORLD), LPI_OK);
+    assert_int_equal(lpi_get_state(sys, a, n), LPI_OK);
+    assert_int_equal(lpi_get_state(loaded, b, n), LPI_OK);
+    assert_memory_equal(a, b, n * sizeof *a);
+    lpi_destroy(loaded), lpi_destroy(sys);
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (rank_ == 0) remove(path);
+    free(x), free(a), free(b), free(lambda), free(f);
+    if (!refused) LPI_SKIP("an address-space limit refused nothing (a sanitizer's reserve?)");
+}
+
 static void test_threads_need_funneled(void **state) {
     (void)state;
     lpi_system *sys;
@@ -626,6 +685,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_different_arguments),
         cmocka_unit_test(test_failure_on_one_process),
+        cmocka_unit_test(test_load_failure_on_one_process),
     };
     const int status = lpi_run_tests(tests);
     MPI_Finalize();

@@ -1,6 +1,6 @@
 // The C ABI of the MPI part (include/liepoisson_mpi.h).
-#include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,7 +60,10 @@ LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
         require_same_arguments(reader, Arguments(out, Text{path}));
         require(out, "out");
         require_path(path);
-        // Rank 0 reads; every process decodes the same bytes.
+        // Rank 0 reads; every process decodes the same bytes. Whatever a
+        // process allocates between two collectives is agreed on: one
+        // process short of memory fails the call on all of them instead of
+        // leaving the others waiting in the next collective.
         std::vector<unsigned char> bytes;
         double size = 0.0;
         reader.on_root([&] {
@@ -68,26 +71,34 @@ LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
             size = static_cast<double>(bytes.size());
         });
         reader.broadcast(&size, 1);
-        std::vector<double> words((static_cast<std::size_t>(size) + sizeof(double) - 1) / sizeof(double));
-        if (reader.rank() == 0) std::memcpy(words.data(), bytes.data(), bytes.size());
-        reader.broadcast(words.data(), words.size());
-        const auto *data = reinterpret_cast<const unsigned char *>(words.data());
+        reader.agree([&] { bytes.resize(static_cast<std::size_t>(size)); });
+        reader.broadcast(bytes.data(), bytes.size());
         lpi::Checkpoint cp;
+        int N = 0;
+        std::string split;
+        std::optional<lpi::sine_euler::Hamiltonian> hamiltonian;
         reader.agree([&] {
-            naming_path(path, [&] { cp = lpi::decode_checkpoint(data, static_cast<std::size_t>(size)); });
+            naming_path(path, [&] { cp = lpi::decode_checkpoint(bytes.data(), bytes.size()); });
+            std::vector<unsigned char>().swap(bytes);
             if (std::string(cp.model->kind()) != "sine-euler")
                 lpi::fail(LPI_ERR_UNSUPPORTED, lpi::quoted(path) + " holds a " +
                                                    cp.model->kind() +
                                                    " system; only sine-euler is spread over processes");
+            const auto &whole = static_cast<const lpi::SineEulerModel &>(*cp.model);
+            N = whole.truncation();
+            split = whole.split();
+            hamiltonian.emplace(whole.hamiltonian());
+            cp.model.reset();  // the whole field is not kept
         });
-        const int N = static_cast<const lpi::SineEulerModel &>(*cp.model).truncation();
         std::unique_ptr<lpi::Model> model = lpi::make_sine_euler_mpi(N, communicator);
-        model->set_split(cp.model->split());
-        static_cast<lpi::SineEulerModel &>(*model).set_hamiltonian(
-            static_cast<const lpi::SineEulerModel &>(*cp.model).hamiltonian());
-        cp.state = lpi::local_state_of_modes(*model, cp.state.data());
-        cp.model.reset();  // the whole field is not kept
-        auto handle = std::make_unique<lpi_system>(std::move(model));
+        model->set_split(split);
+        static_cast<lpi::SineEulerModel &>(*model).set_hamiltonian(std::move(*hamiltonian));
+        hamiltonian.reset();
+        std::unique_ptr<lpi_system> handle;
+        reader.agree([&] {
+            cp.state = lpi::local_state_of_modes(*model, cp.state.data());
+            handle = std::make_unique<lpi_system>(std::move(model));
+        });
         reader.agree([&] { naming_path(path, [&] { lpi::restore_checkpoint(handle->system, cp); }); });
         *out = handle.release();
     });

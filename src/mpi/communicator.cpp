@@ -135,6 +135,15 @@ void Communicator::broadcast(double *values, std::size_t n) const {
     }
 }
 
+void Communicator::broadcast(unsigned char *bytes, std::size_t n) const {
+    while (n > 0) {
+        const int count = n > INT_MAX ? INT_MAX : static_cast<int>(n);
+        check(MPI_Bcast(bytes, count, MPI_UNSIGNED_CHAR, 0, comm_), "MPI_Bcast");
+        bytes += count;
+        n -= static_cast<std::size_t>(count);
+    }
+}
+
 void Communicator::share_outcome(int status, const std::string &message) const {
     std::vector<int> statuses(static_cast<std::size_t>(size_));
     check(MPI_Allgather(&status, 1, MPI_INT, statuses.data(), 1, MPI_INT, comm_), "MPI_Allgather");

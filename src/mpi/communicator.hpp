@@ -46,6 +46,7 @@ public:
     void require_same(long long value, const std::string &what) const;
     bool all(bool value) const;
     void broadcast(double *values, std::size_t n) const;  // from rank 0
+    void broadcast(unsigned char *bytes, std::size_t n) const;  // from rank 0
 
     // Runs action on every process; when it throws on any of them, every
     // process throws the status and message of the lowest such rank, so
