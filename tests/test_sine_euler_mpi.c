@@ -546,7 +546,7 @@ static void test_failure_on_one_process(void **state) {
 #if defined(__SANITIZE_ADDRESS__)
     LPI_SKIP("AddressSanitizer ends the process when a mapping is refused");
 #endif
-    const int N = 301;
+    const int N = 101;
     const size_t n = (size_t)N * N;
     double *x = malloc(n * sizeof *x), *before = malloc(n * sizeof *before), *after = malloc(n * sizeof *after);
     double *lambda = malloc(n * sizeof *lambda), *f = malloc(2 * n * sizeof *f);
@@ -612,7 +612,7 @@ static void test_load_failure_on_one_process(void **state) {
 #if defined(__SANITIZE_ADDRESS__)
     LPI_SKIP("AddressSanitizer ends the process when a mapping is refused");
 #endif
-    const int N = 301;
+    const int N = 101;
     const size_t n = (size_t)N * N;
     double *x = malloc(n * sizeof *x), *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
     double *lambda = malloc(n * sizeof *lambda), *f = malloc(2 * n * sizeof *f);
