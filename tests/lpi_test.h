@@ -5,6 +5,7 @@
 #define LPI_TEST_H
 
 #include <liepoisson.h>
+#include <malloc.h>
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -13,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #ifdef __cplusplus /* cmocka.h declares its functions without C linkage */
 extern "C" {
 #endif
@@ -110,6 +112,41 @@ static inline void lpi_assert_unchanged(const lpi_system *sys, const lpi_snapsho
             fail_msg("message '%s' does not name %s", lpi_msg_, function);                \
         if (sys) lpi_assert_unchanged(sys, &lpi_before_);                                 \
     } while (0)
+
+/* ---- a call short of memory ----------------------------------------------
+ * lpi_test_with_address_space_limited runs one call with this process's
+ * address space limited (when `limited`) to what it has mapped, so that what
+ * the call maps is refused: blocks of 16 KiB and more are then mapped on
+ * their own, never carved from freed heap (whose threshold glibc otherwise
+ * raises as large blocks are freed). It returns the call's status. Not under
+ * AddressSanitizer, which ends the process when a mapping is refused. */
+static inline size_t lpi_test_mapped_bytes(void) { /* VmSize; 0 where /proc does not say */
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    size_t kib = 0;
+    while (f && fgets(line, sizeof line, f))
+        if (strncmp(line, "VmSize:", 7) == 0) kib = (size_t)strtoull(line + 7, NULL, 10);
+    if (f) fclose(f);
+    return kib * 1024;
+}
+
+typedef int (*lpi_test_limited_call)(lpi_system *sys, const void *context);
+static inline int lpi_test_with_address_space_limited(int limited, lpi_test_limited_call call, lpi_system *sys,
+                                                      const void *context) {
+    mallopt(M_MMAP_THRESHOLD, 16 * 1024);
+    malloc_trim(0);
+    struct rlimit saved;
+    assert_int_equal(getrlimit(RLIMIT_AS, &saved), 0);
+    const size_t mapped = lpi_test_mapped_bytes();
+    if (limited && mapped > 0 && (saved.rlim_cur == RLIM_INFINITY || saved.rlim_cur > mapped)) {
+        struct rlimit tight = saved;
+        tight.rlim_cur = mapped;
+        assert_int_equal(setrlimit(RLIMIT_AS, &tight), 0);
+    }
+    const int status = call(sys, context);
+    if (limited) assert_int_equal(setrlimit(RLIMIT_AS, &saved), 0);
+    return status;
+}
 
 /* Random numbers in [-1, 1) from a 64-bit linear congruential generator:
  * the same sequence on every platform, for the tests' random states. */

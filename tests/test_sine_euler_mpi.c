@@ -7,8 +7,6 @@
  * file that both load, and bad input gets the same status on every process
  * with the state unchanged. */
 #include <liepoisson_mpi.h>
-#include <malloc.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include "lpi_test.h"
@@ -483,39 +481,10 @@ static void test_bad_input(void **state) {
     lpi_destroy(spread), lpi_destroy(single);
 }
 
-/* Run with --thread-single: MPI at MPI_THREAD_SINGLE, where no other thread
- * may exist, so threads within a process are refused. */
-/* Bytes of address space this process has mapped (VmSize), or 0. */
-static size_t mapped_bytes(void) {
-    FILE *f = fopen("/proc/self/status", "r");
-    char line[256];
-    size_t kib = 0;
-    while (f && fgets(line, sizeof line, f))
-        if (strncmp(line, "VmSize:", 7) == 0) kib = (size_t)strtoull(line + 7, NULL, 10);
-    if (f) fclose(f);
-    return kib * 1024;
-}
-
 /* One call with the last process's address space limited to what it has
- * mapped, so that what the call allocates there is refused (blocks of 16 KiB
- * and more are mapped on their own, never carved from freed heap, whose
- * threshold glibc otherwise raises as large blocks are freed). */
-typedef int (*limited_call)(lpi_system *sys, const void *context);
-static int with_last_process_limited(limited_call call, lpi_system *sys, const void *context) {
-    const int last = rank_ == size_ - 1;
-    mallopt(M_MMAP_THRESHOLD, 16 * 1024);
-    malloc_trim(0);
-    struct rlimit saved;
-    assert_int_equal(getrlimit(RLIMIT_AS, &saved), 0);
-    const size_t mapped = mapped_bytes();
-    if (last && mapped > 0 && (saved.rlim_cur == RLIM_INFINITY || saved.rlim_cur > mapped)) {
-        struct rlimit tight = saved;
-        tight.rlim_cur = mapped;
-        assert_int_equal(setrlimit(RLIMIT_AS, &tight), 0);
-    }
-    const int status = call(sys, context);
-    if (last) assert_int_equal(setrlimit(RLIMIT_AS, &saved), 0);
-    return status;
+ * mapped (lpi_test_with_address_space_limited). */
+static int with_last_process_limited(lpi_test_limited_call call, lpi_system *sys, const void *context) {
+    return lpi_test_with_address_space_limited(rank_ == size_ - 1, call, sys, context);
 }
 
 typedef struct {
@@ -561,7 +530,7 @@ static void test_failure_on_one_process(void **state) {
     /* In this order: nothing before them has planned or exchanged. */
     const struct {
         const char *name;
-        limited_call call;
+        lpi_test_limited_call call;
         const void *context;
     } calls[] = {{"lpi_sine_euler_set_planning", new_plans, NULL},
                  {"lpi_step", first_step, NULL},
@@ -652,6 +621,8 @@ static void test_load_failure_on_one_process(void **state) {
     if (!refused) LPI_SKIP("an address-space limit refused nothing (a sanitizer's reserve?)");
 }
 
+/* Run with --thread-single: MPI at MPI_THREAD_SINGLE, where no other thread
+ * may exist, so threads within a process are refused. */
 static void test_threads_need_funneled(void **state) {
     (void)state;
     lpi_system *sys;

@@ -88,6 +88,19 @@ void require_physical_memory(double bytes, const std::string &what);
 // wisdom operation in the library holds this lock.
 std::mutex &fftw_planner_mutex();
 
+// FFTW ends the process when one of its own allocations fails (its
+// malloc_plain asserts on the result): in a planner, in wisdom, or in an
+// execution that allocates buffers (Rader's, buffered loops). So before each,
+// the memory FFTW may take is mapped and given back at once; where it cannot
+// be had, the call fails here with LPI_ERR_NO_MEMORY, the state unchanged, as
+// for an allocation of ours. What FFTW takes for transforms of length N:
+// planning (plans, twiddles, Bluestein's padded buffers, the planner's own
+// tables) 2048 N bytes, at least 4 MiB; executing (Rader's buffer, buffered
+// loops of 8 transforms) 1024 N bytes a thread.
+std::size_t fftw_planning_headroom(int N);
+std::size_t fftw_execution_headroom(int N, int threads);
+void require_fftw_headroom(std::size_t bytes, const std::string &what);
+
 // ---- matrix form (sine_euler_matrix.cpp) ----------------------------------
 // W = sum_m w_m J_m, J_m = exp(2 pi i m1 m2 / N) g^m1 h^m2 (the transforms:
 // sine_euler/matrix_form.hpp). O(N^3) products, used only on request.

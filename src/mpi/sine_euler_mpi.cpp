@@ -171,11 +171,14 @@ public:
     }
 
     // The plans, and every buffer of the exchange and of line 0's weights
-    // at its largest: a flow then allocates nothing.
+    // at its largest: a flow then allocates nothing, and FFTW has room for
+    // what its executions allocate.
     void prepare_step() override {
         transforms();
         exchange_.reserve(&riders_);
         share_.reserve(origin_);
+        require_fftw_headroom(fftw_execution_headroom(N_, threads_),
+                              "the flows' transforms of length " + std::to_string(N_));
     }
     void flow(std::size_t piece, double t, double *state) override;
     TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) override;

@@ -124,6 +124,12 @@ public:
     }
     void grid(const double *state, double *out) const override { grid_from_modes(N_, state, out); }
 
+    // Room for what FFTW's executions allocate (the plans are made by the
+    // first flow, which a baseline method never calls).
+    void prepare_step() override {
+        require_fftw_headroom(fftw_execution_headroom(N_, threads_),
+                              "the flows' transforms of length " + std::to_string(N_));
+    }
     void flow(std::size_t piece, double t, double *state) override;
 
     double energy(const double *state) const override { return hamiltonian_.energy(state); }

@@ -10,6 +10,8 @@
 #include <mutex>
 #include <new>
 
+#include <sys/mman.h>
+
 #include "../../core/error.hpp"
 #include "../../core/files.hpp"
 #include "../../core/text.hpp"
@@ -32,6 +34,25 @@ std::mutex &fftw_planner_mutex() {
 namespace {
 constexpr const char *kPlanningNames[] = {"estimate", "measure", "patient"};
 }  // namespace
+
+std::size_t fftw_planning_headroom(int N) {
+    return std::max<std::size_t>(std::size_t{4} << 20, std::size_t{2048} * static_cast<std::size_t>(N));
+}
+
+std::size_t fftw_execution_headroom(int N, int threads) {
+    return std::size_t{1024} * static_cast<std::size_t>(N) * static_cast<std::size_t>(std::max(threads, 1));
+}
+
+// Mapped, not malloc'ed: a compiler may drop a malloc whose block is never
+// used, and a mapping is given back whole.
+void require_fftw_headroom(std::size_t bytes, const std::string &what) {
+    void *probe = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (probe == MAP_FAILED)
+        fail(LPI_ERR_NO_MEMORY, "FFTW may take " + std::to_string(bytes) + " bytes for " + what +
+                                    ", which this process cannot have (FFTW ends the process when its "
+                                    "own allocation fails, so it is not called)");
+    munmap(probe, bytes);
+}
 
 const char *planning_name(FftPlanning planning) { return kPlanningNames[static_cast<int>(planning)]; }
 
@@ -71,6 +92,7 @@ LineTransforms::LineTransforms(int N, int lines, FftPlanning planning)
         phase_ = static_cast<double *>(fftw_malloc(sizeof(double) * phase_table_doubles(N)));
         if (!spectrum_ || !phase_) throw std::bad_alloc();
         reserve_threads(1);
+        require_fftw_headroom(fftw_planning_headroom(N), "the plans of length " + std::to_string(N));
         std::lock_guard<std::mutex> lock(fftw_planner_mutex());
         const unsigned flags = planner_flags(planning);
         fftw_complex *b = complex_of(spectrum_), *x = complex_of(blocks_[0]);
@@ -143,6 +165,8 @@ namespace {
 
 // A 2D DFT of N x N complex values, in place, with a plan of its own.
 void dft_2d(int N, fftw_complex *buffer, int sign) {
+    require_fftw_headroom(fftw_planning_headroom(N),
+                          "the grid's " + std::to_string(N) + " x " + std::to_string(N) + " transform");
     fftw_plan plan;
     {
         std::lock_guard<std::mutex> lock(fftw_planner_mutex());
@@ -216,6 +240,7 @@ void fftw_wisdom_import_file(const char *path) {
     if (text.size() > kMaxWisdomBytes)
         fail(LPI_ERR_INVALID, quoted(path) + " is not FFTW wisdom: more than " +
                                   std::to_string(kMaxWisdomBytes) + " bytes, more than wisdom takes");
+    require_fftw_headroom(fftw_planning_headroom(0) + 8 * text.size(), "its wisdom");
     std::lock_guard<std::mutex> lock(fftw_planner_mutex());
     if (text.find('\0') != std::string::npos || !fftw_import_wisdom_from_string(text.c_str()))
         fail(LPI_ERR_INVALID, quoted(path) + " is not FFTW wisdom");
@@ -228,6 +253,7 @@ void fftw_wisdom_export_file(const char *path) {
 }
 
 void fftw_wisdom_import_string(const char *wisdom) {
+    require_fftw_headroom(fftw_planning_headroom(0) + 8 * std::strlen(wisdom), "its wisdom");
     std::lock_guard<std::mutex> lock(fftw_planner_mutex());
     if (!fftw_import_wisdom_from_string(wisdom))
         fail(LPI_ERR_INVALID, "the string is not valid FFTW wisdom");
@@ -235,6 +261,7 @@ void fftw_wisdom_import_string(const char *wisdom) {
 
 std::string fftw_wisdom_export_string() {
     char *text;
+    require_fftw_headroom(fftw_planning_headroom(0), "its wisdom");
     {
         std::lock_guard<std::mutex> lock(fftw_planner_mutex());
         text = fftw_export_wisdom_to_string();
