@@ -504,6 +504,31 @@ static int new_plans(lpi_system *sys, const void *context) {
     return lpi_sine_euler_set_planning(sys, "estimate");
 }
 
+/* The address-space tests' system: spread over every process at N = 101
+ * (what a call maps is then refused under the limit), a random field set,
+ * SQG over topography's lambda and f at hand, and two buffers of N^2. */
+typedef struct {
+    size_t n;
+    double *x, *lambda, *f, *a, *b;
+    lpi_system *sys;
+} limited_case;
+static limited_case limited_case_create(unsigned seed) {
+    const int N = 101;
+    limited_case c = {(size_t)N * N, NULL, NULL, NULL, NULL, NULL, NULL};
+    c.x = malloc(c.n * sizeof *c.x), c.lambda = malloc(c.n * sizeof *c.lambda);
+    c.f = malloc(2 * c.n * sizeof *c.f), c.a = malloc(c.n * sizeof *c.a), c.b = malloc(c.n * sizeof *c.b);
+    assert_true(c.x && c.lambda && c.f && c.a && c.b);
+    random_field(c.x, c.n, seed);
+    sqg_over_topography(N, c.lambda, c.f);
+    assert_int_equal(lpi_sine_euler_create_mpi(&c.sys, N, MPI_COMM_WORLD), LPI_OK);
+    assert_int_equal(lpi_set_state(c.sys, c.x, c.n), LPI_OK);
+    return c;
+}
+static void limited_case_free(limited_case *c) {
+    lpi_destroy(c->sys);
+    free(c->x), free(c->lambda), free(c->f), free(c->a), free(c->b);
+}
+
 /* Calls that fail on one process alone, in what they allocate or set up (a
  * step's plans and buffers, a Hamiltonian, plans), refused here by an
  * address-space limit on the last process: every process returns
@@ -515,18 +540,12 @@ static void test_failure_on_one_process(void **state) {
 #if defined(__SANITIZE_ADDRESS__)
     LPI_SKIP("AddressSanitizer ends the process when a mapping is refused");
 #endif
-    const int N = 101;
-    const size_t n = (size_t)N * N;
-    double *x = malloc(n * sizeof *x), *before = malloc(n * sizeof *before), *after = malloc(n * sizeof *after);
-    double *lambda = malloc(n * sizeof *lambda), *f = malloc(2 * n * sizeof *f);
-    assert_true(x && before && after && lambda && f);
-    random_field(x, n, 5);
-    sqg_over_topography(N, lambda, f);
-    lpi_system *sys;
-    assert_int_equal(lpi_sine_euler_create_mpi(&sys, N, MPI_COMM_WORLD), LPI_OK);
-    assert_int_equal(lpi_set_state(sys, x, n), LPI_OK);
+    limited_case c = limited_case_create(5);
+    lpi_system *sys = c.sys;
+    const size_t n = c.n;
+    double *before = c.a, *after = c.b;
     assert_int_equal(lpi_get_state(sys, before, n), LPI_OK);
-    const hamiltonian_arguments sqg = {lambda, f, n};
+    const hamiltonian_arguments sqg = {c.lambda, c.f, n};
     /* In this order: nothing before them has planned or exchanged. */
     const struct {
         const char *name;
@@ -556,8 +575,7 @@ static void test_failure_on_one_process(void **state) {
         }
     }
     assert_int_equal(lpi_step(sys, 0.01, 1), LPI_OK); /* and it goes on */
-    lpi_destroy(sys);
-    free(x), free(before), free(after), free(lambda), free(f);
+    limited_case_free(&c);
     if (rank_ == 0) printf("%d of 3 calls refused on the last of %d processes, on all\n", refused, size_);
     if (refused == 0) LPI_SKIP("an address-space limit refused nothing (a sanitizer's reserve?)");
 }
@@ -581,19 +599,12 @@ static void test_load_failure_on_one_process(void **state) {
 #if defined(__SANITIZE_ADDRESS__)
     LPI_SKIP("AddressSanitizer ends the process when a mapping is refused");
 #endif
-    const int N = 101;
-    const size_t n = (size_t)N * N;
-    double *x = malloc(n * sizeof *x), *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
-    double *lambda = malloc(n * sizeof *lambda), *f = malloc(2 * n * sizeof *f);
-    assert_true(x && a && b && lambda && f);
-    random_field(x, n, 11);
-    sqg_over_topography(N, lambda, f);
+    limited_case c = limited_case_create(11);
+    lpi_system *sys = c.sys, *loaded = NULL;
+    const size_t n = c.n;
     char path[64];
     snprintf(path, sizeof path, "test_sine_euler_mpi_short_%d.lpi", size_);
-    lpi_system *sys, *loaded = NULL;
-    assert_int_equal(lpi_sine_euler_create_mpi(&sys, N, MPI_COMM_WORLD), LPI_OK);
-    assert_int_equal(lpi_set_state(sys, x, n), LPI_OK);
-    assert_int_equal(lpi_sine_euler_set_hamiltonian(sys, lambda, n, f, 2 * n), LPI_OK);
+    assert_int_equal(lpi_sine_euler_set_hamiltonian(sys, c.lambda, n, c.f, 2 * n), LPI_OK);
     assert_int_equal(lpi_save(sys, path), LPI_OK);
     const load_arguments load = {path, &loaded};
     const int status = with_last_process_limited(load_spread, NULL, &load);
@@ -611,13 +622,13 @@ static void test_load_failure_on_one_process(void **state) {
     assert_int_equal(all, refused);
     /* And the file loads once the memory is there. */
     assert_int_equal(lpi_load_mpi(&loaded, path, MPI_COMM_WORLD), LPI_OK);
-    assert_int_equal(lpi_get_state(sys, a, n), LPI_OK);
-    assert_int_equal(lpi_get_state(loaded, b, n), LPI_OK);
-    assert_memory_equal(a, b, n * sizeof *a);
-    lpi_destroy(loaded), lpi_destroy(sys);
+    assert_int_equal(lpi_get_state(sys, c.a, n), LPI_OK);
+    assert_int_equal(lpi_get_state(loaded, c.b, n), LPI_OK);
+    assert_memory_equal(c.a, c.b, n * sizeof *c.a);
+    lpi_destroy(loaded);
+    limited_case_free(&c);
     MPI_Barrier(MPI_COMM_WORLD);
     if (rank_ == 0) remove(path);
-    free(x), free(a), free(b), free(lambda), free(f);
     if (!refused) LPI_SKIP("an address-space limit refused nothing (a sanitizer's reserve?)");
 }
 
