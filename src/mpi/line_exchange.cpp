@@ -101,7 +101,8 @@ void for_each_exchanged(const Transition &T, const LineOwnership &L, int target,
         for (int d = L.first[source]; d < L.first[source + 1]; ++d) {
             // d - offset and N - d - offset lie in (-N, N): one correction each.
             const int on_d = d - offset, on_minus_d = N - d - offset;
-            T.solve(on_d < 0 ? on_d + N : on_d, [&](int s_new) { f(d_new, s_new, d, T.element(base, s_new), false); });
+            T.solve(on_d < 0 ? on_d + N : on_d,
+                    [&](int s_new) { f(d_new, s_new, d, T.element(base, s_new), false); });
             T.solve(on_minus_d < 0 ? on_minus_d + N : on_minus_d, [&](int s_new) {
                 const int u = T.element(base, s_new);
                 f(d_new, s_new, d, u == 0 ? 0 : N - u, true);

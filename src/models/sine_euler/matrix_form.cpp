@@ -26,7 +26,8 @@ MatrixForm::MatrixForm(int N, Layout layout)
             const std::size_t a = (k + n - m2) * half % n, b = (a + m2) % n;
             index_[m2 * n + k] = layout == ColumnMajor ? a + b * n : a * n + b;
         }
-    require_fftw_headroom(fftw_planning_headroom(N), "the matrix form's plans of length " + std::to_string(N));
+    require_fftw_headroom(fftw_planning_headroom(N),
+                          "the matrix form's plans of length " + std::to_string(N));
     std::lock_guard<std::mutex> lock(fftw_planner_mutex());
     plans_ = new Plans;
     fftw_complex *buffer = fftw_alloc_complex(index_.size());
