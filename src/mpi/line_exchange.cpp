@@ -161,33 +161,6 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
         im = mirrored ? -z[1] : z[1];
     };
 
-    // Pack: for each process, the new line 0's modes held here, the riders,
-    // then its lines' modes. Written through pointers into buffers sized by
-    // reserve() to the largest exchange (checked above).
-    double *out = send_.data();
-    std::size_t sent = 0;  // complex entries
-    send_counts_.assign(P, 0);
-    send_offsets_.assign(P, 0);
-    for (int q = 0; q < P; ++q) {
-        const std::size_t start = sent;
-        for (int i = origin_first[me]; i < origin_first[me + 1]; ++i) {
-            const int s = origin_order[i];
-            old_value(T.line_of_new_origin_line(s), T.element(0, s), out[2 * sent], out[2 * sent + 1]);
-            ++sent;
-        }
-        if (riders) {
-            std::copy(riders->own.begin(), riders->own.end(), out + 2 * sent);
-            sent += riders->own.size() / 2;
-        }
-        for_each_exchanged(T, L, q, me, [&](int, int, int d, int e, bool mirrored) {
-            const double *z = slab + 2 * (static_cast<std::size_t>(e) * mine + (d - L.first[me]));
-            out[2 * sent] = z[0];
-            out[2 * sent + 1] = mirrored ? -z[1] : z[1];
-            ++sent;
-        });
-        send_offsets_[q] = as_count(start);
-        send_counts_[q] = as_count(sent - start);
-    }
     // Where each value received goes (complex entries after the index: line
     // 0 at 0 .. N-1, the lines from N).
     std::uint64_t *target = targets_.data();
@@ -212,6 +185,44 @@ void LineExchange::move(const Direction &from, std::size_t from_index, const Dir
     }
     old_line0_.assign(line0, line0 + 2 * static_cast<std::size_t>(N));
 
+    // Pack: for each process, the new line 0's modes held here, the riders,
+    // then its lines' modes. Written through pointers into buffers sized by
+    // reserve() to the largest exchange (checked above). This process's own
+    // block goes straight to where it is received, and the collective
+    // carries the others only (on one process: nothing to copy).
+    auto pack = [&](int q, double *out) {
+        std::size_t k = 0;  // complex entries
+        for (int i = origin_first[me]; i < origin_first[me + 1]; ++i, ++k) {
+            const int s = origin_order[i];
+            old_value(T.line_of_new_origin_line(s), T.element(0, s), out[2 * k], out[2 * k + 1]);
+        }
+        if (riders) {
+            std::copy(riders->own.begin(), riders->own.end(), out + 2 * k);
+            k += riders->own.size() / 2;
+        }
+        for_each_exchanged(T, L, q, me, [&](int, int, int d, int e, bool mirrored) {
+            const double *z = slab + 2 * (static_cast<std::size_t>(e) * mine + (d - L.first[me]));
+            out[2 * k] = z[0];
+            out[2 * k + 1] = mirrored ? -z[1] : z[1];
+            ++k;
+        });
+        return k;
+    };
+    std::size_t sent = 0;
+    send_counts_.assign(P, 0);
+    send_offsets_.assign(P, 0);
+    for (int q = 0; q < P; ++q) {
+        send_offsets_[q] = as_count(sent);
+        if (q != me) {
+            const std::size_t count = pack(q, send_.data() + 2 * sent);
+            send_counts_[q] = as_count(count);
+            sent += count;
+        } else if (pack(q, receive_.data() + 2 * static_cast<std::size_t>(receive_offsets_[me])) !=
+                   static_cast<std::size_t>(receive_counts_[me])) {
+            fail(LPI_ERR_INTERNAL, "a line exchange packed another count than it receives");
+        }
+    }
+    receive_counts_[me] = 0;  // in place already
     comm_.alltoallv(send_.data(), send_counts_, send_offsets_, receive_.data(), receive_counts_,
                     receive_offsets_);
 
