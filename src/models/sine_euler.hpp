@@ -100,6 +100,9 @@ std::mutex &fftw_planner_mutex();
 std::size_t fftw_planning_headroom(int N);
 std::size_t fftw_execution_headroom(int N, int threads);
 void require_fftw_headroom(std::size_t bytes, const std::string &what);
+// Before a step's transforms: fftw_execution_headroom, where it reaches
+// 64 KiB (below, the buffers come from freed heap blocks of their sizes).
+void require_fftw_execution_headroom(int N, int threads);
 
 // ---- matrix form (sine_euler_matrix.cpp) ----------------------------------
 // W = sum_m w_m J_m, J_m = exp(2 pi i m1 m2 / N) g^m1 h^m2 (the transforms:

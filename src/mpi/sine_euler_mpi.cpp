@@ -177,8 +177,7 @@ public:
         transforms();
         exchange_.reserve(&riders_);
         share_.reserve(origin_);
-        require_fftw_headroom(fftw_execution_headroom(N_, threads_),
-                              "the flows' transforms of length " + std::to_string(N_));
+        require_fftw_execution_headroom(N_, threads_);
     }
     void flow(std::size_t piece, double t, double *state) override;
     TransformTiming time_transforms(std::size_t flows_per_step, std::int64_t steps) override;
