@@ -98,10 +98,9 @@ std::mutex &fftw_planner_mutex();
 // tables) 2048 N bytes, at least 4 MiB; executing (Rader's buffer, buffered
 // loops of 8 transforms) 1024 N bytes a thread.
 std::size_t fftw_planning_headroom(int N);
-std::size_t fftw_execution_headroom(int N, int threads);
 void require_fftw_headroom(std::size_t bytes, const std::string &what);
-// Before a step's transforms: fftw_execution_headroom, where it reaches
-// 64 KiB (below, the buffers come from freed heap blocks of their sizes).
+// Before a step's transforms: the execution's bound, where it reaches 64 KiB
+// (below, the buffers come from freed heap blocks of their sizes).
 void require_fftw_execution_headroom(int N, int threads);
 
 // ---- matrix form (sine_euler_matrix.cpp) ----------------------------------

@@ -39,16 +39,13 @@ std::size_t fftw_planning_headroom(int N) {
     return std::max<std::size_t>(std::size_t{4} << 20, std::size_t{2048} * static_cast<std::size_t>(N));
 }
 
-std::size_t fftw_execution_headroom(int N, int threads) {
-    return std::size_t{1024} * static_cast<std::size_t>(N) * static_cast<std::size_t>(std::max(threads, 1));
-}
-
 void require_fftw_execution_headroom(int N, int threads) {
     // Below 64 KiB FFTW's execution buffers are heap blocks of the sizes the
     // last execution freed, found again without growing the heap; a mapping
-    // per call would cost a small system more than its check is worth (1.5 us
-    // of a 10 us step at N = 7, one step a call).
-    const std::size_t bytes = fftw_execution_headroom(N, threads);
+    // per call would cost a small system more than its check is worth (5 us
+    // a call in a VM, where a step at N = 7 takes 5 us).
+    const std::size_t bytes =
+        std::size_t{1024} * static_cast<std::size_t>(N) * static_cast<std::size_t>(std::max(threads, 1));
     if (bytes < (std::size_t{64} << 10)) return;
     require_fftw_headroom(bytes, "the flows' transforms of length " + std::to_string(N));
 }
