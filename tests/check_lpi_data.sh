@@ -98,6 +98,39 @@ pad=$((128 - 10 - ${#dict} - 1))
 { printf '\223NUMPY\001\000\166\000%s%*s\n' "$dict" "$pad" ""; head -c 80 /dev/zero; } > "$out/claims.npy"
 [ "$(wc -c < "$out/claims.npy")" -eq 208 ] || fail "claims.npy: the test wrote $(wc -c < "$out/claims.npy") bytes"
 limited refused 1 "truncated" sine-euler --init "$out/claims.npy"
+# The header is read as NumPy reads it (a Python literal with exactly the keys
+# descr, fortran_order and shape): a header NumPy refuses, or one that says
+# two things (a key twice: NumPy keeps the last) or gives a negative size, is
+# refused (exit status 1) and not read some other way. Each
+# file holds the 72 bytes of a 3 x 3 float64 grid; the first is readable.
+header_case() {  # header_case NAME DICT
+    pad=$((128 - 10 - ${#2} - 1))
+    { printf '\223NUMPY\001\000\166\000%s%*s\n' "$2" "$pad" ""; head -c 72 /dev/zero; } > "$out/$1.npy"
+}
+header_case plain "{\"descr\":\"<f8\",\"fortran_order\":True,\"shape\":(3,3)}"
+"$lpi" run sine-euler --init "$out/plain.npy" --steps 1 --out "$out/plain" >/dev/null 2>"$out/err" ||
+    { cat "$out/err"; fail "lpi run --init with a header in double quotes, without spaces"; }
+o="'fortran_order': False"
+header_case no_comma "{'descr': '<f8', $o, 'shape': (3 3), }"
+header_case no_tuple "{'descr': '<f8', $o, 'shape': (9), }"
+header_case leading_zero "{'descr': '<f8', $o, 'shape': (03, 3), }"
+header_case negative "{'descr': '<f8', $o, 'shape': (-3, 3), }"
+header_case twice "{'descr': '<i8', 'descr': '<f8', $o, 'shape': (3, 3), }"
+header_case other_key "{'descr': '<f8', $o, 'shape': (3, 3), 'x': 1}"
+header_case unclosed "{'descr': '<f8', $o, 'shape': (3, 3), "
+header_case after "{'descr': '<f8', $o, 'shape': (3, 3)} x"
+header_case no_order "{'descr': '<f8', 'shape': (3, 3), }"
+header_case not_bool "{'descr': '<f8', 'fortran_order': 0, 'shape': (3, 3), }"
+refused 1 "shape is not a tuple" sine-euler --init "$out/no_comma.npy"
+refused 1 "shape is not a tuple" sine-euler --init "$out/no_tuple.npy"
+refused 1 "shape is not a tuple" sine-euler --init "$out/leading_zero.npy"
+refused 1 "shape is not a tuple" sine-euler --init "$out/negative.npy"
+refused 1 "the key 'descr' twice" sine-euler --init "$out/twice.npy"
+refused 1 "a key 'x'" sine-euler --init "$out/other_key.npy"
+refused 1 "no closing" sine-euler --init "$out/unclosed.npy"
+refused 1 "more after its dictionary" sine-euler --init "$out/after.npy"
+refused 1 "no fortran_order" sine-euler --init "$out/no_order.npy"
+refused 1 "fortran_order is not True or False" sine-euler --init "$out/not_bool.npy"
 le8() { printf "\\$(printf %o "$1")\\$(printf %o "$2")\\000\\000\\000\\000\\000\\000"; }  # le8 LOW HIGH: 8 bytes
 zeros='\x00\x00\x00\x00\x00\x00\x00'
 dims="\\x03$zeros\\x09$zeros\\x09$zeros"

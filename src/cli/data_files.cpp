@@ -2,7 +2,6 @@
 
 #include <unistd.h>
 
-#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -43,44 +42,135 @@ std::uint64_t get_le(const unsigned char *in, int bytes) {
     return v;
 }
 
-// The value of 'key' in a .npy header dictionary: the text after "'key':",
-// up to the next top-level comma (a shape tuple is kept whole).
-std::string header_value(const std::string &header, const std::string &key) {
-    const std::size_t at = header.find("'" + key + "'");
-    if (at == std::string::npos) return "";
-    std::size_t i = header.find(':', at);
-    if (i == std::string::npos) return "";
-    ++i;
-    while (i < header.size() && header[i] == ' ') ++i;
-    int depth = 0;
-    std::string value;
-    for (; i < header.size(); ++i) {
-        const char c = header[i];
-        if (c == '(') ++depth;
-        if (c == ')') --depth;
-        if ((c == ',' || c == '}') && depth == 0) break;
-        value += c;
-    }
-    while (!value.empty() && value.back() == ' ') value.pop_back();
-    return value;
+// The dictionary of a .npy header, read as NumPy reads it (a Python literal
+// with exactly the keys 'descr', 'fortran_order' and 'shape'), so that a file
+// NumPy refuses is refused here too, not read in some other way: a shape
+// "(3 3)" or "(9)" (no tuple), a key twice, another key, anything after the
+// closing brace but the padding.
+struct NpyHeader {
+    std::string descr;
+    bool fortran_order = false;
+    std::vector<std::size_t> shape;
+};
+
+// Text from a file, for a message: printable ASCII, at most 40 characters.
+std::string shown(const std::string &text) {
+    std::string out;
+    for (char c : text.substr(0, 40)) out += c >= ' ' && c <= '~' ? c : '?';
+    return text.size() > 40 ? out + "..." : out;
 }
 
-bool parse_shape(const std::string &text, std::vector<std::size_t> &shape) {
-    if (text.size() < 2 || text.front() != '(' || text.back() != ')') return false;
-    shape.clear();
-    const char *p = text.c_str() + 1;
-    for (;;) {
-        while (*p == ' ' || *p == ',') ++p;
-        if (*p == ')') return true;
-        if (*p < '0' || *p > '9') return false;
-        char *end = nullptr;
-        errno = 0;
-        const unsigned long long n = std::strtoull(p, &end, 10);
-        if (errno == ERANGE || n > kMaxValues) return false;
-        shape.push_back(static_cast<std::size_t>(n));
-        p = end;
+class HeaderParser {
+public:
+    explicit HeaderParser(const std::string &text)
+        : p_(text.c_str()), end_(text.c_str() + text.size()) {}
+
+    // "" or what is wrong with the dictionary.
+    std::string parse(NpyHeader &h) {
+        bool have_descr = false, have_order = false, have_shape = false;
+        skip_space();
+        if (!take('{')) return "the header is not a dictionary";
+        for (;;) {
+            skip_space();
+            if (p_ == end_) return "the header's dictionary has no closing '}'";
+            if (take('}')) break;
+            std::string key;
+            if (!string_literal(key)) return "a key of the header's dictionary is not a string";
+            skip_space();
+            if (!take(':')) return "no ':' after '" + shown(key) + "' in the header";
+            skip_space();
+            bool *seen = key == "descr" ? &have_descr : key == "fortran_order" ? &have_order
+                       : key == "shape" ? &have_shape : nullptr;
+            if (!seen)
+                return "the header has a key '" + shown(key) +
+                       "' (a .npy header has 'descr', 'fortran_order' and 'shape' only)";
+            if (*seen) return "the header has the key '" + key + "' twice";
+            *seen = true;
+            if (key == "descr" && !string_literal(h.descr)) return "the header's descr is not a string";
+            if (key == "fortran_order" && !boolean(h.fortran_order))
+                return "the header's fortran_order is not True or False";
+            if (key == "shape" && !tuple(h.shape))
+                return "the header's shape is not a tuple of sizes below 2^28";
+            skip_space();
+            if (take(',')) continue;
+            skip_space();
+            if (take('}')) break;
+            if (p_ == end_) return "the header's dictionary has no closing '}'";
+            return "no ',' or '}' after the header's '" + key + "'";
+        }
+        skip_space();
+        if (p_ != end_) return "the header has more after its dictionary";
+        if (!have_descr) return "the header has no descr";
+        if (!have_order) return "the header has no fortran_order";
+        if (!have_shape) return "the header has no shape";
+        return "";
     }
-}
+
+private:
+    void skip_space() {
+        while (p_ != end_ && (*p_ == ' ' || *p_ == '\t' || *p_ == '\n' || *p_ == '\r')) ++p_;
+    }
+    bool take(char c) {
+        if (p_ == end_ || *p_ != c) return false;
+        ++p_;
+        return true;
+    }
+    bool word(const char *w) {
+        const std::size_t n = std::strlen(w);
+        if (static_cast<std::size_t>(end_ - p_) < n || std::memcmp(p_, w, n) != 0) return false;
+        p_ += n;
+        return true;
+    }
+    // 'text' or "text" without escapes (NumPy writes none in these values).
+    bool string_literal(std::string &out) {
+        if (p_ == end_ || (*p_ != '\'' && *p_ != '"')) return false;
+        const char quote = *p_++;
+        const char *start = p_;
+        while (p_ != end_ && *p_ != quote && *p_ != '\\' && *p_ != '\n') ++p_;
+        if (p_ == end_ || *p_ != quote) return false;
+        out.assign(start, p_);
+        ++p_;
+        return true;
+    }
+    bool boolean(bool &out) {
+        if (word("True")) out = true;
+        else if (word("False")) out = false;
+        else return false;
+        return true;
+    }
+    // A decimal size as Python writes it (no sign, no leading zero).
+    bool size(std::size_t &out) {
+        if (p_ == end_ || *p_ < '0' || *p_ > '9') return false;
+        if (*p_ == '0' && p_ + 1 != end_ && p_[1] >= '0' && p_[1] <= '9') return false;
+        std::size_t n = 0;
+        for (; p_ != end_ && *p_ >= '0' && *p_ <= '9'; ++p_) {
+            n = 10 * n + static_cast<std::size_t>(*p_ - '0');
+            if (n > kMaxValues) return false;
+        }
+        out = n;
+        return true;
+    }
+    // () or (a,) or (a, b, ...) with an optional trailing comma: (a) is a
+    // number, not a tuple.
+    bool tuple(std::vector<std::size_t> &out) {
+        out.clear();
+        if (!take('(')) return false;
+        skip_space();
+        if (take(')')) return true;
+        for (;;) {
+            std::size_t n = 0;
+            if (!size(n)) return false;
+            out.push_back(n);
+            skip_space();
+            const bool comma = take(',');
+            skip_space();
+            if (take(')')) return comma || out.size() > 1;
+            if (!comma) return false;
+        }
+    }
+
+    const char *p_, *end_;
+};
 
 }  // namespace
 
@@ -142,20 +232,20 @@ std::string parse_npy(RegularFileReader &f, Array &a) {
     std::string header(length, '\0');
     if (f.read(reinterpret_cast<unsigned char *>(&header[0]), length) != length) return "truncated header";
     const std::size_t data_bytes = f.size() - (major == 1 ? 10 : 12) - length;
-    const std::string descr = header_value(header, "descr");
-    const std::string order = header_value(header, "fortran_order");
+    NpyHeader fields;
+    const std::string unreadable = HeaderParser(header).parse(fields);
+    if (!unreadable.empty()) return unreadable;
+    const std::string &descr = fields.descr;
     int item = 0;
     bool integer = false;
-    if (descr == "'<f8'") item = 8;
-    else if (descr == "'<f4'") item = 4;
-    else if (descr == "'<i8'") item = 8, integer = true;
-    else if (descr == "'<i4'") item = 4, integer = true;
-    else return "dtype " + (descr.empty() ? std::string("(none)") : descr) +
-                " is not read here (little-endian float64, float32, int64 or int32)";
-    if (order != "False" && order != "True") return "no fortran_order in the header";
+    if (descr == "<f8") item = 8;
+    else if (descr == "<f4") item = 4;
+    else if (descr == "<i8") item = 8, integer = true;
+    else if (descr == "<i4") item = 4, integer = true;
+    else return "dtype '" + shown(descr) + "' is not read here (little-endian float64, float32, int64 or int32)";
     Array out;
     out.integer = integer;
-    if (!parse_shape(header_value(header, "shape"), out.shape)) return "no readable shape in the header";
+    out.shape = fields.shape;
     bool too_many = false;
     const std::size_t count = element_count(out.shape, &too_many);
     if (too_many) return "more than 2^28 values";
@@ -182,7 +272,7 @@ std::string parse_npy(RegularFileReader &f, Array &a) {
             out.values[i] = v;  // exact
         }
     }
-    if (order == "True" && out.shape.size() > 1) {
+    if (fields.fortran_order && out.shape.size() > 1) {
         // Fortran order: the first index runs fastest. Reorder to C order.
         std::vector<double> c_order(count);
         std::vector<std::size_t> index(out.shape.size(), 0);
