@@ -25,7 +25,7 @@ refused() {  # refused OPTION-NAME-IN-MESSAGE lpi-arguments...
 rb="run rigid-body --out $out/bad"
 for v in -5 0 -0 nan inf 1e400 1e-400 "" 10x " 5" 0x; do refused --until $rb --until "$v"; done
 for v in 0 -0 -1 nan -inf 1e999 "" 1e-320 0.1.2; do refused --dt $rb --dt "$v"; done
-for v in -3 0 2.9 1e400 "" 10x 9223372036854775808 18446744073709551621 nan; do refused --steps $rb --steps "$v"; done
+for v in -3 0 2.9 1e400 "" 10x 9223372036854775808 18446744073709551621 nan 4611686018427387904; do refused --steps $rb --steps "$v"; done
 for v in 0 -1 0.5 9223372036854775808 ""; do refused --every $rb --every "$v"; done
 for v in 0 -1 4294967297 2147483648 1.5; do refused --threads $rb --threads "$v"; done
 for v in 1e12 4 1 -7 2.5 4294967303 ""; do refused --N run sine-euler --out "$out/bad" --N "$v"; done

@@ -116,7 +116,7 @@ std::vector<CsvRow> csv_up_to(const std::string &path, int64_t step, std::size_t
         if (fields.size() != 4 + casimir_count)
             return bad(format("%zu fields, not %zu", fields.size(), 4 + casimir_count));
         CsvRow row;
-        std::string wrong = whole_problem(fields[0], 0, (int64_t(1) << 62) - 1, row.step);
+        std::string wrong = whole_problem(fields[0], 0, kMaxSteps, row.step);
         if (!wrong.empty()) return bad("step: " + wrong);
         if (!rows.empty() && row.step <= rows.back().step) return bad("the steps do not increase");
         std::vector<double> values(fields.size());

@@ -68,7 +68,7 @@ bool parse_run_options(int argc, char **argv, RunOptions &o) {
         const std::string arg = args.next();
         if (arg == "--method") o.method = args.value(arg);
         else if (arg == "--dt") o.dt = args.positive(arg);
-        else if (arg == "--steps") o.steps = args.integer(arg, 1, INT64_MAX);
+        else if (arg == "--steps") o.steps = args.integer(arg, 1, kMaxSteps);
         else if (arg == "--until") o.until = args.positive(arg);
         else if (arg == "--every") o.every = args.integer(arg, 1, INT64_MAX);
         else if (arg == "--threads") o.threads = static_cast<int32_t>(args.integer(arg, 1, int32_max));
