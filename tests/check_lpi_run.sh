@@ -147,6 +147,15 @@ fi
 refused "not a checkpoint of this scene" run rigid-body --resume "$out/pendulum.lpi" --out "$out/bad"
 "$lpi" run rigid-body --dt 0.05 --steps 20 --out "$out/r" --checkpoint "$out/rigid.lpi" >/dev/null
 refused "Hamiltonian differs" run rigid-body --inertia 1,1,2 --resume "$out/rigid.lpi" --out "$out/bad"
+# ... also where the energies agree at the checkpoint's state: I1 = 1.5 and
+# the I2 that gives m1^2/I1 + m2^2/I2 its value for I = (1, 2, 3) at the state
+# m the run ended at (its last snapshot, printed to 17 digits).
+"$lpi" run rigid-body --dt 0.05 --steps 20 --every 10 --snapshots 1 --format npy --out "$out/m" \
+    --checkpoint "$out/m.lpi" >/dev/null
+same_energy=$(tail -c 24 "$out/m/rigid-body/state.npy" | od -An -t f8 -v |
+    awk '{ for (i = 1; i <= NF; ++i) m[++n] = $i }
+         END { a = m[1] * m[1]; b = m[2] * m[2]; printf "1.5,%.17g,3", b / (a + b / 2 - a / 1.5) }')
+refused "Hamiltonian differs" run rigid-body --inertia "$same_energy" --resume "$out/m.lpi" --out "$out/bad"
 refused "not a whole number of steps" run rigid-body --dt 0.03 --resume "$out/rigid.lpi" --out "$out/bad"
 refused "past the run's end" run rigid-body --dt 0.05 --steps 10 --resume "$out/rigid.lpi" --out "$out/bad"
 # The checkpoint holds the run's method: another --method would splice rows

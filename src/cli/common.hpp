@@ -24,6 +24,16 @@ namespace lpi_cli {
 
 constexpr double kPi = 3.14159265358979323846;
 
+// Uniform in [0, 1) from splitmix64: a small, well-mixed deterministic
+// generator (the same numbers on every machine).
+inline double uniform_random(std::uint64_t &state) {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    z ^= z >> 31;
+    return static_cast<double>(z >> 11) * 0x1.0p-53;
+}
+
 // printf into a std::string.
 inline std::string format(const char *pattern, ...) __attribute__((format(printf, 1, 2)));
 inline std::string format(const char *pattern, ...) {

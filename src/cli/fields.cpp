@@ -11,15 +11,6 @@ namespace {
 // Representative of a mod N in -M..M.
 int centred(int a, int N) { return a > N / 2 ? a - N : a; }
 
-// splitmix64: a small, well-mixed deterministic generator.
-double uniform(std::uint64_t &state) {
-    std::uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-    z ^= z >> 31;
-    return static_cast<double>(z >> 11) * 0x1.0p-53;
-}
-
 }  // namespace
 
 std::vector<double> smooth_random_field(int N, double k0, std::uint64_t seed) {
@@ -31,8 +22,8 @@ std::vector<double> smooth_random_field(int N, double k0, std::uint64_t seed) {
             // Draw each pair +-m once, from its member in the upper half plane.
             if (!(m1 > 0 || (m1 == 0 && m2 > 0))) continue;
             const double amplitude = std::exp(-(m1 * m1 + m2 * m2) / (2.0 * k0 * k0)) *
-                                     (0.5 + uniform(seed));
-            const double phase = 2.0 * kPi * uniform(seed);
+                                     (0.5 + uniform_random(seed));
+            const double phase = 2.0 * kPi * uniform_random(seed);
             const std::size_t i = static_cast<std::size_t>(a) * N + b;
             const std::size_t j = static_cast<std::size_t>((N - a) % N) * N + (N - b) % N;
             w[2 * i] = amplitude * std::cos(phase);
