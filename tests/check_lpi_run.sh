@@ -152,7 +152,7 @@ refused "Hamiltonian differs" run rigid-body --inertia 1,1,2 --resume "$out/rigi
 # m the run ended at (its last snapshot, printed to 17 digits).
 "$lpi" run rigid-body --dt 0.05 --steps 20 --every 10 --snapshots 1 --format npy --out "$out/m" \
     --checkpoint "$out/m.lpi" >/dev/null
-same_energy=$(tail -c 24 "$out/m/rigid-body/state.npy" | od -An -t f8 -v |
+same_energy=$(tail -c 24 "$out/m/rigid-body/state.npy" | od -An -t f8 -v --endian=little |
     awk '{ for (i = 1; i <= NF; ++i) m[++n] = $i }
          END { a = m[1] * m[1]; b = m[2] * m[2]; printf "1.5,%.17g,3", b / (a + b / 2 - a / 1.5) }')
 refused "Hamiltonian differs" run rigid-body --inertia "$same_energy" --resume "$out/m.lpi" --out "$out/bad"

@@ -291,13 +291,13 @@ inline double energy_of(const lpi_system *sys) {
     return h;
 }
 
-// The number of steps of `dt` in `span`, rounded: below 2^62, where a run's
-// step counts and their sums stay exact in 64 bits; past that (a huge time
-// or a tiny step) the command stops with a message and exit status 2.
 // The most steps a run takes: below 2^62, where a step's time and index still
 // tell each other apart (a resumed run finds its step as time / dt).
 constexpr int64_t kMaxSteps = (int64_t(1) << 62) - 1;
 
+// The number of steps of `dt` in `span`, rounded: below 2^62, where a run's
+// step counts and their sums stay exact in 64 bits; past that (a huge time
+// or a tiny step) the command stops with a message and exit status 2.
 inline int64_t step_count(double span, double dt, const std::string &what) {
     const double steps = span / dt;
     if (!(steps >= 0.0 && steps < 0x1p62)) {

@@ -73,7 +73,13 @@ std::string mismatch(lpi_system *fresh, const lpi_system *loaded) {
             for (double &v : x) v = scale * (2.0 * uniform_random(seed) - 1.0);
         check(lpi_set_state(fresh, x.data(), x.size()), fresh, "set state");
         check(lpi_set_state(copy.get(), x.data(), x.size()), copy.get(), "set state");
-        const double h_fresh = energy_of(fresh), h_loaded = energy_of(copy.get());
+        double h_fresh = 0.0, h_loaded = 0.0;
+        if (probe == 0) {
+            h_fresh = energy_of(fresh);
+            h_loaded = energy_of(copy.get());
+        } else if (lpi_energy(fresh, &h_fresh) != LPI_OK || lpi_energy(copy.get(), &h_loaded) != LPI_OK) {
+            continue;  // an energy beyond a double there (a state near the range's end)
+        }
         if (std::fabs(h_fresh - h_loaded) > 1e-12 * std::max(std::fabs(h_fresh), std::fabs(h_loaded)))
             return "its Hamiltonian differs (other parameters, such as --inertia)";
     }
