@@ -42,11 +42,7 @@ std::uint64_t get_le(const unsigned char *in, int bytes) {
     return v;
 }
 
-// The dictionary of a .npy header, read as NumPy reads it (a Python literal
-// with exactly the keys 'descr', 'fortran_order' and 'shape'), so that a file
-// NumPy refuses is refused here too, not read in some other way: a shape
-// "(3 3)" or "(9)" (no tuple), a key twice, another key, anything after the
-// closing brace but the padding.
+// What a .npy header's dictionary says.
 struct NpyHeader {
     std::string descr;
     bool fortran_order = false;
@@ -60,6 +56,11 @@ std::string shown(const std::string &text) {
     return text.size() > 40 ? out + "..." : out;
 }
 
+// The dictionary of a .npy header, read as NumPy reads it (a Python literal
+// with exactly the keys 'descr', 'fortran_order' and 'shape'), so that a file
+// NumPy refuses is refused here too, not read in some other way: a shape
+// "(3 3)" or "(9)" (no tuple), a key twice, another key, anything after the
+// closing brace but the padding.
 class HeaderParser {
 public:
     explicit HeaderParser(const std::string &text)
