@@ -307,7 +307,9 @@ LPI_API int lpi_sine_euler_get_grid(const lpi_system *sys, double *w, size_t n);
  * the getters below, a value that overflows a double gives LPI_ERR_OVERFLOW
  * naming it (the output is then untouched). */
 LPI_API int lpi_sine_euler_enstrophy(const lpi_system *sys, double *out);
-/* out[k-1] = (1/N) tr W^k for k = 1 .. kmax (kmax >= 1; O(kmax N^3)). */
+/* out[k-1] = (1/N) tr W^k for k = 1 .. kmax (kmax >= 1; O(kmax N^3), less
+ * where a trace overflows, which ends the call there, or a power of W is zero,
+ * after which every trace is 0). */
 LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, double *out);
 
 /* Measures the FFT floor: FFTW executing, with this system's plans, buffers

@@ -490,6 +490,44 @@ static void test_traces_match_spectrum(void **state) {
     if (!have_spectrum) LPI_SKIP("built without LAPACK: no spectrum to compare the traces with");
 }
 
+/* Past a power of W that is exactly zero every trace is 0, and a trace that
+ * overflows stops the call there, naming it, with out untouched: neither
+ * needs the later powers (each N^3 operations) nor a list of kmax values. */
+static void test_traces_past_zero_and_overflow(void **state) {
+    (void)state;
+    const int N = 5;
+    static double traces[1 << 16], first[5];
+    double w[2 * 25];
+    random_field(N, 4, w);
+    for (int i = 0; i < 2 * 25; ++i) w[i] *= 1e-3;
+    w[0] = 0.0;
+    lpi_system *sys = sine_euler(N, w);
+    assert_int_equal(lpi_sine_euler_casimir_traces(sys, 5, first), LPI_OK);
+    assert_int_equal(lpi_sine_euler_casimir_traces(sys, 400, traces), LPI_OK);
+    assert_memory_equal(traces, first, sizeof first);
+    assert_true(traces[1] > 0.0); /* (1/N) tr W^2 = 2 x enstrophy / N */
+    int zero_from = 400;
+    while (zero_from > 0 && traces[zero_from - 1] == 0.0) --zero_from;
+    assert_true(zero_from > 5 && zero_from < 200); /* |W| ~ 1e-3: W^k underflows near k = 108 */
+    for (int k = zero_from; k < 400; ++k) assert_true(traces[k] == 0.0 && !signbit(traces[k]));
+    /* W = 0: every trace 0. */
+    for (int i = 0; i < 2 * 25; ++i) w[i] = 0.0;
+    assert_int_equal(lpi_sine_euler_set_modes(sys, w, 2 * 25), LPI_OK);
+    traces[7] = 1.0;
+    assert_int_equal(lpi_sine_euler_casimir_traces(sys, 1 << 16, traces), LPI_OK);
+    for (int k = 0; k < 1 << 16; ++k) assert_true(traces[k] == 0.0);
+    /* w_0 = 1e300: (1/N) tr W = 1e300, tr W^2 overflows. */
+    random_field(N, 4, w);
+    w[0] = 1e300;
+    assert_int_equal(lpi_sine_euler_set_modes(sys, w, 2 * 25), LPI_OK);
+    for (int k = 0; k < 1 << 16; ++k) traces[k] = -7.0;
+    LPI_ASSERT_FAILS(sys, lpi_sine_euler_casimir_traces(sys, 1 << 16, traces), LPI_ERR_OVERFLOW,
+                     "lpi_sine_euler_casimir_traces");
+    assert_non_null(strstr(lpi_last_error(sys), "tr W^2 "));
+    for (int k = 0; k < 1 << 16; ++k) assert_true(traces[k] == -7.0);
+    lpi_destroy(sys);
+}
+
 /* A Hermitian field given by a formula, so that a large one can be checked
  * entry by entry without a second copy: w(a, b) = conj(w(-a, -b)). */
 static double formula_part(int a, int b, int N, int imaginary) {
@@ -956,6 +994,7 @@ int main(void) {
         cmocka_unit_test(test_paper_figure2),
         cmocka_unit_test(test_modes_grid_and_state_round_trips),
         cmocka_unit_test(test_traces_match_spectrum),
+        cmocka_unit_test(test_traces_past_zero_and_overflow),
         cmocka_unit_test(test_large_n),
         cmocka_unit_test(test_threads_bitwise),
         cmocka_unit_test(test_handles_on_threads),

@@ -128,13 +128,13 @@ LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, d
         const auto &model = sine_euler(sys);
         require(out, "out");
         if (kmax < 1) lpi::fail(LPI_ERR_INVALID, "kmax must be >= 1, got " + std::to_string(kmax));
-        std::vector<double> traces;
-        model.agree_on_every_process([&] { traces.resize(static_cast<std::size_t>(kmax)); });
-        model.casimir_traces(sys->system.working_state().data(), kmax, traces.data());
+        const std::vector<double> traces = model.casimir_traces(sys->system.working_state().data(), kmax);
         lpi::require_no_overflow(traces.data(), traces.size(), [](std::size_t i) {
             return "(1/N) tr W^" + std::to_string(i + 1) + " of this state";
         });
+        // Fewer than kmax: the later powers of W are zero.
         std::copy(traces.begin(), traces.end(), out);
+        std::fill(out + traces.size(), out + kmax, 0.0);
     });
 }
 

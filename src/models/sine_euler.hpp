@@ -17,6 +17,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "../core/model.hpp"
 #include "sine_euler/hamiltonian.hpp"
@@ -54,7 +55,8 @@ public:
     virtual void public_from_grid(const double *grid, double *x) const = 0;
     virtual void grid(const double *state, double *out) const = 0;
     virtual double enstrophy(const double *state) const = 0;
-    virtual void casimir_traces(const double *state, int kmax, double *out) const = 0;
+    // sine_euler_traces of the state: kmax values or fewer (see there).
+    virtual std::vector<double> casimir_traces(const double *state, int kmax) const = 0;
     // The Hamiltonian every method, the energy and the diagnostics use
     // (Euler's until set; see sine_euler/hamiltonian.hpp): a copy, which a
     // model spread over processes assembles on request (none holds it whole).
@@ -111,11 +113,13 @@ void require_fftw_execution_headroom(int N, int threads);
 // other half is its conjugate and the inert mode w_0 does not move.
 void sine_euler_matrix_vector_field(const sine_euler::Hamiltonian &H, const double *modes,
                                     double *rate);
-// (1/N) tr W^k, k = 1 .. kmax. At the first k whose trace is not finite it
-// stops, that trace written and the later ones left as they were: its
-// callers refuse the whole call there, so the later powers (each N^3
-// operations) would be work for nothing.
-void sine_euler_traces(int N, const double *modes, int kmax, double *out);
+// (1/N) tr W^k for k = 1 .. kmax, or fewer: the list ends at the first
+// trace that is not finite (its callers refuse the whole call there, so the
+// later powers, each N^3 operations, and a list of kmax values would be work
+// and memory for nothing), and before the first power of W that is exactly
+// zero (W = 0, or a small W whose powers underflow), whose trace and those
+// of every later power are 0.
+std::vector<double> sine_euler_traces(int N, const double *modes, int kmax);
 // Sorted eigenvalues of the Hermitian W (LAPACK zheevd); LPI_ERR_OVERFLOW
 // when W has overflowed, LPI_ERR_UNSUPPORTED naming LAPACK when built
 // without it.

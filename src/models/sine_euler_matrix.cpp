@@ -73,27 +73,30 @@ void sine_euler_matrix_vector_field(const sine_euler::Hamiltonian &H, const doub
         }
 }
 
-void sine_euler_traces(int N, const double *modes, int kmax, double *out) {
+std::vector<double> sine_euler_traces(int N, const double *modes, int kmax) {
     const std::size_t n2 = static_cast<std::size_t>(N) * N;
     std::vector<cplx> W(n2), power(n2), next(n2);
     sine_euler::MatrixForm(N, sine_euler::MatrixForm::RowMajor).to_matrix(modes, W.data());
     power = W;
+    std::vector<double> traces;
     for (int k = 1; k <= kmax; ++k) {
         if (k > 1) {
             multiply(N, power.data(), W.data(), next.data());
             power.swap(next);
         }
+        if (std::all_of(power.begin(), power.end(), [](const cplx &z) { return z == 0.0; })) break;
         double trace = 0.0;
         for (int i = 0; i < N; ++i) trace += power[at(i, i, N)].real();
-        if (std::isfinite(trace)) {
-            out[k - 1] = trace / N;
-        } else {  // the sum overflows, the mean need not (W = w_0 I, w_0 = 1e308)
-            double mean = 0.0;
-            for (int i = 0; i < N; ++i) mean += power[at(i, i, N)].real() / N;
-            out[k - 1] = mean;
-            if (!std::isfinite(mean)) return;
+        if (!std::isfinite(trace)) {  // the sum overflows, the mean need not (W = w_0 I, w_0 = 1e308)
+            trace = 0.0;
+            for (int i = 0; i < N; ++i) trace += power[at(i, i, N)].real() / N;
+            traces.push_back(trace);
+            if (!std::isfinite(trace)) break;
+        } else {
+            traces.push_back(trace / N);
         }
     }
+    return traces;
 }
 
 #if LPI_HAVE_LAPACK

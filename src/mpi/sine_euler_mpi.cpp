@@ -153,10 +153,15 @@ public:
         comm_->on_root([&] { sine_euler_spectrum(N_, modes.data(), out); });
         comm_->broadcast(out, casimir_count());
     }
-    void casimir_traces(const double *state, int kmax, double *out) const override {
+    std::vector<double> casimir_traces(const double *state, int kmax) const override {
         const std::vector<double> modes = whole_state(state);
-        comm_->on_root([&] { sine_euler_traces(N_, modes.data(), kmax, out); });
-        comm_->broadcast(out, static_cast<std::size_t>(kmax));
+        std::vector<double> traces;
+        comm_->on_root([&] { traces = sine_euler_traces(N_, modes.data(), kmax); });
+        double count = static_cast<double>(traces.size());  // at most kmax < 2^31: exact
+        comm_->broadcast(&count, 1);
+        comm_->agree([&] { traces.resize(static_cast<std::size_t>(count)); });
+        comm_->broadcast(traces.data(), traces.size());
+        return traces;
     }
     std::size_t casimir_count() const override { return static_cast<std::size_t>(N_); }
     double energy(const double *state) const override;

@@ -142,8 +142,8 @@ public:
     void casimirs(const double *state, double *out) const override {
         sine_euler_spectrum(N_, state, out);
     }
-    void casimir_traces(const double *state, int kmax, double *out) const override {
-        sine_euler_traces(N_, state, kmax, out);
+    std::vector<double> casimir_traces(const double *state, int kmax) const override {
+        return sine_euler_traces(N_, state, kmax);
     }
     void vector_field(const double *state, double *rate) const override {
         sine_euler_matrix_vector_field(hamiltonian_, state, rate);
