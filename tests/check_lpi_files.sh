@@ -161,9 +161,10 @@ fi
 # the checkpoint ahead of the CSV), and the CSV reaches the checkpoint left:
 # resumed, the run's CSV is the uninterrupted run's (no new file started at
 # the checkpoint's step, the rows before it and the energy at step 0 lost).
-set -- run rigid-body --steps 1000 --every 1 --checkpoint-every 1 --format npy
+set -- run rigid-body --steps 1000 --every 1 --format npy
 "$lpi" "$@" --out "$out/ck-whole" >/dev/null
-rc=0; limited "$@" --out "$out/ck-full" --checkpoint "$out/ck-full.lpi" >"$out/stdout" 2>"$out/stderr" || rc=$?
+set -- "$@" --checkpoint "$out/ck-full.lpi" --checkpoint-every 1
+rc=0; limited "$@" --out "$out/ck-full" >"$out/stdout" 2>"$out/stderr" || rc=$?
 [ "$rc" -eq 1 ] && grep -q "rigid-body.csv.*File too large" "$out/stderr" && ! grep -q "^done" "$out/stdout" ||
     { cat "$out/stderr"; fail "a CSV that cannot be written with its checkpoint: exit status $rc, expected 1 at once"; }
 "$lpi" "$@" --out "$out/ck-full" --resume "$out/ck-full.lpi" >"$out/stdout"
@@ -181,9 +182,9 @@ diff -r "$out/ck-whole/rigid-body" "$out/ck-full/rigid-body" >/dev/null ||
 # not grow, so ulimit -f cannot fail a later save alone; root writes
 # through a mode). Resumed, the run is the uninterrupted one, data included.
 rm -rf "$out/ck-dir" "$out/ck-dir.gone" "$out/ck-gone" "$out/ck-ref"; mkdir -p "$out/ck-dir"
-set -- run rigid-body --dt 0.01 --every 100000 --snapshots 1 --checkpoint-every 1 --format npy
+set -- run rigid-body --dt 0.01 --every 100000 --snapshots 1 --format npy
 timeout 60 "$lpi" "$@" --steps 1000000000 --out "$out/ck-gone" --checkpoint "$out/ck-dir/run.lpi" \
-    >"$out/stdout" 2>"$out/stderr" &
+    --checkpoint-every 1 >"$out/stdout" 2>"$out/stderr" &
 pid=$!
 waited=0
 until [ -f "$out/ck-dir/run.lpi" ] || [ $waited -ge 600 ]; do sleep 0.05; waited=$((waited + 1)); done
@@ -194,7 +195,8 @@ rc=0; wait $pid || rc=$?
 [ -f "$out/ck-gone/rigid-body/state.npy" ] || fail "a checkpoint save that failed mid-run: no data written"
 stop=$(tail -n 1 "$out/ck-gone/rigid-body.csv" | cut -d, -f1)
 mv "$out/ck-dir.gone" "$out/ck-dir"
-"$lpi" "$@" --steps $((stop + 300000)) --out "$out/ck-gone" --resume "$out/ck-dir/run.lpi" >/dev/null
+"$lpi" "$@" --steps $((stop + 300000)) --out "$out/ck-gone" --checkpoint "$out/ck-dir/run.lpi" \
+    --checkpoint-every 1 --resume "$out/ck-dir/run.lpi" >/dev/null
 "$lpi" "$@" --steps $((stop + 300000)) --out "$out/ck-ref" >/dev/null
 cmp -s "$out/ck-ref/rigid-body.csv" "$out/ck-gone/rigid-body.csv" &&
     diff -r "$out/ck-ref/rigid-body" "$out/ck-gone/rigid-body" >/dev/null ||

@@ -78,6 +78,8 @@ for option in "--every 3" "--threads 2" "--planning patient" "--snapshots 2" "--
     refused "${option% *}" run rollup --N 5 --steps 3 $option --out "$out/bad"
 done
 refused --N report rigid-body --N 5 --out "$out/bad"
+refused --checkpoint-every $rb --checkpoint-every 5
+refused --checkpoint-every $rb --checkpoint-every 0 --resume "$out/none.ckpt"
 refused --T report pendulum --T 5 --out "$out/bad"
 
 # Every failure: non-zero. A checkpoint that cannot be written stops the run

@@ -106,6 +106,8 @@ bool parse_run_options(int argc, char **argv, RunOptions &o) {
     }
     if (o.scene.empty()) args.fail("which scene? (lpi --help lists them)");
     if (o.steps > 0 && o.until > 0.0) args.fail("--steps and --until exclude each other");
+    if (o.checkpoint.empty() && args.given().count("--checkpoint-every"))
+        args.fail("--checkpoint-every: there is no --checkpoint to save (it would be ignored)");
     if (!o.init.empty() && !o.resume.empty())
         args.fail("--init and --resume exclude each other (the checkpoint holds the state)");
     if (o.format.empty()) o.format = have_hdf5() ? "h5" : "npy";
