@@ -194,10 +194,14 @@ private:
 // Runs body() with sys claimed (Claim); maps lpi::Error to its status,
 // std::bad_alloc and std::length_error to LPI_ERR_NO_MEMORY and anything else
 // to LPI_ERR_INTERNAL, recording the message on sys (or the thread when sys
-// is NULL). A body may return a status of its own (LPI_STOPPED).
+// is NULL). A body may return a status of its own (LPI_STOPPED). Nothing
+// leaves but the forced unwind of a thread ending inside a callback
+// (rethrow_if_thread_ending): the system rolled back on its way and the claim
+// released, it goes on to end the thread. So these are not noexcept, which
+// would abort the process there.
 template <class Body>
 int run_guarded(const lpi_system *sys, bool mutates, const char *function, const Arguments *arguments,
-                Body &&body) noexcept {
+                Body &&body) {
     Claim claim(sys, mutates);
     if (const char *why = claim.refused()) {
         record(claim.by_another_thread() ? nullptr : sys, function, why);
@@ -228,6 +232,7 @@ int run_guarded(const lpi_system *sys, bool mutates, const char *function, const
         record(sys, function, "internal error: ", e.what());
         return LPI_ERR_INTERNAL;
     } catch (...) {
+        lpi::rethrow_if_thread_ending();
         record(sys, function, "internal error");
         return LPI_ERR_INTERNAL;
     }
@@ -240,19 +245,19 @@ int run_guarded(const lpi_system *sys, bool mutates, const char *function, const
 // names its arguments; reads that stay on one process (sizes, names, the
 // time) do not, so a program may make them on one process alone.
 template <class Body>
-int guarded(lpi_system *sys, const char *function, const Arguments &arguments, Body &&body) noexcept {
+int guarded(lpi_system *sys, const char *function, const Arguments &arguments, Body &&body) {
     return run_guarded(sys, true, function, &arguments, std::forward<Body>(body));
 }
 template <class Body>
-int guarded(const lpi_system *sys, const char *function, const Arguments &arguments, Body &&body) noexcept {
+int guarded(const lpi_system *sys, const char *function, const Arguments &arguments, Body &&body) {
     return run_guarded(sys, false, function, &arguments, std::forward<Body>(body));
 }
 template <class Body>
-int guarded_local_read(const lpi_system *sys, const char *function, Body &&body) noexcept {
+int guarded_local_read(const lpi_system *sys, const char *function, Body &&body) {
     return run_guarded(sys, false, function, nullptr, std::forward<Body>(body));
 }
 template <class Body>
-int guarded(std::nullptr_t, const char *function, Body &&body) noexcept {
+int guarded(std::nullptr_t, const char *function, Body &&body) {
     return run_guarded(nullptr, false, function, nullptr, std::forward<Body>(body));
 }
 
@@ -269,7 +274,7 @@ inline void require_path(const char *path) {
 
 // Creates a handle around a model built by make(); *out is NULL on failure.
 template <class Make>
-int create(lpi_system **out, const char *function, Make &&make) noexcept {
+int create(lpi_system **out, const char *function, Make &&make) {
     if (out) *out = nullptr;
     return guarded(nullptr, function, [&] {
         require(out, "out");

@@ -4,6 +4,9 @@
 
 #include <stdexcept>
 #include <string>
+#if defined(__GLIBCXX__)
+#include <cxxabi.h>
+#endif
 
 #include "liepoisson.h"
 
@@ -32,9 +35,29 @@ public:
     explicit MethodNotApplicable(const std::string &message) : Error(LPI_ERR_UNSUPPORTED, message) {}
 };
 
+// Rethrows the exception being handled where it is the forced unwind of a
+// thread that is ending inside a callback (pthread_exit, pthread_cancel, or
+// Python ending a daemon thread at exit). No handler may stop it: caught and
+// not rethrown, it aborted the process. Called first in a catch (...). The
+// unwind is no C++ object, so its reference binds to null, which UBSan would
+// report.
+#if defined(__GLIBCXX__)
+__attribute__((no_sanitize("null"))) inline void rethrow_if_thread_ending() {
+    try {
+        throw;
+    } catch (abi::__forced_unwind &) {
+        throw;
+    } catch (...) {
+    }
+}
+#else
+inline void rethrow_if_thread_ending() {}
+#endif
+
 // Calls a user callback. A C++ exception thrown from it (a callback written
 // in C++) is the user's failure: LPI_ERR_CALLBACK naming the callback
-// (name() is formed only then), not an internal error of the library.
+// (name() is formed only then), not an internal error of the library. A
+// thread ending inside it goes on ending (rethrow_if_thread_ending).
 template <class Call, class Name>
 decltype(auto) call_user(Call &&call, Name &&name) {
     try {
@@ -42,6 +65,7 @@ decltype(auto) call_user(Call &&call, Name &&name) {
     } catch (const std::exception &e) {
         fail(LPI_ERR_CALLBACK, name() + " threw an exception: " + e.what());
     } catch (...) {
+        rethrow_if_thread_ending();
         fail(LPI_ERR_CALLBACK, name() + " threw an exception");
     }
 }
