@@ -442,17 +442,25 @@ def _unmasked(values, what):
     return values
 
 
+def _c_ready(a):
+    """Whether C can take the array's memory as it is: C-contiguous and aligned
+    for its type (np.frombuffer at an odd offset, or a field of a packed
+    record, is neither a copy nor aligned)."""
+    return a.flags.c_contiguous and a.flags.aligned
+
+
 def _doubles_in(values, what="values"):
     """(pointer, length, keep-alive) for a flat sequence of real numbers. A
-    C-contiguous float64 numpy vector is passed as it is (no copy); any other
-    real array (float32, integers, a strided view) is copied."""
+    C-contiguous, aligned float64 numpy vector is passed as it is (no copy);
+    any other real array (float32, integers, a strided view, doubles at an
+    address C may not read them from) is copied."""
     if np is not None:
         a = _unmasked(values, what)
-        if not (isinstance(a, np.ndarray) and a.ndim == 1 and a.dtype == np.float64 and a.flags.c_contiguous):
+        if not (isinstance(a, np.ndarray) and a.ndim == 1 and a.dtype == np.float64 and _c_ready(a)):
             a = _real_array(values, what)
             if a.ndim != 1:
                 raise ValueError("%s must be one-dimensional, not of shape %s" % (what, a.shape))
-            a = np.ascontiguousarray(a, dtype=np.float64)
+            a = np.require(a, np.float64, ["C_CONTIGUOUS", "ALIGNED"])
         return a.ctypes.data_as(_lib.c_double_p), a.size, a
     vals = _reals(values, what)
     buf = (c_double * len(vals))(*vals)
@@ -460,14 +468,14 @@ def _doubles_in(values, what="values"):
 
 
 def _doubles_out(n, out=None):
-    """(pointer, result-maker) for n output doubles; out, a C-contiguous float64
-    numpy array of n elements, is filled in place."""
+    """(pointer, result-maker) for n output doubles; out, a C-contiguous, aligned
+    float64 numpy array of n elements, is filled in place."""
     if np is not None:
         if out is None:
             out = np.empty(n, dtype=np.float64)
         elif not (isinstance(out, np.ndarray) and out.dtype == np.float64
-                  and out.flags.c_contiguous and out.flags.writeable and out.size == n):
-            raise ValueError("out must be a writeable C-contiguous float64 array of %d elements" % n)
+                  and _c_ready(out) and out.flags.writeable and out.size == n):
+            raise ValueError("out must be a writeable, aligned, C-contiguous float64 array of %d elements" % n)
         return out.ctypes.data_as(_lib.c_double_p), (lambda: out)
     if out is not None:
         raise ValueError("out= needs numpy")
@@ -1533,13 +1541,16 @@ class SineEuler(System):
     def _square_in(self, values: Any, what: str, complex_: bool = False) -> Tuple[Any, int, Any]:
         """(pointer, number of doubles, keep-alive) for an N x N array of real
         numbers, or of complex numbers as (re, im) pairs with complex_. A
-        C-contiguous float64 (complex128) numpy array is passed as it is."""
+        C-contiguous, aligned float64 (complex128) numpy array is passed as it
+        is."""
         if np is not None:
             dtype = np.complex128 if complex_ else np.float64
             a = _unmasked(values, what)
-            if not (isinstance(a, np.ndarray) and a.ndim == 2 and a.dtype == dtype
-                    and a.flags.c_contiguous):
-                a = np.ascontiguousarray(_real_array(values, what, "iufc" if complex_ else "iuf"), dtype=dtype)
+            if not (isinstance(a, np.ndarray) and a.ndim == 2 and a.dtype == dtype and _c_ready(a)):
+                if not isinstance(a, np.ndarray):  # ragged rows: SizeError, as in list mode (numpy's ValueError)
+                    self._check_square(_shape(_nested(a, what, _complex if complex_ else _real)), what)
+                a = np.require(_real_array(values, what, "iufc" if complex_ else "iuf"), dtype,
+                               ["C_CONTIGUOUS", "ALIGNED"])
             self._check_square(a.shape, what)
             return a.ctypes.data_as(_lib.c_double_p), a.size * (2 if complex_ else 1), a
         rows = _nested(values, what, _complex if complex_ else _real)
@@ -1872,6 +1883,13 @@ def fftw_wisdom_export_string() -> str:
     """
     length = c_size_t()
     _check_free(lib.lpi_fftw_wisdom_export_string(None, 0, byref(length)))  # a query of the length
-    buf = ctypes.create_string_buffer(length.value + 1)
-    _check_free(lib.lpi_fftw_wisdom_export_string(buf, len(buf), byref(length)))
+    # The wisdom is the process's: another thread planning between the query
+    # and the copy adds to it, and the buffer is then made again at the new
+    # length (given with LPI_ERR_SIZE).
+    for _ in range(100):
+        buf = ctypes.create_string_buffer(length.value + 1)
+        status = lib.lpi_fftw_wisdom_export_string(buf, len(buf), byref(length))
+        if status != STATUS["LPI_ERR_SIZE"]:
+            break
+    _check_free(status)
     return buf.value.decode()

@@ -591,10 +591,32 @@ class TestSineEuler(unittest.TestCase):
         self.assertEqual(s.energy(), energy_before)
         with self.assertRaises(lp.SizeError):
             s.set_hamiltonian([[1.0] * N] * (N - 1))
+        # Rows of different lengths: SizeError in both modes (numpy's own
+        # ValueError reached the caller).
+        with self.assertRaises(lp.SizeError):
+            s.grid = [[0.0] * N] * (N - 1) + [[0.0] * (N - 1)]
 
     def test_wisdom(self):
         text = lp.fftw_wisdom_export_string()
         self.assertIn("fftw", text)
+        # Wisdom that another thread adds between the query of the length and
+        # the copy (the wisdom is the process's): the copy is made again, not
+        # refused as a buffer too small.
+        export = lp.lib.lpi_fftw_wisdom_export_string
+        planned = []
+
+        def export_after_planning(buf, size, length):
+            if buf is not None and not planned:
+                with lp.SineEuler(43) as other:
+                    other.planning = "measure"
+                planned.append(other)
+            return export(buf, size, length)
+
+        with unittest.mock.patch.object(lp.lib, "lpi_fftw_wisdom_export_string", export_after_planning):
+            grown = lp.fftw_wisdom_export_string()
+        self.assertTrue(planned)
+        self.assertGreater(len(grown), len(text))
+        self.assertEqual(grown, lp.fftw_wisdom_export_string())
         lp.fftw_wisdom_import_string(text)
         with self.assertRaises(lp.InvalidArgumentError):
             lp.fftw_wisdom_import_string("not wisdom")
@@ -623,6 +645,30 @@ class TestNumpy(unittest.TestCase):
             self.assertEqual(b.state.tolist(), [1.0, 2.0, 3.0])
             b.state = np.array([1.0, 0.0, 2.0, 0.0, 3.0])[::2]  # strided: copied
             self.assertEqual(b.state.tolist(), [1.0, 2.0, 3.0])
+
+    def test_unaligned_arrays(self):
+        # Doubles at an address C may not read them from (an odd offset into a
+        # buffer, a field of a packed record) are copied on the way in, and
+        # refused as out=: passed as they were, they reached C misaligned.
+        raw = bytearray(8 * 9 + 1)
+        values = np.frombuffer(raw, dtype=np.float64, count=9, offset=1)
+        self.assertFalse(values.flags.aligned)
+        values[:3] = [1.0, 0.5, -0.3]
+        with lp.RigidBody(*INERTIA) as b:
+            b.state = values[:3]
+            self.assertEqual(b.state.tolist(), [1.0, 0.5, -0.3])
+            with self.assertRaises(ValueError) as caught:
+                b.get_state(out=values[3:6])
+            self.assertIn("aligned", str(caught.exception))
+        try:
+            se = lp.SineEuler(3)
+        except lp.UnsupportedError:
+            return
+        with se:
+            grid = values.reshape(3, 3)
+            grid[:] = np.arange(9.0).reshape(3, 3)
+            se.grid = grid
+            self.assertTrue(np.allclose(se.grid, grid, atol=1e-14))
 
     def test_masked_entries_are_refused(self):
         # A masked array is an ndarray: its entries under the mask reached C.
