@@ -17,6 +17,9 @@
 ! bracket arrays of lpi_generic_create differing in length, and an array for
 ! lpi_rigid_body_exact of other than 3 values (LPI_ERR_SIZE).
 ! lpi_last_error does not describe these; the stop message does.
+! Every wrapper is recursive: a callback may call the library again (on
+! another handle, or read its own from an observer), which a procedure not
+! declared so may not be (gfortran -fcheck=recursion stopped such a call).
 ! Handles are type(c_ptr). Index sets and bracket indices are 0-based, as in C.
 ! Sine-Euler modes and grids are arrays w(0:N-1, 0:N-1) with w(a, b) = mode
 ! (a, b) (resp. the vorticity at (2 pi a/N, 2 pi b/N)), of exactly that shape;
@@ -464,7 +467,7 @@ contains
     ! ---- helpers ----------------------------------------------------------------
 
     ! A NUL-terminated C string as a Fortran string ("" for NULL).
-    function f_string(p) result(s)
+    recursive function f_string(p) result(s)
         type(c_ptr), intent(in) :: p
         character(len=:), allocatable :: s
         character(kind=c_char), pointer :: chars(:)
@@ -483,7 +486,7 @@ contains
 
     ! s less trailing blanks, NUL-terminated for C. Callers refuse a NUL
     ! inside s first (nul_refused): C would end the string there.
-    function c_string(s) result(c)
+    recursive function c_string(s) result(c)
         character(len=*), intent(in) :: s
         character(kind=c_char, len=len_trim(s) + 1) :: c
         c = trim(s)//c_null_char
@@ -492,7 +495,7 @@ contains
     ! A refusal made here, before any C call, of what the C function cannot
     ! see: status receives code, or the program stops with message (C has no
     ! way to take it, so lpi_last_error keeps what it had).
-    subroutine refuse(code, message, status)
+    recursive subroutine refuse(code, message, status)
         integer(c_int), intent(in) :: code
         character(len=*), intent(in) :: message
         integer, intent(out), optional :: status
@@ -502,7 +505,7 @@ contains
 
     ! .true. after refusing s (LPI_ERR_INVALID) when it holds a NUL: C would
     ! take the string before it ("leapfrog"//c_null_char//"x" as "leapfrog").
-    logical function nul_refused(s, what, status)
+    recursive logical function nul_refused(s, what, status)
         character(len=*), intent(in) :: s, what
         integer, intent(out), optional :: status
         nul_refused = index(s, c_null_char) > 0
@@ -511,7 +514,7 @@ contains
 
     ! .true. after refusing n < 0 (LPI_ERR_INVALID): int(n, c_size_t) would
     ! wrap it to nearly 2^64, and C would report that number.
-    logical function negative_refused(n, what, status)
+    recursive logical function negative_refused(n, what, status)
         integer, intent(in) :: n
         character(len=*), intent(in) :: what
         integer, intent(out), optional :: status
@@ -526,7 +529,7 @@ contains
     ! .true. after refusing an array of shape dims (LPI_ERR_SIZE) that is not
     ! N x N on a sine-Euler system: C sees only the element count, which a
     ! 49 x 1 array shares with 7 x 7. Any other handle is left to C to report.
-    logical function shape_refused(sys, dims, what, status)
+    recursive logical function shape_refused(sys, dims, what, status)
         type(c_ptr), intent(in) :: sys
         integer, intent(in) :: dims(2)
         character(len=*), intent(in) :: what
@@ -543,7 +546,7 @@ contains
     end function
 
     ! Hands st to status when present; otherwise a failure stops the program.
-    subroutine finish(st, sys, status)
+    recursive subroutine finish(st, sys, status)
         integer(c_int), intent(in) :: st
         type(c_ptr), intent(in) :: sys
         integer, intent(out), optional :: status
@@ -556,55 +559,55 @@ contains
 
     ! ---- version, status codes, methods ----------------------------------------
 
-    function lpi_version_string() result(s)
+    recursive function lpi_version_string() result(s)
         character(len=:), allocatable :: s
         s = f_string(c_lpi_version_string())
     end function
 
     ! MAJOR * 10000 + MINOR * 100 + PATCH of the library that runs.
-    integer function lpi_version_number()
+    recursive integer function lpi_version_number()
         lpi_version_number = c_lpi_version_number()
     end function
 
-    function lpi_status_name(status) result(s)
+    recursive function lpi_status_name(status) result(s)
         integer, intent(in) :: status
         character(len=:), allocatable :: s
         s = f_string(c_lpi_status_name(int(status, c_int)))
     end function
 
-    function lpi_status_message(status) result(s)
+    recursive function lpi_status_message(status) result(s)
         integer, intent(in) :: status
         character(len=:), allocatable :: s
         s = f_string(c_lpi_status_message(int(status, c_int)))
     end function
 
-    integer function lpi_method_count()
+    recursive integer function lpi_method_count()
         lpi_method_count = c_lpi_method_count()
     end function
 
     ! Methods are numbered 0 .. lpi_method_count() - 1, as in C; "" out of range.
-    function lpi_method_name(i) result(s)
+    recursive function lpi_method_name(i) result(s)
         integer, intent(in) :: i
         character(len=:), allocatable :: s
         s = f_string(c_lpi_method_name(int(i, c_int)))
     end function
 
-    integer function lpi_method_order(i)
+    recursive integer function lpi_method_order(i)
         integer, intent(in) :: i
         lpi_method_order = c_lpi_method_order(int(i, c_int))
     end function
 
-    integer function lpi_method_is_poisson(i)
+    recursive integer function lpi_method_is_poisson(i)
         integer, intent(in) :: i
         lpi_method_is_poisson = c_lpi_method_is_poisson(int(i, c_int))
     end function
 
-    integer function lpi_method_stages(i)
+    recursive integer function lpi_method_stages(i)
         integer, intent(in) :: i
         lpi_method_stages = c_lpi_method_stages(int(i, c_int))
     end function
 
-    function lpi_method_reference(i) result(s)
+    recursive function lpi_method_reference(i) result(s)
         integer, intent(in) :: i
         character(len=:), allocatable :: s
         s = f_string(c_lpi_method_reference(int(i, c_int)))
@@ -612,14 +615,14 @@ contains
 
     ! ---- systems ------------------------------------------------------------------
 
-    subroutine lpi_rigid_body_create(sys, i1, i2, i3, status)
+    recursive subroutine lpi_rigid_body_create(sys, i1, i2, i3, status)
         type(c_ptr), intent(out) :: sys
         real(c_double), intent(in) :: i1, i2, i3
         integer, intent(out), optional :: status
         call finish(c_lpi_rigid_body_create(sys, i1, i2, i3), c_null_ptr, status)
     end subroutine
 
-    subroutine lpi_rigid_body_exact(sys, t, m, status)
+    recursive subroutine lpi_rigid_body_exact(sys, t, m, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: t
         real(c_double), intent(out) :: m(:)
@@ -635,7 +638,7 @@ contains
         call finish(c_lpi_rigid_body_exact(sys, t, m), sys, status)
     end subroutine
 
-    subroutine lpi_pendulum_create(sys, status)
+    recursive subroutine lpi_pendulum_create(sys, status)
         type(c_ptr), intent(out) :: sys
         integer, intent(out), optional :: status
         call finish(c_lpi_pendulum_create(sys), c_null_ptr, status)
@@ -643,7 +646,7 @@ contains
 
     ! Releases the handle and sets sys to c_null_ptr (a null handle is a no-op).
     ! From one of the handle's own callbacks: LPI_ERR_BUSY, nothing released.
-    subroutine lpi_destroy(sys, status)
+    recursive subroutine lpi_destroy(sys, status)
         type(c_ptr), intent(inout) :: sys
         integer, intent(out), optional :: status
         integer(c_int) :: st
@@ -652,7 +655,7 @@ contains
         call finish(st, sys, status)
     end subroutine
 
-    subroutine lpi_set_method(sys, name, status)
+    recursive subroutine lpi_set_method(sys, name, status)
         type(c_ptr), intent(in) :: sys
         character(len=*), intent(in) :: name
         integer, intent(out), optional :: status
@@ -660,7 +663,7 @@ contains
         call finish(c_lpi_set_method(sys, c_string(name)), sys, status)
     end subroutine
 
-    subroutine lpi_set_split(sys, name, status)
+    recursive subroutine lpi_set_split(sys, name, status)
         type(c_ptr), intent(in) :: sys
         character(len=*), intent(in) :: name
         integer, intent(out), optional :: status
@@ -668,27 +671,27 @@ contains
         call finish(c_lpi_set_split(sys, c_string(name)), sys, status)
     end subroutine
 
-    integer function lpi_dim(sys)
+    recursive integer function lpi_dim(sys)
         type(c_ptr), intent(in) :: sys
         lpi_dim = int(c_lpi_dim(sys))
     end function
 
     ! size(x) must equal lpi_dim(sys).
-    subroutine lpi_set_state(sys, x, status)
+    recursive subroutine lpi_set_state(sys, x, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: x(:)
         integer, intent(out), optional :: status
         call finish(c_lpi_set_state(sys, x, size(x, kind=c_size_t)), sys, status)
     end subroutine
 
-    subroutine lpi_get_state(sys, x, status)
+    recursive subroutine lpi_get_state(sys, x, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(inout) :: x(:)
         integer, intent(out), optional :: status
         call finish(c_lpi_get_state(sys, x, size(x, kind=c_size_t)), sys, status)
     end subroutine
 
-    subroutine lpi_step_i4(sys, dt, nsteps, status)
+    recursive subroutine lpi_step_i4(sys, dt, nsteps, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: dt
         integer(c_int32_t), intent(in) :: nsteps
@@ -696,7 +699,7 @@ contains
         call finish(c_lpi_step(sys, dt, int(nsteps, c_int64_t)), sys, status)
     end subroutine
 
-    subroutine lpi_step_i8(sys, dt, nsteps, status)
+    recursive subroutine lpi_step_i8(sys, dt, nsteps, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: dt
         integer(c_int64_t), intent(in) :: nsteps
@@ -705,7 +708,7 @@ contains
     end subroutine
 
     ! Sets the observer of lpi_step (every >= 1); without fn, removes it.
-    subroutine lpi_set_observer(sys, every, fn, user, status)
+    recursive subroutine lpi_set_observer(sys, every, fn, user, status)
         type(c_ptr), intent(in) :: sys
         integer, intent(in) :: every
         procedure(lpi_observer_fn), optional :: fn
@@ -720,25 +723,25 @@ contains
         call finish(c_lpi_set_observer(sys, int(every, c_int64_t), f, u), sys, status)
     end subroutine
 
-    real(c_double) function lpi_time(sys)
+    recursive real(c_double) function lpi_time(sys)
         type(c_ptr), intent(in) :: sys
         lpi_time = c_lpi_time(sys)
     end function
 
-    subroutine lpi_energy(sys, h, status)
+    recursive subroutine lpi_energy(sys, h, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(out) :: h
         integer, intent(out), optional :: status
         call finish(c_lpi_energy(sys, h), sys, status)
     end subroutine
 
-    integer function lpi_casimir_count(sys)
+    recursive integer function lpi_casimir_count(sys)
         type(c_ptr), intent(in) :: sys
         lpi_casimir_count = int(c_lpi_casimir_count(sys))
     end function
 
     ! size(c) must equal lpi_casimir_count(sys).
-    subroutine lpi_casimirs(sys, c, status)
+    recursive subroutine lpi_casimirs(sys, c, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(inout) :: c(:)
         integer, intent(out), optional :: status
@@ -749,25 +752,25 @@ contains
     ! thread's last failure of a call without a handle (a failed create).
     ! The system's kind ("rigid-body", ..., "sine-euler"), method and split
     ! names ("" for a null handle).
-    function lpi_kind(sys) result(s)
+    recursive function lpi_kind(sys) result(s)
         type(c_ptr), intent(in) :: sys
         character(len=:), allocatable :: s
         s = f_string(c_lpi_kind(sys))
     end function
 
-    function lpi_get_method(sys) result(s)
+    recursive function lpi_get_method(sys) result(s)
         type(c_ptr), intent(in) :: sys
         character(len=:), allocatable :: s
         s = f_string(c_lpi_get_method(sys))
     end function
 
-    function lpi_get_split(sys) result(s)
+    recursive function lpi_get_split(sys) result(s)
         type(c_ptr), intent(in) :: sys
         character(len=:), allocatable :: s
         s = f_string(c_lpi_get_split(sys))
     end function
 
-    function lpi_last_error(sys) result(s)
+    recursive function lpi_last_error(sys) result(s)
         type(c_ptr), intent(in) :: sys
         character(len=:), allocatable :: s
         s = f_string(c_lpi_last_error(sys))
@@ -775,14 +778,14 @@ contains
 
     ! ---- composition methods, implicit baselines ---------------------------------
 
-    subroutine lpi_set_composition(sys, gammas, status)
+    recursive subroutine lpi_set_composition(sys, gammas, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: gammas(:)
         integer, intent(out), optional :: status
         call finish(c_lpi_set_composition(sys, size(gammas, kind=c_size_t), gammas), sys, status)
     end subroutine
 
-    subroutine lpi_flows_per_step(sys, flows, status)
+    recursive subroutine lpi_flows_per_step(sys, flows, status)
         type(c_ptr), intent(in) :: sys
         integer, intent(out) :: flows
         integer, intent(out), optional :: status
@@ -794,7 +797,7 @@ contains
         call finish(st, sys, status)
     end subroutine
 
-    subroutine lpi_set_implicit_options(sys, tolerance, max_iterations, status)
+    recursive subroutine lpi_set_implicit_options(sys, tolerance, max_iterations, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: tolerance
         integer, intent(in) :: max_iterations
@@ -806,7 +809,7 @@ contains
     ! ---- generic systems and the moment algebra ------------------------------------
 
     ! {x_i, x_j} = sum c x_k over the entries (i(e), j(e), k(e), c(e)), 0-based.
-    subroutine lpi_generic_create(sys, dim, i, j, k, c, status)
+    recursive subroutine lpi_generic_create(sys, dim, i, j, k, c, status)
         type(c_ptr), intent(out) :: sys
         integer, intent(in) :: dim
         integer(c_int32_t), intent(in) :: i(:), j(:), k(:)
@@ -824,7 +827,7 @@ contains
     end subroutine
 
     ! Appends the piece on the 0-based abelian index set indices.
-    subroutine lpi_add_piece(sys, indices, grad, energy, user, status)
+    recursive subroutine lpi_add_piece(sys, indices, grad, energy, user, status)
         type(c_ptr), intent(in) :: sys
         integer(c_int32_t), intent(in) :: indices(:)
         procedure(lpi_gradient_fn) :: grad
@@ -838,7 +841,7 @@ contains
                                     c_funloc(energy), u), sys, status)
     end subroutine
 
-    subroutine lpi_add_casimir(sys, fn, user, status)
+    recursive subroutine lpi_add_casimir(sys, fn, user, status)
         type(c_ptr), intent(in) :: sys
         procedure(lpi_casimir_fn) :: fn
         type(c_ptr), intent(in), optional :: user
@@ -849,7 +852,7 @@ contains
         call finish(c_lpi_add_casimir(sys, c_funloc(fn), u), sys, status)
     end subroutine
 
-    subroutine lpi_poisson_rank(sys, x, rank, status)
+    recursive subroutine lpi_poisson_rank(sys, x, rank, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: x(:)
         integer, intent(out) :: rank
@@ -862,13 +865,13 @@ contains
         call finish(st, sys, status)
     end subroutine
 
-    subroutine lpi_moments_create(sys, status)
+    recursive subroutine lpi_moments_create(sys, status)
         type(c_ptr), intent(out) :: sys
         integer, intent(out), optional :: status
         call finish(c_lpi_moments_create(sys), c_null_ptr, status)
     end subroutine
 
-    subroutine lpi_moments_add_product_piece(sys, h, dh, user, status)
+    recursive subroutine lpi_moments_add_product_piece(sys, h, dh, user, status)
         type(c_ptr), intent(in) :: sys
         procedure(lpi_scalar_fn) :: h, dh
         type(c_ptr), intent(in), optional :: user
@@ -881,14 +884,14 @@ contains
 
     ! ---- sine-Euler, threads, FFTW wisdom ---------------------------------------------
 
-    subroutine lpi_sine_euler_create(sys, n, status)
+    recursive subroutine lpi_sine_euler_create(sys, n, status)
         type(c_ptr), intent(out) :: sys
         integer, intent(in) :: n
         integer, intent(out), optional :: status
         call finish(c_lpi_sine_euler_create(sys, int(n, c_int32_t)), c_null_ptr, status)
     end subroutine
 
-    subroutine lpi_sine_euler_size(sys, n, status)
+    recursive subroutine lpi_sine_euler_size(sys, n, status)
         type(c_ptr), intent(in) :: sys
         integer, intent(out) :: n
         integer, intent(out), optional :: status
@@ -901,7 +904,7 @@ contains
     end subroutine
 
     ! w(a, b) is mode (a, b) mod N (lower bounds 0 or 1 alike: position counts).
-    subroutine lpi_sine_euler_set_modes(sys, w, status)
+    recursive subroutine lpi_sine_euler_set_modes(sys, w, status)
         type(c_ptr), intent(in) :: sys
         complex(c_double_complex), intent(in) :: w(:, :)
         integer, intent(out), optional :: status
@@ -922,7 +925,7 @@ contains
         call finish(c_lpi_sine_euler_set_modes(sys, buf, size(buf, kind=c_size_t)), sys, status)
     end subroutine
 
-    subroutine lpi_sine_euler_get_modes(sys, w, status)
+    recursive subroutine lpi_sine_euler_get_modes(sys, w, status)
         type(c_ptr), intent(in) :: sys
         complex(c_double_complex), intent(inout) :: w(:, :)
         integer, intent(out), optional :: status
@@ -947,7 +950,7 @@ contains
     end subroutine
 
     ! w(a, b) is the vorticity at (2 pi a / N, 2 pi b / N).
-    subroutine lpi_sine_euler_set_grid(sys, w, status)
+    recursive subroutine lpi_sine_euler_set_grid(sys, w, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: w(:, :)
         integer, intent(out), optional :: status
@@ -958,7 +961,7 @@ contains
         call finish(c_lpi_sine_euler_set_grid(sys, t, size(t, kind=c_size_t)), sys, status)
     end subroutine
 
-    subroutine lpi_sine_euler_get_grid(sys, w, status)
+    recursive subroutine lpi_sine_euler_get_grid(sys, w, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(inout) :: w(:, :)
         integer, intent(out), optional :: status
@@ -971,7 +974,7 @@ contains
         call finish(st, sys, status)
     end subroutine
 
-    subroutine lpi_sine_euler_enstrophy(sys, e, status)
+    recursive subroutine lpi_sine_euler_enstrophy(sys, e, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(out) :: e
         integer, intent(out), optional :: status
@@ -979,7 +982,7 @@ contains
     end subroutine
 
     ! traces(k) = (1/N) tr W^k for k = 1 .. size(traces).
-    subroutine lpi_sine_euler_casimir_traces(sys, traces, status)
+    recursive subroutine lpi_sine_euler_casimir_traces(sys, traces, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(inout) :: traces(:)
         integer, intent(out), optional :: status
@@ -987,7 +990,7 @@ contains
                     sys, status)
     end subroutine
 
-    subroutine lpi_sine_euler_fft_floor(sys, nsteps, seconds_per_step, transforms_per_step, status)
+    recursive subroutine lpi_sine_euler_fft_floor(sys, nsteps, seconds_per_step, transforms_per_step, status)
         type(c_ptr), intent(in) :: sys
         integer, intent(in) :: nsteps
         real(c_double), intent(out) :: seconds_per_step, transforms_per_step
@@ -997,7 +1000,7 @@ contains
     end subroutine
 
     ! rigor: "estimate" (the default), "measure" or "patient".
-    subroutine lpi_sine_euler_set_planning(sys, rigor, status)
+    recursive subroutine lpi_sine_euler_set_planning(sys, rigor, status)
         type(c_ptr), intent(in) :: sys
         character(len=*), intent(in) :: rigor
         integer, intent(out), optional :: status
@@ -1005,7 +1008,7 @@ contains
         call finish(c_lpi_sine_euler_set_planning(sys, c_string(rigor)), sys, status)
     end subroutine
 
-    subroutine lpi_sine_euler_get_planning(sys, rigor, status)
+    recursive subroutine lpi_sine_euler_get_planning(sys, rigor, status)
         type(c_ptr), intent(in) :: sys
         character(len=:), allocatable, intent(out) :: rigor
         integer, intent(out), optional :: status
@@ -1020,7 +1023,7 @@ contains
     ! H = 1/2 sum lambda_n |w_n|^2 + sum conj(f_n) w_n: lambda(a, b) and
     ! f(a, b) belong to mode (a-1, b-1), as in lpi_sine_euler_set_modes; f
     ! absent for f = 0.
-    subroutine lpi_sine_euler_set_hamiltonian(sys, lambda, f, status)
+    recursive subroutine lpi_sine_euler_set_hamiltonian(sys, lambda, f, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: lambda(:, :)
         complex(c_double_complex), intent(in), optional :: f(:, :)
@@ -1054,7 +1057,7 @@ contains
     end subroutine
 
     ! psi(a, b) is the stream function at (2 pi (a-1) / N, 2 pi (b-1) / N).
-    subroutine lpi_sine_euler_get_stream(sys, psi, status)
+    recursive subroutine lpi_sine_euler_get_stream(sys, psi, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(inout) :: psi(:, :)
         integer, intent(out), optional :: status
@@ -1070,7 +1073,7 @@ contains
     ! energy(k), enstrophy(k): shell k (k - 1/2 <= |n| < k + 1/2), k = 1 ..
     ! shells; the arrays need at least `shells` elements (LPI_ERR_SIZE, with
     ! shells set, otherwise).
-    subroutine lpi_sine_euler_spectrum(sys, energy, enstrophy, shells, status)
+    recursive subroutine lpi_sine_euler_spectrum(sys, energy, enstrophy, shells, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(inout) :: energy(:), enstrophy(:)
         integer, intent(out) :: shells
@@ -1082,28 +1085,28 @@ contains
         shells = int(count)
     end subroutine
 
-    subroutine lpi_set_threads(sys, n, status)
+    recursive subroutine lpi_set_threads(sys, n, status)
         type(c_ptr), intent(in) :: sys
         integer, intent(in) :: n
         integer, intent(out), optional :: status
         call finish(c_lpi_set_threads(sys, int(n, c_int32_t)), sys, status)
     end subroutine
 
-    subroutine lpi_fftw_wisdom_import_file(path, status)
+    recursive subroutine lpi_fftw_wisdom_import_file(path, status)
         character(len=*), intent(in) :: path
         integer, intent(out), optional :: status
         if (nul_refused(path, "lpi_fftw_wisdom_import_file: path", status)) return
         call finish(c_lpi_fftw_wisdom_import_file(c_string(path)), c_null_ptr, status)
     end subroutine
 
-    subroutine lpi_fftw_wisdom_export_file(path, status)
+    recursive subroutine lpi_fftw_wisdom_export_file(path, status)
         character(len=*), intent(in) :: path
         integer, intent(out), optional :: status
         if (nul_refused(path, "lpi_fftw_wisdom_export_file: path", status)) return
         call finish(c_lpi_fftw_wisdom_export_file(c_string(path)), c_null_ptr, status)
     end subroutine
 
-    subroutine lpi_fftw_wisdom_import_string(wisdom, status)
+    recursive subroutine lpi_fftw_wisdom_import_string(wisdom, status)
         character(len=*), intent(in) :: wisdom
         integer, intent(out), optional :: status
         if (nul_refused(wisdom, "lpi_fftw_wisdom_import_string: wisdom", status)) return
@@ -1111,7 +1114,7 @@ contains
     end subroutine
 
     ! The process's FFTW wisdom as one string.
-    subroutine lpi_fftw_wisdom_export_string(wisdom, status)
+    recursive subroutine lpi_fftw_wisdom_export_string(wisdom, status)
         character(len=:), allocatable, intent(out) :: wisdom
         integer, intent(out), optional :: status
         character(kind=c_char), allocatable, target :: buf(:)
@@ -1122,8 +1125,15 @@ contains
         length = 0
         st = c_lpi_fftw_wisdom_export_string(c_null_ptr, 0_c_size_t, length)  ! a query of the length
         if (st == LPI_OK) then
-            allocate (buf(length + 1))
-            st = c_lpi_fftw_wisdom_export_string(c_loc(buf), size(buf, kind=c_size_t), length)
+            ! The wisdom is the process's: another thread planning between the
+            ! query and the copy adds to it, and the buffer is then made again
+            ! at the new length (given with LPI_ERR_SIZE).
+            do q = 1, 100
+                if (allocated(buf)) deallocate (buf)
+                allocate (buf(length + 1))
+                st = c_lpi_fftw_wisdom_export_string(c_loc(buf), size(buf, kind=c_size_t), length)
+                if (st /= LPI_ERR_SIZE) exit
+            end do
             if (st == LPI_OK) then
                 deallocate (wisdom)
                 allocate (character(len=int(length)) :: wisdom)
@@ -1137,7 +1147,7 @@ contains
 
     ! ---- checkpoints ----------------------------------------------------------
 
-    subroutine lpi_save(sys, path, status)
+    recursive subroutine lpi_save(sys, path, status)
         type(c_ptr), intent(in) :: sys
         character(len=*), intent(in) :: path
         integer, intent(out), optional :: status
@@ -1145,7 +1155,7 @@ contains
         call finish(c_lpi_save(sys, c_string(path)), sys, status)
     end subroutine
 
-    subroutine lpi_load(sys, path, status)
+    recursive subroutine lpi_load(sys, path, status)
         type(c_ptr), intent(out) :: sys
         character(len=*), intent(in) :: path
         integer, intent(out), optional :: status
@@ -1155,7 +1165,7 @@ contains
     end subroutine
 
     ! The checkpoint in memory, as an allocatable byte array.
-    subroutine lpi_save_buffer(sys, bytes, status)
+    recursive subroutine lpi_save_buffer(sys, bytes, status)
         type(c_ptr), intent(in) :: sys
         integer(c_int8_t), allocatable, target, intent(out) :: bytes(:)
         integer, intent(out), optional :: status
@@ -1171,7 +1181,7 @@ contains
         call finish(st, sys, status)
     end subroutine
 
-    subroutine lpi_load_buffer(sys, bytes, status)
+    recursive subroutine lpi_load_buffer(sys, bytes, status)
         type(c_ptr), intent(out) :: sys
         ! contiguous: a strided or reversed section is copied in, so that the
         ! address C reads from holds the bytes in order.

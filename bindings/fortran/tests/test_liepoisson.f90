@@ -53,6 +53,28 @@ contains
         if (step /= 5_c_int64_t * calls .or. t <= 0) calls = calls + 100
         stop_second = merge(1, 0, calls == 2)
     end function
+    ! Calls the wrappers (not the bind(C) interfaces) from inside lpi_step:
+    ! lpi_step on another system (user), lpi_energy on its own handle (a
+    ! read, allowed) and lpi_step on its own handle (LPI_ERR_BUSY). The module
+    ! is built with -fcheck=recursion, which stops a nested call of a wrapper
+    ! not declared recursive.
+    integer(c_int) function step_another(sys, step, t, user) bind(C)
+        use liepoisson, only: lpi_step, lpi_energy, LPI_OK, LPI_ERR_BUSY
+        type(c_ptr), value :: sys
+        integer(c_int64_t), value :: step
+        real(c_double), value :: t
+        type(c_ptr), value :: user
+        type(c_ptr), pointer :: other
+        real(c_double) :: h
+        integer :: status, own
+        call c_f_pointer(user, other)
+        call lpi_step(other, 0.01_c_double, 2, status)
+        call lpi_energy(sys, h, own)
+        step_another = 0
+        if (status /= LPI_OK .or. own /= LPI_OK .or. step < 0 .or. t < 0) step_another = 1
+        call lpi_step(sys, 0.01_c_double, 1, own)
+        if (own /= LPI_ERR_BUSY) step_another = 1
+    end function
 end module
 
 program test_liepoisson
@@ -88,6 +110,7 @@ contains
 
     subroutine test_observer()
         type(c_ptr) :: sys
+        type(c_ptr), target :: other
         integer(c_int), target :: calls
         integer :: status
         real(c_double) :: m(3) = [1.0_c_double, 0.5_c_double, -0.3_c_double]
@@ -105,6 +128,17 @@ contains
         call check(calls == 2, "observer removed")
         call lpi_destroy(sys)
         call check(.not. c_associated(sys), "destroy nulls the handle")
+        ! Wrappers called from inside a wrapper's call (see step_another).
+        call lpi_rigid_body_create(sys, 1.0_c_double, 2.0_c_double, 3.0_c_double)
+        call lpi_rigid_body_create(other, 1.0_c_double, 2.0_c_double, 3.0_c_double)
+        call lpi_set_state(sys, m)
+        call lpi_set_state(other, m)
+        call lpi_set_observer(sys, 1, step_another, c_loc(other))
+        call lpi_step(sys, 0.01_c_double, 3, status)
+        call check(status == LPI_OK, "an observer calls the wrappers on another handle and its own")
+        call check(abs(lpi_time(other) - 0.06_c_double) < 1e-15_c_double, "the other system stepped")
+        call lpi_destroy(sys)
+        call lpi_destroy(other)
     end subroutine
 
     subroutine test_statuses()
