@@ -241,9 +241,11 @@ function Generic(dim::Integer, brackets = Tuple{Int,Int,Int,Float64}[])
 end
 
 # The system's kind ("rigid-body", ..., "sine-euler"), method and split names.
-kind(sys::System) = unsafe_string(C.lpi_kind(_h(sys)))
-method_name(sys::System) = unsafe_string(C.lpi_get_method(_h(sys)))
-split_name(sys::System) = unsafe_string(C.lpi_get_split(_h(sys)))
+# The strings belong to the handle: sys is kept alive (its finalizer would
+# free them) until they are copied.
+kind(sys::System) = GC.@preserve sys unsafe_string(C.lpi_kind(_h(sys)))
+method_name(sys::System) = GC.@preserve sys unsafe_string(C.lpi_get_method(_h(sys)))
+split_name(sys::System) = GC.@preserve sys unsafe_string(C.lpi_get_split(_h(sys)))
 set_method!(sys::System, name::AbstractString) = _call(h -> C.lpi_set_method(h, name), sys)
 set_split!(sys::System, name::AbstractString) = _call(h -> C.lpi_set_split(h, name), sys)
 set_composition!(sys::System, gammas::AbstractVector{<:Real}) =
@@ -271,7 +273,7 @@ function casimirs(sys::System)
     out = Vector{Float64}(undef, casimir_count(sys))
     _call(h -> C.lpi_casimirs(h, out, length(out)), sys); out
 end
-last_error(sys::System) = unsafe_string(C.lpi_last_error(_h(sys)))
+last_error(sys::System) = GC.@preserve sys unsafe_string(C.lpi_last_error(_h(sys)))
 function exact(sys::System, t::Real)
     out = Vector{Float64}(undef, 3); _call(h -> C.lpi_rigid_body_exact(h, t, out), sys); out
 end
@@ -394,7 +396,7 @@ end
 function modes(sys::System)
     N = sine_euler_size(sys)
     buf = Matrix{ComplexF64}(undef, N, N)   # interleaved re, im in memory
-    _call(h -> C.lpi_sine_euler_get_modes(h, Ptr{Cdouble}(pointer(buf)), 2 * N * N), sys)
+    GC.@preserve buf _call(h -> C.lpi_sine_euler_get_modes(h, Ptr{Cdouble}(pointer(buf)), 2 * N * N), sys)
     permutedims(buf)
 end
 # C sees only the element count, which a 49 x 1 array shares with 7 x 7: an
@@ -409,7 +411,7 @@ end
 function set_modes!(sys::System, w::AbstractMatrix{<:Number})
     _require_square(sys, w, "modes")
     buf = Matrix{ComplexF64}(permutedims(w))
-    _call(h -> C.lpi_sine_euler_set_modes(h, Ptr{Cdouble}(pointer(buf)), 2 * length(buf)), sys)
+    GC.@preserve buf _call(h -> C.lpi_sine_euler_set_modes(h, Ptr{Cdouble}(pointer(buf)), 2 * length(buf)), sys)
 end
 function grid(sys::System)
     N = sine_euler_size(sys)
@@ -449,8 +451,8 @@ function set_hamiltonian!(sys::System, lambda::AbstractMatrix{<:Real},
         _call(h -> C.lpi_sine_euler_set_hamiltonian(h, lam, length(lam), C_NULL, 0), sys)
     else
         fbuf = Matrix{ComplexF64}(permutedims(f))
-        _call(h -> C.lpi_sine_euler_set_hamiltonian(h, lam, length(lam),
-                                                    Ptr{Cdouble}(pointer(fbuf)), 2 * length(fbuf)), sys)
+        GC.@preserve fbuf _call(h -> C.lpi_sine_euler_set_hamiltonian(h, lam, length(lam),
+                                                                  Ptr{Cdouble}(pointer(fbuf)), 2 * length(fbuf)), sys)
     end
 end
 """stream_function(sys): psi = sum (lambda_n w_n + f_n) exp(i n.x) on the grid."""
@@ -476,8 +478,16 @@ fftw_wisdom_import_string(w::AbstractString) = _check(C.lpi_fftw_wisdom_import_s
 function fftw_wisdom_export_string()
     len = Ref{Csize_t}(0)
     _check(C.lpi_fftw_wisdom_export_string(C_NULL, 0, len))  # a query of the length
-    buf = Vector{UInt8}(undef, len[] + 1)
-    _check(C.lpi_fftw_wisdom_export_string(buf, length(buf), len))
+    # The wisdom is the process's: another thread planning between the query
+    # and the copy adds to it, and the buffer is then made again at the new
+    # length (given with LPI_ERR_SIZE).
+    buf, status = UInt8[], -3  # LPI_ERR_SIZE
+    for _ in 1:100
+        buf = Vector{UInt8}(undef, len[] + 1)
+        status = C.lpi_fftw_wisdom_export_string(buf, length(buf), len)
+        status == -3 || break
+    end
+    _check(status)
     String(buf[1:len[]])
 end
 
