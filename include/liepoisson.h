@@ -7,7 +7,8 @@
  * lpi_step only - the positive LPI_STOPPED. A failed call leaves the handle's
  * state exactly as it was. The library never prints, aborts or exits (FFTW,
  * libgomp and libgfortran can, when memory is exhausted: liepoisson(7)), and
- * no C++ exception crosses this interface.
+ * no C++ exception crosses this interface (a thread that ends inside a
+ * callback unwinds through it, the call rolled back: liepoisson(7)).
  *
  * Threading: one handle is used by one thread at a time; different handles
  * are independent and may be used concurrently.
