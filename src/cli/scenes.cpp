@@ -87,6 +87,15 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
                               {0.8, 0.4, 0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625});
     rigid.options = {"--inertia"};
     rigid.exact_reference = true;
+    {
+        // lpi_rigid_body_exact(3): within 3e-15 |m| for rate T up to 10, then
+        // growing like the unit round-off times rate T (5e-14 |m| at 300),
+        // rate = |m| max |1/I_i - 1/I_j|.
+        const double m = std::sqrt(1.0 + 0.25 + 0.09),
+                     rate = m * std::max({std::fabs(1 / I1 - 1 / I2), std::fabs(1 / I2 - 1 / I3),
+                                          std::fabs(1 / I1 - 1 / I3)});
+        rigid.exact_accuracy = m * std::max(3e-15, 2e-16 * rate * rigid.final_time);
+    }
     scenes.push_back(rigid);
 
     Scene pendulum_scene = sweep_scene(

@@ -30,9 +30,11 @@ struct Scene {
     double run_step = 0.01;          // lpi run's default --dt
     std::vector<double> steps;       // the sweep, largest first (a custom_run's steps, for the check of
                                      // final_time / step below 2^62 before any scene runs)
-    // Reference: the exact solution when the system has one, otherwise a much
-    // finer run of `reference_method` with `reference_step`.
+    // Reference: the exact solution when the system has one (accurate to
+    // `exact_accuracy` at T, as its documentation bounds it), otherwise a
+    // much finer run of `reference_method` with `reference_step`.
     bool exact_reference = false;
+    double exact_accuracy = 0.0;
     std::string reference_method;
     double reference_step = 0.0;
     bool in_default_report = true;
