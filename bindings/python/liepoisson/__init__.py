@@ -840,7 +840,7 @@ class System:
         Parameters
         ----------
         out : numpy.ndarray, optional
-            A writeable C-contiguous float64 array of `dim` entries to fill.
+            A writeable, aligned, C-contiguous float64 array of `dim` entries to fill.
 
         Returns
         -------
@@ -1150,7 +1150,7 @@ class System:
         Parameters
         ----------
         out : numpy.ndarray, optional
-            A writeable C-contiguous float64 array of `casimir_count` entries.
+            A writeable, aligned, C-contiguous float64 array of `casimir_count` entries.
 
         Returns
         -------
