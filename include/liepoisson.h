@@ -75,7 +75,7 @@ extern "C" {
     X(LPI_ERR_NO_CONVERGENCE, -10, "an implicit method's iteration did not converge") \
     X(LPI_ERR_IO, -11, "a file could not be opened, read, written or renamed")       \
     X(LPI_ERR_FORMAT, -12, "data is not a valid checkpoint of this library")           \
-    X(LPI_ERR_BUSY, -13, "the handle is inside one of its own callbacks")            \
+    X(LPI_ERR_BUSY, -13, "the handle is busy (in one of its callbacks, or another thread's call)") \
     X(LPI_ERR_OVERFLOW, -14, "a result of finite inputs overflows a double")          \
     X(LPI_STOPPED, 1, "the observer stopped the step loop (not an error)")
 
@@ -314,8 +314,10 @@ LPI_API int lpi_sine_euler_enstrophy(const lpi_system *sys, double *out);
 LPI_API int lpi_sine_euler_casimir_traces(const lpi_system *sys, int32_t kmax, double *out);
 
 /* Measures the FFT floor: FFTW executing, with this system's plans, buffers
- * and thread count, the transforms that nsteps steps of the current method
- * execute (and nothing else). Gives seconds per step and transforms per step.
+ * and thread count, the transforms of nsteps x lpi_flows_per_step flows of
+ * the current method (and nothing else): those of nsteps steps in a long run
+ * (one lpi_step call runs one flow more, its first). Gives seconds per step
+ * and transforms per step.
  * A diagnostic: the time per step over this floor is what the library adds to
  * FFTW on this machine and thread count, the figure to judge its overhead by
  * (and to compare thread counts or wisdom). The state is not touched.

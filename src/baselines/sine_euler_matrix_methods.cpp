@@ -304,12 +304,14 @@ private:
 namespace {
 
 // The order N of the sine-Euler model, or LPI_ERR_UNSUPPORTED: these methods
-// integrate sine-Euler's matrix form and apply to no other system.
+// integrate sine-Euler (its matrix form, or eq. 5 summed term by term) and
+// apply to no other system.
 int sine_euler_order(const Method &method, const Model &model) {
     const auto *sine_euler = dynamic_cast<const SineEulerModel *>(&model);
     if (!sine_euler)
-        refuse_system("method '" + method.name + "' integrates the matrix form of sine-Euler and "
-                      "applies to sine-Euler systems only (this system is " + model.kind() + ")");
+        refuse_system("method '" + method.name + "' integrates sine-Euler (" +
+                      (method.name == "direct-eq5" ? "eq. 5 summed term by term" : "its matrix form") +
+                      ") and applies to sine-Euler systems only (this system is " + model.kind() + ")");
     return sine_euler->truncation();
 }
 

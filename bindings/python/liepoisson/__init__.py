@@ -299,7 +299,7 @@ _ERROR_CLASSES = {
 # Statuses of newer libraries, by value, so that their exception classes exist
 # (and map) whatever library is loaded: value -> (name, message).
 _KNOWN_AHEAD = {
-    -13: ("LPI_ERR_BUSY", "the handle is inside one of its own callbacks"),
+    -13: ("LPI_ERR_BUSY", "the handle is busy (in one of its callbacks, or another thread's call)"),
     -14: ("LPI_ERR_OVERFLOW", "a result of finite inputs overflows a double"),
     1: ("LPI_STOPPED", "the observer stopped the step loop (not an error)"),
 }
