@@ -79,6 +79,10 @@ for option in "--every 3" "--threads 2" "--planning patient" "--snapshots 2" "--
 done
 refused --N report rigid-body --N 5 --out "$out/bad"
 refused --checkpoint-every $rb --checkpoint-every 5
+# Rows or snapshots past 2^28 values, which lpi keeps in memory and reads back
+# no larger, are refused before the run.
+refused --every $rb --steps 1000000000 --every 1 --snapshots 0
+refused --snapshots run sine-euler --N 63 --steps 10000000 --every 100 --snapshots 1 --out "$out/bad"
 refused --checkpoint-every $rb --checkpoint-every 0 --resume "$out/none.ckpt"
 refused --T report pendulum --T 5 --out "$out/bad"
 

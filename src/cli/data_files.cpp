@@ -18,9 +18,7 @@ namespace lpi_cli {
 
 namespace {
 
-// The most values lpi reads from one file (2 GiB of doubles): a bound on
-// what a corrupt or hostile header can make it allocate.
-const std::size_t kMaxValues = std::size_t(1) << 28;
+const std::size_t kMaxValues = kMaxArrayValues;
 
 std::size_t element_count(const std::vector<std::size_t> &shape, bool *too_many) {
     std::size_t count = 1;

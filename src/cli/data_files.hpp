@@ -3,11 +3,17 @@
 // HDF5 file per run (h5py, xarray through h5netcdf, HDFView).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace lpi_cli {
+
+// The most values lpi reads from one array (2 GiB of doubles): a bound on
+// what a corrupt or hostile header can make it allocate, and so on what a
+// run may write and still resume from.
+constexpr std::size_t kMaxArrayValues = std::size_t(1) << 28;
 
 // An n-dimensional array in C order. `integer` arrays (steps) are stored as
 // 64-bit integers; their values are whole numbers below 2^53.

@@ -399,6 +399,30 @@ int run_command(int argc, char **argv) {
     const int64_t every = o.every > 0 ? o.every : std::max<int64_t>(1, end / 100);
     // Row r is written after step min(r * every, end).
     auto row_index = [&](int64_t step) { return step / every + (step % every != 0); };
+    // The rows and the snapshots are kept in memory until they are written,
+    // and read back to resume: at most kMaxArrayValues (2 GiB of doubles) an
+    // array, the most lpi reads back as one. A run past that would hold more
+    // and could not be resumed.
+    {
+        const int64_t rows = row_index(end) + 1;
+        const int64_t shots = o.snapshot_every > 0 ? (rows - 1) / o.snapshot_every + 1 : 0;
+        const double most = static_cast<double>(kMaxArrayValues);
+        const double casimir_values = static_cast<double>(rows) * static_cast<double>(std::max<std::size_t>(data.casimir_count, 1)),
+                     snapshot_values = static_cast<double>(shots) * static_cast<double>(data.snapshot_size());
+        if (casimir_values > most) {
+            std::fprintf(stderr, "lpi run: --every: %lld rows of %zu Casimirs are %.3g values, more than the "
+                                 "2^28 (2 GiB) lpi keeps as one array: write rows less often\n",
+                         static_cast<long long>(rows), data.casimir_count, casimir_values);
+            return 2;
+        }
+        if (snapshot_values > most) {
+            std::fprintf(stderr, "lpi run: --snapshots: %lld snapshots of %zu values are %.3g values, more "
+                                 "than the 2^28 (2 GiB) lpi keeps as one array: take them less often (or "
+                                 "none: --snapshots 0)\n",
+                         static_cast<long long>(shots), data.snapshot_size(), snapshot_values);
+            return 2;
+        }
+    }
 
     // Every process makes it (or finds it there), each on its own disk.
     std::string no_output = make_output_dir(o.out_dir);
