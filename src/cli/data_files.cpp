@@ -18,13 +18,11 @@ namespace lpi_cli {
 
 namespace {
 
-const std::size_t kMaxValues = kMaxArrayValues;
-
 std::size_t element_count(const std::vector<std::size_t> &shape, bool *too_many) {
     std::size_t count = 1;
     *too_many = false;
     for (std::size_t n : shape) {
-        if (n != 0 && count > kMaxValues / n) *too_many = true;
+        if (n != 0 && count > kMaxArrayValues / n) *too_many = true;
         count = *too_many ? 0 : count * n;
     }
     return count;
@@ -144,7 +142,7 @@ private:
         std::size_t n = 0;
         for (; p_ != end_ && *p_ >= '0' && *p_ <= '9'; ++p_) {
             n = 10 * n + static_cast<std::size_t>(*p_ - '0');
-            if (n > kMaxValues) return false;
+            if (n > kMaxArrayValues) return false;
         }
         out = n;
         return true;

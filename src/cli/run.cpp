@@ -406,8 +406,9 @@ int run_command(int argc, char **argv) {
     {
         const int64_t rows = row_index(end) + 1;
         const int64_t shots = o.snapshot_every > 0 ? (rows - 1) / o.snapshot_every + 1 : 0;
-        const double most = static_cast<double>(kMaxArrayValues);
-        const double casimir_values = static_cast<double>(rows) * static_cast<double>(std::max<std::size_t>(data.casimir_count, 1)),
+        const double most = static_cast<double>(kMaxArrayValues),
+                     row_width = static_cast<double>(std::max<std::size_t>(data.casimir_count, 1)),
+                     casimir_values = static_cast<double>(rows) * row_width,
                      snapshot_values = static_cast<double>(shots) * static_cast<double>(data.snapshot_size());
         if (casimir_values > most) {
             std::fprintf(stderr, "lpi run: --every: %lld rows of %zu Casimirs are %.3g values, more than the "

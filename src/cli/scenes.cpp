@@ -80,10 +80,11 @@ Scene sweep_scene(const std::string &name, const std::string &description, std::
 std::vector<Scene> builtin_scenes(const SceneOptions &options) {
     std::vector<Scene> scenes;
     const double I1 = options.inertia[0], I2 = options.inertia[1], I3 = options.inertia[2];
+    const std::vector<double> m0 = {1.0, 0.5, -0.3};
     Scene rigid = sweep_scene("rigid-body",
                               "free rigid body, I = (" + format_number(I1) + ", " + format_number(I2) + ", " +
                                   format_number(I3) + "), m(0) = (1, 0.5, -0.3)",
-                              [I1, I2, I3] { return rigid_body(I1, I2, I3, {1.0, 0.5, -0.3}); }, 100.0,
+                              [I1, I2, I3, m0] { return rigid_body(I1, I2, I3, m0); }, 100.0,
                               {0.8, 0.4, 0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625});
     rigid.options = {"--inertia"};
     rigid.exact_reference = true;
@@ -91,7 +92,7 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
         // lpi_rigid_body_exact(3): within 3e-15 |m| for rate T up to 10, then
         // growing like the unit round-off times rate T (5e-14 |m| at 300),
         // rate = |m| max |1/I_i - 1/I_j|.
-        const double m = std::sqrt(1.0 + 0.25 + 0.09),
+        const double m = std::sqrt(m0[0] * m0[0] + m0[1] * m0[1] + m0[2] * m0[2]),
                      rate = m * std::max({std::fabs(1 / I1 - 1 / I2), std::fabs(1 / I2 - 1 / I3),
                                           std::fabs(1 / I1 - 1 / I3)});
         rigid.exact_accuracy = m * std::max(3e-15, 2e-16 * rate * rigid.final_time);
