@@ -82,7 +82,7 @@ refused --checkpoint-every $rb --checkpoint-every 5
 # Rows or snapshots past 2^28 values, which lpi keeps in memory and reads back
 # no larger, are refused before the run.
 refused --every $rb --steps 1000000000 --every 1 --snapshots 0
-refused --snapshots run sine-euler --N 63 --steps 10000000 --every 100 --snapshots 1 --out "$out/bad"
+refused --snapshots $rb --steps 200000000 --every 1 --snapshots 1
 refused --checkpoint-every $rb --checkpoint-every 0 --resume "$out/none.ckpt"
 refused --T report pendulum --T 5 --out "$out/bad"
 
