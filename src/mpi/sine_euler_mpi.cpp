@@ -204,7 +204,6 @@ public:
 private:
     LineTransforms &transforms();
     bool line_spectrum(const double *line0);
-    void move_block(const Direction &D, int block, double *x, double *slab);
     template <class Term>
     double sum_over_field(const double *state, Term &&term) const;
     void require_same_input(const double *x, std::size_t n, const char *what) const {
@@ -351,26 +350,6 @@ bool SineEulerMpi::line_spectrum(const double *line0) {
     return true;
 }
 
-// Block `block` of this process's lines: gathered from the rows of the slab,
-// transformed, multiplied by the lines' (exp(t Lambda_l) - 1) / N, transformed
-// back and added to the modes.
-void SineEulerMpi::move_block(const Direction &D, int block, double *x, double *slab) {
-    const int i0 = block * kBlock, count = lines_in_block(mine_, block);
-    const int d0 = first_ + i0;
-    const std::size_t row = 2 * static_cast<std::size_t>(mine_);
-    for (int s = 0; s < N_; ++s)
-        std::memcpy(x + 2 * static_cast<std::size_t>(s) * count, slab + s * row + 2 * i0,
-                    sizeof(double) * 2 * count);
-    transforms_->forward(count, x);
-    apply_phase(N_, d0, count, transforms_->phase(), -D.sigma, x);
-    transforms_->backward(count, x);
-    for (int s = 0; s < N_; ++s) {
-        double *z = slab + s * row + 2 * i0;
-        const double *increment = x + 2 * static_cast<std::size_t>(s) * count;
-        for (int i = 0; i < 2 * count; ++i) z[i] = z[i] + increment[i];
-    }
-}
-
 void SineEulerMpi::flow(std::size_t piece, double t, double *state) {
     transforms();
     const std::size_t held = static_cast<std::size_t>(state[0]);
@@ -387,8 +366,32 @@ void SineEulerMpi::flow(std::size_t piece, double t, double *state) {
     if (!line_spectrum(state + mpi::line0_entry())) return;
     const double factor = t / (2.0 * eps_);
     double *slab = state + mpi::slab_entry(N_);
-    run_line_flows(*transforms_, N_, mine_, threads_, factor,
-                   [&](int block, double *x) { move_block(D, block, x, slab); });
+    // Block b of this process's lines: gathered from the rows of the slab,
+    // transformed, multiplied by the lines' (exp(t Lambda_l) - 1) / N,
+    // transformed back and added to the modes.
+    const std::size_t row = 2 * static_cast<std::size_t>(mine_);
+    run_line_flows(
+        *transforms_, N_, mine_, threads_, factor,
+        [&](int b, double *x) {
+            const int i0 = b * kBlock, count = lines_in_block(mine_, b);
+            for (int s = 0; s < N_; ++s)
+                std::memcpy(x + 2 * static_cast<std::size_t>(s) * count, slab + s * row + 2 * i0,
+                            sizeof(double) * 2 * count);
+        },
+        [&](int b, double *x) {
+            const int count = lines_in_block(mine_, b);
+            transforms_->forward(count, x);
+            apply_phase(N_, first_ + b * kBlock, count, transforms_->phase(), -D.sigma, x);
+            transforms_->backward(count, x);
+        },
+        [&](int b, double *x) {
+            const int i0 = b * kBlock, count = lines_in_block(mine_, b);
+            for (int s = 0; s < N_; ++s) {
+                double *z = slab + s * row + 2 * i0;
+                const double *increment = x + 2 * static_cast<std::size_t>(s) * count;
+                for (int i = 0; i < 2 * count; ++i) z[i] = z[i] + increment[i];
+            }
+        });
 }
 
 // The transforms of this process's lines alone; the slowest process's time.

@@ -3,6 +3,7 @@
 // region; and the FFT floor, the same transforms timed alone.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -34,23 +35,88 @@ inline int this_thread() {
 inline int blocks_of(int lines) { return (lines + kBlock - 1) / kBlock; }
 inline int lines_in_block(int lines, int b) { return lines - b * kBlock < kBlock ? lines - b * kBlock : kBlock; }
 
+// Up to this many threads one of them, the writer, moves every block in
+// and out of the modes, and the others only transform (run_line_flows).
+constexpr int kMostThreadsPerWriter = 4;
+
+inline void spin_pause() {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+}
+
 // Writes the phase tables of the transformed line spectrum (write_phase),
-// then calls move_block(b, x) for every block b of `lines` lines with the
-// block buffer x of its thread. The implicit barrier between the two loops
-// orders them; blocks are the same whichever thread runs them, so the
+// then, for every block b of `lines` lines and a block buffer x, calls
+// gather(b, x) (the lines out of the modes), transform(b, x) (forward,
+// phase, backward) and scatter(b, x) (the increments into the modes).
+//
+// On 2 .. kMostThreadsPerWriter threads, thread 0 alone gathers and
+// scatters, in the order of the blocks, through a ring of two buffers a
+// thread; every thread transforms the blocks gathered, claimed in order
+// (thread 0 when it has nothing to move). Two threads each writing its own
+// blocks put both in every row of the modes, which on a host with two free
+// cores made a step 0.67-0.82x as fast as on one thread at N = 125 .. 375
+// (design.md, "Threads"); handed over, 1.09-1.45x, at the price of every
+// block's buffer crossing between the cores. Beyond that many threads one
+// writer could not keep up, and each thread moves its own blocks whole.
+//
+// Each block meets the same operations whichever thread runs them, so the
 // results are the same for every thread count.
-template <class MoveBlock>
-void run_line_flows(LineTransforms &T, int N, int lines, int threads, double factor, MoveBlock &&move_block) {
+template <class Gather, class Transform, class Scatter>
+void run_line_flows(LineTransforms &T, int N, int lines, int threads, double factor, Gather &&gather,
+                    Transform &&transform, Scatter &&scatter) {
     const int blocks = blocks_of(lines);
     auto phase = [&](int l) { write_phase(N, l, factor, T.spectrum(), T.phase()); };
 #if LPI_HAVE_OPENMP
     if (threads > 1 && blocks > 1) {
+        enum : int { kEmpty, kGathered, kTransformed };
+        std::atomic<int> *stage = T.handover();
+        for (int b = 0; b < blocks; ++b) stage[b].store(kEmpty, std::memory_order_relaxed);
+        std::atomic<int> next_transform{0};
+        const int ring = static_cast<int>(T.buffers());
+        auto buffer = [&](int b) { return T.block(static_cast<std::size_t>(b % ring)); };
+        auto transform_and_hand_back = [&](int b) {
+            transform(b, buffer(b));
+            stage[b].store(kTransformed, std::memory_order_release);
+        };
 #pragma omp parallel num_threads(threads)
         {
 #pragma omp for schedule(static)
             for (int l = 0; l < N; ++l) phase(l);
+            if (threads > kMostThreadsPerWriter) {
+                double *x = T.block(static_cast<std::size_t>(this_thread()));
 #pragma omp for schedule(static)
-            for (int b = 0; b < blocks; ++b) move_block(b, T.block(static_cast<std::size_t>(this_thread())));
+                for (int b = 0; b < blocks; ++b) {
+                    gather(b, x);
+                    transform(b, x);
+                    scatter(b, x);
+                }
+            } else if (this_thread() == 0) {
+                // The writer: gather up to a ring ahead, scatter in order,
+                // transform when neither can go on.
+                int gathered = 0, scattered = 0;
+                while (scattered < blocks) {
+                    if (gathered < blocks && gathered - scattered < ring) {
+                        gather(gathered, buffer(gathered));
+                        stage[gathered].store(kGathered, std::memory_order_release);
+                        ++gathered;
+                    } else if (stage[scattered].load(std::memory_order_acquire) == kTransformed) {
+                        scatter(scattered, buffer(scattered));
+                        ++scattered;
+                    } else {
+                        int b = next_transform.load(std::memory_order_relaxed);
+                        if (b < gathered && next_transform.compare_exchange_strong(b, b + 1))
+                            transform_and_hand_back(b);
+                        else
+                            spin_pause();
+                    }
+                }
+            } else {
+                for (int b; (b = next_transform.fetch_add(1)) < blocks;) {
+                    while (stage[b].load(std::memory_order_acquire) != kGathered) spin_pause();
+                    transform_and_hand_back(b);
+                }
+            }
         }
         return;
     }
@@ -60,7 +126,12 @@ void run_line_flows(LineTransforms &T, int N, int lines, int threads, double fac
     // (a host program stepping its handles from a parallel region), and share
     // out, or wait at a barrier for, threads working on other handles.
     for (int l = 0; l < N; ++l) phase(l);
-    for (int b = 0; b < blocks; ++b) move_block(b, T.block(0));
+    double *x = T.block(0);
+    for (int b = 0; b < blocks; ++b) {
+        gather(b, x);
+        transform(b, x);
+        scatter(b, x);
+    }
 }
 
 // The flow count of `steps` steps of `flows_per_step` flows: LPI_ERR_INVALID

@@ -162,7 +162,6 @@ public:
 private:
     LineTransforms &transforms();
     bool line_spectrum(const Direction &D, const double *w);
-    void move_block(const Direction &D, int block, double *x, double *w);
 
     int N_;
     LineBlocks blocks_;
@@ -189,28 +188,29 @@ bool SineEuler::line_spectrum(const Direction &D, const double *w) {
     return true;
 }
 
-// Lines d = d0 .. d0+count-1 of direction D: gather z_s = w_{d j + s k} into
-// x[s * count + (d - d0)], transform along s, multiply by the line's
-// (exp(t Lambda_l) - 1) / N, transform back, add the increments to the modes
-// and write the conjugates of the sums to the lines -d.
-void SineEuler::move_block(const Direction &D, int block, double *x, double *w) {
-    const int d0 = blocks_.first_line(block), count = blocks_.lines(block);
-    const int first_lane = blocks_.first_lane(block);
-    gather_block(D, N_, d0, count, first_lane, w, x);
-    transforms_->forward(count, x);
-    apply_phase(N_, d0, count, transforms_->phase(), -D.sigma, x);
-    transforms_->backward(count, x);
-    scatter_block(D, N_, d0, count, first_lane, x, w);
-}
-
 void SineEuler::flow(std::size_t piece, double t, double *state) {
     transforms();
     const Direction &D = dirs_[piece];
     // A piece whose stream function is zero on its line moves nothing: its flow is the identity
     // (taken exactly, not through a round trip of FFTs).
     if (!line_spectrum(D, state)) return;
-    run_line_flows(*transforms_, N_, blocks_.M, threads_, t / (2.0 * eps_),
-                   [&](int block, double *x) { move_block(D, block, x, state); });
+    // Block b, lines d = d0 .. d0+count-1 of D: gather z_s = w_{d j + s k}
+    // into x[s * count + (d - d0)], transform along s, multiply by the line's
+    // (exp(t Lambda_l) - 1) / N, transform back, add the increments to the
+    // modes and write the conjugates of the sums to the lines -d.
+    run_line_flows(
+        *transforms_, N_, blocks_.M, threads_, t / (2.0 * eps_),
+        [&](int b, double *x) {
+            gather_block(D, N_, blocks_.first_line(b), blocks_.lines(b), blocks_.first_lane(b), state, x);
+        },
+        [&](int b, double *x) {
+            transforms_->forward(blocks_.lines(b), x);
+            apply_phase(N_, blocks_.first_line(b), blocks_.lines(b), transforms_->phase(), -D.sigma, x);
+            transforms_->backward(blocks_.lines(b), x);
+        },
+        [&](int b, double *x) {
+            scatter_block(D, N_, blocks_.first_line(b), blocks_.lines(b), blocks_.first_lane(b), x, state);
+        });
 }
 
 // The transforms of `flows_per_step * steps` flows alone, on the model's own

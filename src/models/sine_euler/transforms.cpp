@@ -98,6 +98,7 @@ LineTransforms::LineTransforms(int N, int lines, FftPlanning planning)
         spectrum_ = reinterpret_cast<double *>(fftw_alloc_complex(N));
         phase_ = static_cast<double *>(fftw_malloc(sizeof(double) * phase_table_doubles(N)));
         if (!spectrum_ || !phase_) throw std::bad_alloc();
+        handover_.reset(new std::atomic<int>[static_cast<std::size_t>((lines + kBlock - 1) / kBlock + 1)]);
         reserve_threads(1);
         require_fftw_headroom(fftw_planning_headroom(N), "the plans of length " + std::to_string(N));
         std::lock_guard<std::mutex> lock(fftw_planner_mutex());
@@ -146,10 +147,11 @@ void LineTransforms::release() {
 }
 
 void LineTransforms::reserve_threads(std::size_t threads) {
+    const std::size_t buffers = threads > 1 ? 2 * threads : 1;
     // The slot first: a push_back that threw after the buffer was allocated
     // would leave the buffer owned by nothing.
-    if (blocks_.capacity() < threads) blocks_.reserve(threads);
-    while (blocks_.size() < threads) {
+    if (blocks_.capacity() < buffers) blocks_.reserve(buffers);
+    while (blocks_.size() < buffers) {
         fftw_complex *x = fftw_alloc_complex(static_cast<std::size_t>(N_) * kBlock);
         if (!x) throw std::bad_alloc();
         blocks_.push_back(reinterpret_cast<double *>(x));

@@ -8,6 +8,7 @@
 // functions, which refuse with LPI_ERR_UNSUPPORTED in a build without it.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <memory>
 #include <string>
@@ -28,8 +29,10 @@ public:
     LineTransforms(const LineTransforms &) = delete;
     LineTransforms &operator=(const LineTransforms &) = delete;
 
-    // One block buffer per thread (N * kBlock complex each).
+    // The block buffers (N * kBlock complex each) of a flow on `threads`
+    // threads: one, or a ring of two per thread (see run_line_flows).
     void reserve_threads(std::size_t threads);
+    std::size_t buffers() const { return blocks_.size(); }
     // The line spectrum b: N complex (interleaved), transformed in place.
     double *spectrum() { return spectrum_; }
     void transform_spectrum();
@@ -40,6 +43,10 @@ public:
     double *block(std::size_t thread) { return blocks_[thread]; }
     void forward(int lines, double *block);
     void backward(int lines, double *block);
+    // One flag per block of lines, for handing blocks between threads
+    // (run_line_flows): allocated with the plans, so that a flow allocates
+    // nothing.
+    std::atomic<int> *handover() { return handover_.get(); }
 
 private:
     struct Plans;
@@ -48,6 +55,7 @@ private:
     std::unique_ptr<Plans> plans_;
     double *spectrum_ = nullptr, *phase_ = nullptr;
     std::vector<double *> blocks_;
+    std::unique_ptr<std::atomic<int>[]> handover_;
 };
 
 // The 2D DFTs between the mode array (2 N^2 doubles) and the real grid:
