@@ -55,8 +55,8 @@ inline void spin_pause() {
 // thread; every thread transforms the blocks gathered, claimed in order
 // (thread 0 when it has nothing to move). Two threads each writing its own
 // blocks put both in every row of the modes, which on a host with two free
-// cores made a step 0.67-0.82x as fast as on one thread at N = 125 .. 375
-// (design.md, "Threads"); handed over, 1.09-1.45x, at the price of every
+// cores made a step 0.67-0.88x as fast as on one thread at N = 125 .. 375
+// (design.md, "Threads"); handed over, 1.13-1.67x, at the price of every
 // block's buffer crossing between the cores. Beyond that many threads one
 // writer could not keep up, and each thread moves its own blocks whole.
 //
