@@ -182,6 +182,26 @@ void test_compiled_flow_refuses_overflow(void **) {
     LPI_ASSERT_FAILS(sys, lpi_step(sys, 1.0, 1), LPI_ERR_NONFINITE, "exact flow overflows (component 1)");
     assert_false(saw_nonfinite);
     lpi_destroy(sys);
+
+    // A scaling near the identity (<qp> grows x1 by e^0.2) past the largest
+    // double: the compiled flow tests y there only where some |y| exceeds
+    // half the largest double, the general plan every new value.
+    Quadratic squeeze = {};
+    squeeze.alpha[0] = 0.1;
+    const int32_t qp = 1;
+    const double big[8] = {1.7e308, 0.2, 0.5, 2.5, 0.6, 0.6, 0.3, 0.8};
+    for (int generic = 0; generic < 2; ++generic) {
+        sys = nullptr;
+        if (generic) sys = moments_generic_twin();
+        else EXPECT_OK(NULL, lpi_moments_create(&sys));
+        EXPECT_OK(sys, lpi_add_piece(sys, 1, &qp, quadratic_gradient, quadratic_energy, &squeeze));
+        EXPECT_OK(sys, lpi_set_method(sys, "lie-trotter"));
+        EXPECT_OK(sys, lpi_set_state(sys, big, 8));
+        LPI_ASSERT_FAILS(sys, lpi_step(sys, 1.0, 1), LPI_ERR_NONFINITE, "exact flow overflows (component 0)");
+        EXPECT_OK(sys, lpi_get_state(sys, after, 8));
+        assert_memory_equal(after, big, sizeof big);
+        lpi_destroy(sys);
+    }
 }
 
 // New values each finite but whose sum overflows (the flows test them all
