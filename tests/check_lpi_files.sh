@@ -15,7 +15,9 @@
 #    keeps its mode, a new one gets the umask's; a FIFO where an output
 #    goes is refused, not replaced;
 #  - a failure after the run has gathered data (a checkpoint save or the
-#    CSV failing mid-run, the CSV at the end) still writes the data;
+#    CSV failing mid-run, the CSV at the end) still writes the data, and a
+#    run killed by SIGKILL resumes from the CSV and data written with its
+#    last checkpoint to the uninterrupted run's files;
 #  - --checkpoint that cannot work (moments) or names an output of the run
 #    is refused (2) and one that fails leaves the old CSV; --resume with
 #    another --dt is refused (2); --init refuses a FIFO (1) at once;
@@ -228,6 +230,34 @@ for format in $formats; do
         expect 1 "$data.*not a regular file" run rigid-body --steps 2 --format $format --out "$out/mode"
         [ -p "$out/mode/$data" ] || fail "a FIFO at $data was replaced"
     fi
+done
+
+# A run killed outright (SIGKILL: nothing it can catch or write) leaves the
+# CSV and the data written with its last checkpoint: resumed, it is the
+# uninterrupted run, its snapshots from the start included (the data was
+# written only when the run ended, and a killed run's snapshots were lost).
+for format in $formats; do
+    rm -rf "$out/killed" "$out/killed-ref" "$out/killed.lpi"
+    set -- run rigid-body --dt 0.01 --every 100000 --snapshots 1 --format $format
+    "$lpi" "$@" --steps 1000000000 --out "$out/killed" --checkpoint "$out/killed.lpi" \
+        --checkpoint-every 1 >/dev/null 2>&1 &
+    pid=$!  # lpi's own (SIGKILL to a wrapper such as timeout would leave lpi running)
+    waited=0
+    until [ "$(cat "$out/killed/rigid-body.csv" 2>/dev/null | wc -l)" -ge 6 ] || [ $waited -ge 600 ]; do
+        sleep 0.05; waited=$((waited + 1))
+    done
+    kill -KILL $pid 2>/dev/null || true
+    wait $pid 2>/dev/null || true
+    stop=$(tail -n 1 "$out/killed/rigid-body.csv" | cut -d, -f1)
+    [ "$stop" -ge 400000 ] || fail "SIGKILL: the run was not killed mid-run (last row at step $stop)"
+    "$lpi" "$@" --steps $((stop + 300000)) --out "$out/killed" --checkpoint "$out/killed.lpi" \
+        --checkpoint-every 1 --resume "$out/killed.lpi" >"$out/stdout"
+    ! grep -q "no data there" "$out/stdout" || { cat "$out/stdout"; fail "SIGKILL ($format): no data left"; }
+    "$lpi" "$@" --steps $((stop + 300000)) --out "$out/killed-ref" >/dev/null
+    data=rigid-body.h5; [ "$format" = h5 ] || data=rigid-body
+    cmp -s "$out/killed-ref/rigid-body.csv" "$out/killed/rigid-body.csv" &&
+        diff -r "$out/killed-ref/$data" "$out/killed/$data" >/dev/null ||
+        fail "a run killed by SIGKILL ($format), resumed: not the uninterrupted run"
 done
 
 # --checkpoint: refused up front when it cannot work or would overwrite an

@@ -504,9 +504,10 @@ int run_command(int argc, char **argv) {
     synchronize();
 
     // The CSV holds every row of `data` (the kept rows too, written again to
-    // the same bytes). It is replaced as a whole (output.hpp), by rank 0:
-    // with each checkpoint, so that the CSV a killed run leaves matches the
-    // checkpoint it resumes from, and at the end of the run, however it ends.
+    // the same bytes). It is replaced as a whole (output.hpp), by rank 0, as
+    // the data is: with each checkpoint, so that what a killed run leaves
+    // reaches the checkpoint it resumes from, and at the end of the run,
+    // however it ends.
     auto csv_text = [&] {
         std::string text = absolute_error() ? "step,time,energy,absolute_energy_error"
                                             : "step,time,energy,energy_error";
@@ -550,15 +551,17 @@ int run_command(int argc, char **argv) {
     // exit status `status` (its message printed already), but not before
     // they are written: the data (and, with `with_csv`, the CSV; not where
     // the CSV is what failed), each as far as it can be, whatever the other
-    // does. Nothing here is collective: rank 0 writes, every process exits.
-    auto stop_keeping_data = [&](int status, int64_t step, bool with_csv) {
+    // does; not the data where it is what failed (`with_data` false), whose
+    // file is then the one written with the last checkpoint. Nothing here is
+    // collective: rank 0 writes, every process exits.
+    auto stop_keeping_data = [&](int status, int64_t step, bool with_csv, bool with_data = true) {
         progress.finish();
         std::string why = with_csv ? write_csv() : "";
-        const std::string no_data = keep_data();
+        const std::string no_data = with_data ? keep_data() : "";
         if (!no_data.empty()) why += (why.empty() ? "" : "\n") + no_data;
         if (!why.empty())
             std::fprintf(stderr, "%s\n", why.c_str());
-        else if (writes_output())
+        else if (writes_output() && with_data)
             std::fprintf(stderr, "lpi run: the rows and snapshots up to step %lld are in %s\n",
                          static_cast<long long>(step), data_path(o).c_str());
         std::exit(status);
@@ -590,19 +593,22 @@ int run_command(int argc, char **argv) {
         data.snapshot_time.push_back(lpi_time(sys));
     };
     // A checkpoint that cannot be written stops the run: going on would lose
-    // it; and so does the CSV written with it. The CSV goes first, so that a
-    // run stopped between the two (a failure, a kill) leaves a CSV that
-    // reaches the checkpoint it resumes from (--resume replaces the rows past
-    // it; a CSV without the checkpoint's row would be started anew). Either
-    // way the data is written before the run exits (stop_keeping_data): the
-    // rows and snapshots gathered since the last checkpoint are only in
-    // memory, and --resume keeps those up to its checkpoint's step. The
-    // checkpoint's path is probed before the run. `save_file` runs lpi_save
-    // (rank 0 alone may save one) and names the system saved; each outcome
-    // is agreed by all.
+    // it; and so do the CSV and the data written with it. They go first, so
+    // that a run stopped before the checkpoint (a failure, a kill, SIGKILL
+    // included) leaves a CSV and data that reach the checkpoint it resumes
+    // from (--resume replaces the rows and snapshots past it, and keeps those
+    // up to it; a CSV without the checkpoint's row would be started anew, and
+    // data written only at the end lost every snapshot of a killed run). A
+    // failure of either still writes the other before the run exits
+    // (stop_keeping_data). The checkpoint's path is probed before the run.
+    // `save_file` runs lpi_save (rank 0 alone may save one) and names the
+    // system saved; each outcome is agreed by all.
     auto write_checkpoint = [&](int64_t step, const std::function<int(const lpi_system *&)> &save_file) {
         const std::string no_csv = write_csv();
         if (const int agreed = agreed_failure(!no_csv.empty(), no_csv)) stop_keeping_data(agreed, step, false);
+        const std::string no_data = keep_data();
+        if (const int agreed = agreed_failure(!no_data.empty(), no_data))
+            stop_keeping_data(agreed, step, false, false);
         const lpi_system *saved = sys;
         const int status = save_file(saved);
         const std::string why = status == LPI_OK ? ""
@@ -626,8 +632,8 @@ int run_command(int argc, char **argv) {
     // The start's row when the CSV has none, from H0 and C0 (this state's
     // then): the CSV each process read may differ, and energy_of is collective.
     if (kept.empty()) record(start, H0, C0);
+    if (o.resume.empty()) snapshot(0);  // before the checkpoint, whose data then holds it
     save(start, true);
-    if (o.resume.empty()) snapshot(0);
     Watch watch;
     watch.progress = &progress;
     check(lpi_set_observer(sys, observation_interval(sys), watch_steps, &watch), sys, "set observer");
