@@ -260,6 +260,27 @@ for format in $formats; do
         fail "a run killed by SIGKILL ($format), resumed: not the uninterrupted run"
 done
 
+# Data that cannot be written with a checkpoint (its snapshots past the
+# file size limit, the CSV still within it) stops the run as a CSV does,
+# leaving the data of the last checkpoint: resumed, the run is the
+# uninterrupted one.
+if [ "$have_se" = 1 ]; then
+    rm -rf "$out/dck" "$out/dck-ref" "$out/dck.lpi"
+    set -- run sine-euler --N 31 --every 1 --snapshots 1 --steps 8 --format npy
+    "$lpi" "$@" --out "$out/dck-ref" >/dev/null
+    rc=0; limited "$@" --out "$out/dck" --checkpoint "$out/dck.lpi" --checkpoint-every 1 \
+        >"$out/stdout" 2>"$out/stderr" || rc=$?
+    [ "$rc" -eq 1 ] && grep -q "vorticity.npy.*File too large" "$out/stderr" && ! grep -q "^done" "$out/stdout" ||
+        { cat "$out/stderr"; fail "data that cannot be written with a checkpoint: exit status $rc, expected 1 at once"; }
+    no_temporaries "$out/dck/sine-euler"
+    "$lpi" "$@" --out "$out/dck" --checkpoint "$out/dck.lpi" --checkpoint-every 1 --resume "$out/dck.lpi" \
+        >"$out/stdout"
+    ! grep -q "no data there" "$out/stdout" || { cat "$out/stdout"; fail "data stopped at a checkpoint: none left"; }
+    cmp -s "$out/dck-ref/sine-euler.csv" "$out/dck/sine-euler.csv" &&
+        diff -r "$out/dck-ref/sine-euler" "$out/dck/sine-euler" >/dev/null ||
+        fail "a run stopped by data it could not write, resumed: not the uninterrupted run"
+fi
+
 # --checkpoint: refused up front when it cannot work or would overwrite an
 # output, and a failed first save leaves the old CSV.
 "$lpi" run moments --steps 3 --out "$out/ck" >/dev/null
