@@ -254,11 +254,31 @@ for format in $formats; do
         --checkpoint-every 1 --resume "$out/killed.lpi" >"$out/stdout"
     ! grep -q "no data there" "$out/stdout" || { cat "$out/stdout"; fail "SIGKILL ($format): no data left"; }
     "$lpi" "$@" --steps $((stop + 300000)) --out "$out/killed-ref" >/dev/null
+    # The kill may land in a write, whose temporary file it leaves behind.
     data=rigid-body.h5; [ "$format" = h5 ] || data=rigid-body
     cmp -s "$out/killed-ref/rigid-body.csv" "$out/killed/rigid-body.csv" &&
-        diff -r "$out/killed-ref/$data" "$out/killed/$data" >/dev/null ||
+        diff -r -x '.lpi-*' "$out/killed-ref/$data" "$out/killed/$data" >/dev/null ||
         fail "a run killed by SIGKILL ($format), resumed: not the uninterrupted run"
 done
+
+# A kill between two renames of the .npy set leaves files of two writes in
+# turn, which share the rows and snapshots up to the checkpoint: resumed,
+# the run reads those and ends as the uninterrupted run (such a set was
+# refused as damaged, its arrays differing in length, and its snapshots
+# could be kept only by hand).
+rm -rf "$out/mixed" "$out/mixed-old" "$out/mixed-ref" "$out/mixed.lpi" "$out/mixed-later.lpi"
+set -- run rigid-body --every 5 --snapshots 1 --format npy
+"$lpi" "$@" --steps 30 --out "$out/mixed-ref" >/dev/null
+"$lpi" "$@" --steps 10 --out "$out/mixed" --checkpoint "$out/mixed.lpi" >/dev/null
+cp -r "$out/mixed/rigid-body" "$out/mixed-old"
+"$lpi" "$@" --steps 20 --out "$out/mixed" --checkpoint "$out/mixed-later.lpi" --resume "$out/mixed.lpi" >/dev/null
+for name in time energy snapshot_time; do cp "$out/mixed-old/$name.npy" "$out/mixed/rigid-body/"; done
+"$lpi" "$@" --steps 30 --out "$out/mixed" --resume "$out/mixed.lpi" >"$out/stdout" 2>"$out/stderr" ||
+    { cat "$out/stderr"; fail "a .npy set of two writes, resumed: refused"; }
+! grep -q "keeps the snapshots from" "$out/stdout" || { cat "$out/stdout"; fail "a .npy set of two writes: dropped"; }
+cmp -s "$out/mixed-ref/rigid-body.csv" "$out/mixed/rigid-body.csv" &&
+    diff -r "$out/mixed-ref/rigid-body" "$out/mixed/rigid-body" >/dev/null ||
+    fail "a .npy set of two writes, resumed: not the uninterrupted run"
 
 # Data that cannot be written with a checkpoint (its snapshots past the
 # file size limit, the CSV still within it) stops the run as a CSV does,

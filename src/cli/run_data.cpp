@@ -123,6 +123,8 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
     // The set is replaced as a whole: every file is written and flushed beside
     // its target first, and renamed into place only once all of them are, so
     // that a failed write leaves the old set, never old and new files mixed.
+    // Only a kill between two renames can mix them: keep_snapshots then reads
+    // what the two sets share, the rows and snapshots up to the checkpoint.
     const std::vector<std::string> files = data_files(o, d);
     std::vector<std::unique_ptr<FileReplacement>> written;
     const std::string why = failure_of([&] {
@@ -167,11 +169,15 @@ int keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunDat
         const std::string wrong = read(name, *array);
         if (!wrong.empty()) return unreadable(wrong);
     }
-    if (row_steps.values.size() != row_times.values.size() || row_steps.values.size() != row_energies.values.size())
-        return unreadable("its arrays step, time and energy differ in length");
+    // A set that a kill cut between two of its files' renames (write_data)
+    // holds the arrays of two consecutive writes, of different lengths, which
+    // agree on every row and snapshot up to the checkpoint's step: only those
+    // are read, and each array must hold them.
     for (std::size_t i = 0; i < row_steps.values.size() && why.empty(); ++i) {
         const double step = row_steps.values[i];
         if (step > static_cast<double>(start)) continue;
+        if (i >= row_times.values.size() || i >= row_energies.values.size())
+            return unreadable(format("its arrays time and energy end before its row at step %.17g", step));
         if (d.step.empty()) {
             // No CSV: the data's row at the checkpoint's step holds its
             // time, as the CSV's does (run.cpp): another time there is
@@ -206,8 +212,10 @@ int keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunDat
         if (!wrong.empty()) return unreadable(wrong);
     }
     if (!there) why = "no data there";
-    const std::size_t n = steps.values.size();
-    if (why.empty() && (times.values.size() != n || shots.values.size() != n * d.snapshot_size()))
+    const std::size_t size = d.snapshot_size();
+    std::size_t n = 0;  // the snapshots up to the checkpoint's step
+    while (n < steps.values.size() && steps.values[n] <= static_cast<double>(start)) ++n;
+    if (why.empty() && (times.values.size() < n || shots.values.size() % size != 0 || shots.values.size() < n * size))
         why = "its snapshot arrays do not match this run";
     // The steps become 64-bit integers (the images' names, the data's
     // /snapshot_step): whole, increasing and in range; data lpi wrote has
@@ -223,9 +231,9 @@ int keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunDat
                     why.c_str(), static_cast<long long>(start));
         return 0;
     }
-    d.snapshot_step = steps.values;
-    d.snapshot_time = times.values;
-    d.snapshots = shots.values;
+    d.snapshot_step.assign(steps.values.begin(), steps.values.begin() + static_cast<std::ptrdiff_t>(n));
+    d.snapshot_time.assign(times.values.begin(), times.values.begin() + static_cast<std::ptrdiff_t>(n));
+    d.snapshots.assign(shots.values.begin(), shots.values.begin() + static_cast<std::ptrdiff_t>(n * size));
     d.keep_up_to(start);
     return 0;
 }
