@@ -693,11 +693,14 @@ int run_command(int argc, char **argv) {
         save(done, true);
     }
     // Rank 0 alone writes the CSV and the data: each, whether or not the
-    // other could be (the data holds the snapshots, the CSV does not).
-    std::string why = write_csv();
-    const std::string no_data = keep_data();
-    if (!no_data.empty()) why += (why.empty() ? "" : "\n") + no_data;
-    if (const int agreed = agreed_failure(!why.empty(), why)) return agreed;
+    // other could be (the data holds the snapshots, the CSV does not); with
+    // --checkpoint the last save wrote both (a failure there ended the run).
+    if (o.checkpoint.empty()) {
+        std::string why = write_csv();
+        const std::string no_data = keep_data();
+        if (!no_data.empty()) why += (why.empty() ? "" : "\n") + no_data;
+        if (const int agreed = agreed_failure(!why.empty(), why)) return agreed;
+    }
     const double H = energy_of(sys);
     if (interrupted_by) {
         const int64_t stop = stopped_between_rows ? watch.stopped_at : done;
