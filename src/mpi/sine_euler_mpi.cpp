@@ -379,10 +379,7 @@ void SineEulerMpi::flow(std::size_t piece, double t, double *state) {
                             sizeof(double) * 2 * count);
         },
         [&](int b, double *x) {
-            const int count = lines_in_block(mine_, b);
-            transforms_->forward(count, x);
-            apply_phase(N_, first_ + b * kBlock, count, transforms_->phase(), -D.sigma, x);
-            transforms_->backward(count, x);
+            flow_block(*transforms_, N_, first_ + b * kBlock, lines_in_block(mine_, b), -D.sigma, x);
         },
         [&](int b, double *x) {
             const int i0 = b * kBlock, count = lines_in_block(mine_, b);

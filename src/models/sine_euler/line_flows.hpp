@@ -35,6 +35,15 @@ inline int this_thread() {
 inline int blocks_of(int lines) { return (lines + kBlock - 1) / kBlock; }
 inline int lines_in_block(int lines, int b) { return lines - b * kBlock < kBlock ? lines - b * kBlock : kBlock; }
 
+// The flow of a gathered block x of `count` lines d0 .. d0+count-1: forward
+// transform along s, the lines' increments (exp(t Lambda_l) - 1) / N from
+// T's phase tables (`sign` = -sigma of the direction), backward transform.
+inline void flow_block(LineTransforms &T, int N, int d0, int count, double sign, double *x) {
+    T.forward(count, x);
+    apply_phase(N, d0, count, T.phase(), sign, x);
+    T.backward(count, x);
+}
+
 // Up to this many threads one of them, the writer, moves every block in
 // and out of the modes, and the others only transform (run_line_flows).
 constexpr int kMostThreadsPerWriter = 4;

@@ -204,9 +204,7 @@ void SineEuler::flow(std::size_t piece, double t, double *state) {
             gather_block(D, N_, blocks_.first_line(b), blocks_.lines(b), blocks_.first_lane(b), state, x);
         },
         [&](int b, double *x) {
-            transforms_->forward(blocks_.lines(b), x);
-            apply_phase(N_, blocks_.first_line(b), blocks_.lines(b), transforms_->phase(), -D.sigma, x);
-            transforms_->backward(blocks_.lines(b), x);
+            flow_block(*transforms_, N_, blocks_.first_line(b), blocks_.lines(b), -D.sigma, x);
         },
         [&](int b, double *x) {
             scatter_block(D, N_, blocks_.first_line(b), blocks_.lines(b), blocks_.first_lane(b), x, state);
