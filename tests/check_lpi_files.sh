@@ -261,6 +261,25 @@ for format in $formats; do
         fail "a run killed by SIGKILL ($format), resumed: not the uninterrupted run"
 done
 
+# Killed before its second checkpoint, a run resumes from the one at its
+# start, whose data holds the start's snapshot (taken after that checkpoint,
+# it was in no file, and the resumed run never took it).
+rm -rf "$out/early" "$out/early-ref" "$out/early.lpi"
+set -- run rigid-body --dt 0.01 --every 100000 --snapshots 1 --format npy
+"$lpi" "$@" --steps 1000000000 --out "$out/early" --checkpoint "$out/early.lpi" --checkpoint-every 0 \
+    >/dev/null 2>&1 &
+pid=$!
+waited=0
+until [ -f "$out/early.lpi" ] || [ $waited -ge 600 ]; do sleep 0.05; waited=$((waited + 1)); done
+sleep 0.2
+kill -KILL $pid 2>/dev/null || true
+wait $pid 2>/dev/null || true
+"$lpi" "$@" --steps 300000 --out "$out/early" --resume "$out/early.lpi" >"$out/stdout"
+"$lpi" "$@" --steps 300000 --out "$out/early-ref" >/dev/null
+cmp -s "$out/early-ref/rigid-body.csv" "$out/early/rigid-body.csv" &&
+    diff -r -x '.lpi-*' "$out/early-ref/rigid-body" "$out/early/rigid-body" >/dev/null ||
+    { cat "$out/stdout"; fail "a run killed after its first checkpoint, resumed: not the uninterrupted run"; }
+
 # A kill between two renames of the .npy set leaves files of two writes in
 # turn, which share the rows and snapshots up to the checkpoint: resumed,
 # the run reads those and ends as the uninterrupted run (such a set was
