@@ -282,7 +282,10 @@ struct Piece {
         double growths[P.groups > 0 ? P.groups : 1][2 * kMaxMultiple + 1];
         unroll<0, P.groups>([&](auto q) {
             constexpr Group G = P.group[q];
-            expm1_powers(G.base * s[G.parameter], G.largest, growths[q] + kMaxMultiple);
+            if constexpr (Far)
+                expm1_powers(G.base * s[G.parameter], G.largest, growths[q] + kMaxMultiple);
+            else
+                expm1_powers_near(G.base * s[G.parameter], G.largest, growths[q] + kMaxMultiple);
         });
         // c[v][k] = ((tN)^k x / k!)_v, written for k <= level(v) and read
         // only there (the general sweep's lanes above are exact zeros).

@@ -54,6 +54,13 @@ enum class ExpmPath { Nilpotent, DiagonalSeries, Plane, Pade };
 // path takes exp(t k c g_p) - 1 by powers of expm1(+-t c g_p).
 constexpr int kMaxScalingMultiple = 8;
 
+// One side of expm1_powers (below), E[side * k], from its base E[side] by the
+// recurrence.
+inline void expm1_side_powers(int side, double base, int largest, double *E) {
+    E[side] = base;
+    for (int k = 2; k <= largest; ++k) E[side * k] = E[side * (k - 1)] + base + E[side * (k - 1)] * base;
+}
+
 // E[k] = exp(k s) - 1 for k = +-1 .. +-largest (E points at k = 0), by
 // E_{k+1} = E_k + v + E_k v from v = E_1 = expm1(s) on one side and
 // E_{-k-1} = E_{-k} + w + E_{-k} w from w = E_-1 on the other. The growing
@@ -66,12 +73,7 @@ constexpr int kMaxScalingMultiple = 8;
 // from exp itself. The DiagonalSeries path and the compiled flows share it,
 // so that they give the same bits.
 inline void expm1_powers(double s, int largest, double *E) {
-    // One side, E[side * k], from its base E[side] by the recurrence.
-    auto side_powers = [largest, E](int side, double base) {
-        E[side] = base;
-        for (int k = 2; k <= largest; ++k)
-            E[side * k] = E[side * (k - 1)] + base + E[side * (k - 1)] * base;
-    };
+    auto side_powers = [largest, E](int side, double base) { expm1_side_powers(side, base, largest, E); };
     auto other_side = [](double v) { return std::isfinite(v) ? -v / (1.0 + v) : -1.0; };
     if (s >= -0.6931471805599453) {
         const double v = std::expm1(s);
@@ -82,6 +84,14 @@ inline void expm1_powers(double s, int largest, double *E) {
         side_powers(-1, w);
         side_powers(1, other_side(w));
     }
+}
+
+// expm1_powers where |s| <= 1/2 (every multiple within [-1/2, 1/2], as the
+// compiled flows' near case asks): the same bits without its tests.
+inline void expm1_powers_near(double s, int largest, double *E) {
+    const double v = std::expm1(s);
+    expm1_side_powers(1, v, largest, E);
+    expm1_side_powers(-1, -v / (1.0 + v), largest, E);
 }
 
 // z exp(a), given growth = exp(a) - 1: z + growth z, rounding z once (no
