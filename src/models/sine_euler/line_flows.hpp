@@ -62,7 +62,11 @@ inline void spin_pause() {
 // On 2 .. kMostThreadsPerWriter threads, thread 0 alone gathers and
 // scatters, in the order of the blocks, through a ring of two buffers a
 // thread; every thread transforms the blocks gathered, claimed in order
-// (thread 0 when it has nothing to move). Two threads each writing its own
+// (thread 0 when it has nothing to move). The phase tables are the other
+// threads' to write, while thread 0 gathers the first blocks (written by
+// all threads with a barrier after them, thread 0 waited for the slowest
+// and gathered nothing: at N = 125, with 4 blocks a flow, two threads took
+// a step 5-8% longer). Two threads each writing its own
 // blocks put both in every row of the modes, which on a host with two free
 // cores made a step 0.67-0.88x as fast as on one thread at N = 125 .. 375
 // (design.md, "Threads"); handed over, 1.13-1.67x, at the price of every
@@ -81,18 +85,29 @@ void run_line_flows(LineTransforms &T, int N, int lines, int threads, double fac
         enum : int { kEmpty, kGathered, kTransformed };
         std::atomic<int> *stage = T.handover();
         for (int b = 0; b < blocks; ++b) stage[b].store(kEmpty, std::memory_order_relaxed);
-        std::atomic<int> next_transform{0};
+        std::atomic<int> next_transform{0}, phases_written{0};
         const int ring = static_cast<int>(T.buffers());
         auto buffer = [&](int b) { return T.block(static_cast<std::size_t>(b % ring)); };
         auto transform_and_hand_back = [&](int b) {
             transform(b, buffer(b));
             stage[b].store(kTransformed, std::memory_order_release);
         };
+        // The transformers write the phase tables, each its own range of l,
+        // while the writer gathers the first blocks, which need no tables;
+        // a block is transformed once all the ranges are written. (The team
+        // may have fewer threads than asked for; alone, the writer writes
+        // them all.)
 #pragma omp parallel num_threads(threads)
         {
+            const int transformers = omp_get_num_threads() - 1;
+            auto phase_tables_written = [&] {
+                return phases_written.load(std::memory_order_acquire) == transformers;
+            };
+            if (transformers == 0)
+                for (int l = 0; l < N; ++l) phase(l);
+            if (transformers + 1 > kMostThreadsPerWriter) {
 #pragma omp for schedule(static)
-            for (int l = 0; l < N; ++l) phase(l);
-            if (threads > kMostThreadsPerWriter) {
+                for (int l = 0; l < N; ++l) phase(l);
                 double *x = T.block(static_cast<std::size_t>(this_thread()));
 #pragma omp for schedule(static)
                 for (int b = 0; b < blocks; ++b) {
@@ -114,13 +129,18 @@ void run_line_flows(LineTransforms &T, int N, int lines, int threads, double fac
                         ++scattered;
                     } else {
                         int b = next_transform.load(std::memory_order_relaxed);
-                        if (b < gathered && next_transform.compare_exchange_strong(b, b + 1))
+                        if (b < gathered && phase_tables_written() &&
+                            next_transform.compare_exchange_strong(b, b + 1))
                             transform_and_hand_back(b);
                         else
                             spin_pause();
                     }
                 }
             } else {
+                const int range = this_thread() - 1;
+                for (int l = N * range / transformers; l < N * (range + 1) / transformers; ++l) phase(l);
+                phases_written.fetch_add(1, std::memory_order_release);
+                while (!phase_tables_written()) spin_pause();
                 for (int b; (b = next_transform.fetch_add(1)) < blocks;) {
                     while (stage[b].load(std::memory_order_acquire) != kGathered) spin_pause();
                     transform_and_hand_back(b);
@@ -129,6 +149,8 @@ void run_line_flows(LineTransforms &T, int N, int lines, int threads, double fac
         }
         return;
     }
+#else
+    static_cast<void>(threads);
 #endif
     // One thread: plain loops. Work sharing outside a region of the library's
     // own would bind to the caller's enclosing OpenMP team, if it has one
