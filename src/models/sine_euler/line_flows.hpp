@@ -63,10 +63,10 @@ inline void spin_pause() {
 // scatters, in the order of the blocks, through a ring of two buffers a
 // thread; every thread transforms the blocks gathered, claimed in order
 // (thread 0 when it has nothing to move). The phase tables are the other
-// threads' to write, while thread 0 gathers the first blocks (written by
-// all threads with a barrier after them, thread 0 waited for the slowest
-// and gathered nothing: at N = 125, with 4 blocks a flow, two threads took
-// a step 5-8% longer). Two threads each writing its own
+// threads' to write while thread 0 gathers the first blocks: written by
+// every thread with a barrier after them, they kept thread 0 waiting for
+// the slowest before it gathered anything, and at N = 125 (4 blocks a
+// flow) two threads took a step 5-8% longer. Two threads each writing its own
 // blocks put both in every row of the modes, which on a host with two free
 // cores made a step 0.67-0.88x as fast as on one thread at N = 125 .. 375
 // (design.md, "Threads"); handed over, 1.13-1.67x, at the price of every
