@@ -298,6 +298,55 @@ static void test_steps_inside_a_host_parallel_region(void **state) {
 #endif
 }
 
+/* The modes of a field at N = 45 (22 lines a direction: two blocks, so
+ * that more than one thread gets work) after 5 steps of 0.01 with `threads`
+ * threads; 0 on success. */
+static int forty_five_after_5_steps(int threads, double *w) {
+    enum { N = 45 };
+    lpi_system *sys = NULL;
+    if (lpi_sine_euler_create(&sys, N) != LPI_OK) return 100;
+    for (int i = 0; i < 2 * N * N; ++i) w[i] = 0.0;
+    for (int k = 1; k <= 6; ++k) { /* modes (k, 2k) and their mirrors (-k, -2k) */
+        const int row = k, col = 2 * k, mirror = (N - row) * N + (N - col);
+        w[2 * (row * N + col)] = w[2 * mirror] = 1.0 / k;
+        w[2 * (row * N + col) + 1] = 0.5 / k, w[2 * mirror + 1] = -0.5 / k;
+    }
+    int status = lpi_sine_euler_set_modes(sys, w, 2 * N * N);
+    if (status == LPI_OK) status = lpi_set_threads(sys, threads);
+    if (status == LPI_OK) status = lpi_step(sys, 0.01, 5);
+    if (status == LPI_OK) status = lpi_sine_euler_get_modes(sys, w, 2 * N * N);
+    lpi_destroy(sys);
+    return status;
+}
+
+/* A handle set to 2 or 3 threads and stepped from inside a host's active
+ * parallel region opens a nested region, which gets one thread where nested
+ * regions are inactive (the default): that one thread does all of a flow,
+ * the phase tables the others would write included, and the result has the
+ * bits of a serial run (with nested regions active, the usual team has them
+ * too). */
+static void test_threads_asked_inside_a_host_parallel_region(void **state) {
+    (void)state;
+#ifndef _OPENMP
+    LPI_SKIP("a host parallel region: this test is built without OpenMP");
+#else
+    double serial[2 * 45 * 45], inside[2 * 45 * 45];
+    const int status = forty_five_after_5_steps(1, serial);
+    if (status == 100) LPI_SKIP("built without FFTW: no sine-Euler system");
+    assert_int_equal(status, LPI_OK);
+    for (int threads = 2; threads <= 3; ++threads) {
+        int stepped = -1;
+#pragma omp parallel num_threads(2)
+        {
+#pragma omp master
+            stepped = forty_five_after_5_steps(threads, inside);
+        }
+        assert_int_equal(stepped, LPI_OK);
+        assert_memory_equal(inside, serial, sizeof serial);
+    }
+#endif
+}
+
 /* In a child of fork(2), the thread that forked after the library ran a team
  * of threads on it is refused more than one thread (LPI_ERR_UNSUPPORTED: its
  * libgomp pool was not copied, and a team would wait forever); one thread,
@@ -480,6 +529,7 @@ int main(void) {
         cmocka_unit_test(test_handles_on_threads),
         cmocka_unit_test(test_thread_count_bound),
         cmocka_unit_test(test_steps_inside_a_host_parallel_region),
+        cmocka_unit_test(test_threads_asked_inside_a_host_parallel_region),
         cmocka_unit_test(test_fork_after_threads),
         cmocka_unit_test(test_another_thread_is_refused),
         cmocka_unit_test(test_two_threads_at_once),
