@@ -252,16 +252,20 @@ static void test_refused_threads_give_a_status(void **state) {
                  "was killed by signal", WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
 }
 
-/* The modes of sine_euler_15 after 20 steps of 0.01 with `threads` threads,
- * stepped on the calling thread; 0 on success. */
-static int fifteen_after_20_steps(int threads, double *w) {
-    lpi_system *sys = sine_euler_15();
+/* The modes (n doubles) of sys after `steps` steps of 0.01 with `threads`
+ * threads, stepped on the calling thread, sys destroyed; 0 on success, 100
+ * for no system (built without FFTW). */
+static int modes_after_steps(lpi_system *sys, int threads, int steps, double *w, size_t n) {
     if (!sys) return 100;
     int status = lpi_set_threads(sys, threads);
-    if (status == LPI_OK) status = lpi_step(sys, 0.01, 20);
-    if (status == LPI_OK) status = lpi_sine_euler_get_modes(sys, w, 2 * 15 * 15);
+    if (status == LPI_OK) status = lpi_step(sys, 0.01, steps);
+    if (status == LPI_OK) status = lpi_sine_euler_get_modes(sys, w, n);
     lpi_destroy(sys);
     return status;
+}
+
+static int fifteen_after_20_steps(int threads, double *w) {
+    return modes_after_steps(sine_euler_15(), threads, 20, w, 2 * 15 * 15);
 }
 
 /* A host program that steps its handles from its own OpenMP parallel region
@@ -298,25 +302,27 @@ static void test_steps_inside_a_host_parallel_region(void **state) {
 #endif
 }
 
-/* The modes of a field at N = 45 (22 lines a direction: two blocks, so
- * that more than one thread gets work) after 5 steps of 0.01 with `threads`
- * threads; 0 on success. */
-static int forty_five_after_5_steps(int threads, double *w) {
+/* A field at N = 45 (22 lines a direction: two blocks, so that more than
+ * one thread gets work), or NULL. */
+static lpi_system *sine_euler_45(void) {
     enum { N = 45 };
     lpi_system *sys = NULL;
-    if (lpi_sine_euler_create(&sys, N) != LPI_OK) return 100;
-    for (int i = 0; i < 2 * N * N; ++i) w[i] = 0.0;
+    if (lpi_sine_euler_create(&sys, N) != LPI_OK) return NULL;
+    double w[2 * N * N] = {0};
     for (int k = 1; k <= 6; ++k) { /* modes (k, 2k) and their mirrors (-k, -2k) */
         const int row = k, col = 2 * k, mirror = (N - row) * N + (N - col);
         w[2 * (row * N + col)] = w[2 * mirror] = 1.0 / k;
         w[2 * (row * N + col) + 1] = 0.5 / k, w[2 * mirror + 1] = -0.5 / k;
     }
-    int status = lpi_sine_euler_set_modes(sys, w, 2 * N * N);
-    if (status == LPI_OK) status = lpi_set_threads(sys, threads);
-    if (status == LPI_OK) status = lpi_step(sys, 0.01, 5);
-    if (status == LPI_OK) status = lpi_sine_euler_get_modes(sys, w, 2 * N * N);
-    lpi_destroy(sys);
-    return status;
+    if (lpi_sine_euler_set_modes(sys, w, 2 * N * N) != LPI_OK) {
+        lpi_destroy(sys);
+        return NULL;
+    }
+    return sys;
+}
+
+static int forty_five_after_5_steps(int threads, double *w) {
+    return modes_after_steps(sine_euler_45(), threads, 5, w, 2 * 45 * 45);
 }
 
 /* A handle set to 2 or 3 threads and stepped from inside a host's active
