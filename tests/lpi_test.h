@@ -119,7 +119,25 @@ static inline void lpi_assert_unchanged(const lpi_system *sys, const lpi_snapsho
  * the call maps is refused: blocks of 16 KiB and more are then mapped on
  * their own, never carved from freed heap (whose threshold glibc otherwise
  * raises as large blocks are freed). It returns the call's status. Not under
- * AddressSanitizer, which ends the process when a mapping is refused. */
+ * a sanitizer: a test that calls it starts with
+ * LPI_SKIP_UNDER_A_SANITIZER(). AddressSanitizer ends the process when a
+ * mapping is refused, and ThreadSanitizer's own allocator runs out. */
+#if defined(__SANITIZE_ADDRESS__)
+#define LPI_TEST_SANITIZER "AddressSanitizer"
+#elif defined(__SANITIZE_THREAD__)
+#define LPI_TEST_SANITIZER "ThreadSanitizer"
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define LPI_TEST_SANITIZER "AddressSanitizer"
+#elif __has_feature(thread_sanitizer)
+#define LPI_TEST_SANITIZER "ThreadSanitizer"
+#endif
+#endif
+#ifdef LPI_TEST_SANITIZER
+#define LPI_SKIP_UNDER_A_SANITIZER() LPI_SKIP("a low address-space limit: not under " LPI_TEST_SANITIZER)
+#else
+#define LPI_SKIP_UNDER_A_SANITIZER() ((void)0)
+#endif
 static inline size_t lpi_test_mapped_bytes(void) { /* VmSize; 0 where /proc does not say */
     FILE *f = fopen("/proc/self/status", "r");
     char line[256];

@@ -945,9 +945,7 @@ static int grid_of(lpi_system *sys, const void *context) {
 }
 static void test_fftw_short_of_memory(void **state) {
     (void)state;
-#if defined(__SANITIZE_ADDRESS__)
-    LPI_SKIP("AddressSanitizer ends the process when a mapping is refused");
-#endif
+    LPI_SKIP_UNDER_A_SANITIZER();
     const int N = 101;
     const size_t n = 2 * (size_t)N * N;
     double *w = malloc(sizeof(double) * n), *before = malloc(sizeof(double) * n),

@@ -537,9 +537,7 @@ static void limited_case_free(limited_case *c) {
  * went on with another Hamiltonian than the last process. */
 static void test_failure_on_one_process(void **state) {
     (void)state;
-#if defined(__SANITIZE_ADDRESS__)
-    LPI_SKIP("AddressSanitizer ends the process when a mapping is refused");
-#endif
+    LPI_SKIP_UNDER_A_SANITIZER();
     limited_case c = limited_case_create(5);
     lpi_system *sys = c.sys;
     const size_t n = c.n;
@@ -596,9 +594,7 @@ static int load_spread(lpi_system *sys, const void *context) {
 }
 static void test_load_failure_on_one_process(void **state) {
     (void)state;
-#if defined(__SANITIZE_ADDRESS__)
-    LPI_SKIP("AddressSanitizer ends the process when a mapping is refused");
-#endif
+    LPI_SKIP_UNDER_A_SANITIZER();
     limited_case c = limited_case_create(11);
     lpi_system *sys = c.sys, *loaded = NULL;
     const size_t n = c.n;

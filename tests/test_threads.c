@@ -229,11 +229,9 @@ static int run_under_a_low_limit(int n) {
  * (libgomp's threads are not copied into a child), so this runs first. */
 static void test_refused_threads_give_a_status(void **state) {
     (void)state;
-    /* An address-space limit does not mix with ASan's shadow memory or with
-     * valgrind's own mappings. */
-#if defined(__SANITIZE_ADDRESS__)
-    LPI_SKIP("thread limits under a low RLIMIT_AS: not under AddressSanitizer");
-#endif
+    /* An address-space limit does not mix with a sanitizer's shadow memory
+     * and allocator, or with valgrind's own mappings. */
+    LPI_SKIP_UNDER_A_SANITIZER();
     const char *preload = getenv("LD_PRELOAD");
     if (preload && strstr(preload, "vgpreload"))
         LPI_SKIP("thread limits under a low RLIMIT_AS: not under valgrind");
@@ -302,6 +300,7 @@ static void test_steps_inside_a_host_parallel_region(void **state) {
 #endif
 }
 
+#ifdef _OPENMP
 /* A field at N = 45 (22 lines a direction: two blocks, so that more than
  * one thread gets work), or NULL. */
 static lpi_system *sine_euler_45(void) {
@@ -324,6 +323,7 @@ static lpi_system *sine_euler_45(void) {
 static int forty_five_after_5_steps(int threads, double *w) {
     return modes_after_steps(sine_euler_45(), threads, 5, w, 2 * 45 * 45);
 }
+#endif
 
 /* A handle set to 2 or 3 threads and stepped from inside a host's active
  * parallel region opens a nested region, which gets one thread where nested
