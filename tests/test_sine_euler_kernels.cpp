@@ -5,7 +5,9 @@
 // General layouts) and block, full and remainder; apply_phase multiplies by
 // the written-out complex arithmetic of (e - 1) / N to the bit (the tables'
 // layout and the two-at-a-time evaluation change no operation), and that is
-// (exp(t Lambda_l) - 1) / N computed from the angles with std::polar.
+// (exp(t Lambda_l) - 1) / N computed from the angles with std::polar. Both
+// for the kernels this CPU runs (AVX2 where it has it) and for the baseline
+// ones, which every other CPU runs.
 #include <algorithm>
 #include <complex>
 #include <cstdint>
@@ -50,99 +52,114 @@ std::vector<double> hermitian_field(int N, Random &random) {
     return w;
 }
 
+// The kernels this CPU runs, and the baseline ones.
+struct Kernels {
+    const char *name;
+    decltype(&gather_block) gather;
+    decltype(&scatter_block) scatter;
+    decltype(&apply_phase) phase;
+};
+const Kernels kKernels[] = {{kernel_instruction_set(), gather_block, scatter_block, apply_phase},
+                            {"baseline", baseline::gather_block, baseline::scatter_block, baseline::apply_phase}};
+
 const int kGatherSizes[] = {15, 25, 35, 49, 75};
 
 void test_gather_scatter_follow_the_lines(void **) {
     Random random{42};
-    for (int N : kGatherSizes) {
-        const LineBlocks blocks(N);
-        int layouts[3] = {0, 0, 0};
-        for (const Direction &D : projective_line(N)) {
-            ++layouts[D.layout];
-            for (int b = 0; b < blocks.count(); ++b) {
-                const int d0 = blocks.first_line(b), count = blocks.lines(b);
-                const std::vector<double> w = hermitian_field(N, random);
-                std::vector<double> x(2 * static_cast<std::size_t>(N) * count);
-                gather_block(D, N, d0, count, blocks.first_lane(b), w.data(), x.data());
-                std::vector<double> increment(x.size()), expected = w;
-                std::vector<char> moved(static_cast<std::size_t>(N) * N, 0);
-                for (int s = 0; s < N; ++s)
-                    for (int i = 0; i < count; ++i) {
-                        const int d = d0 + i;
-                        const std::size_t e = static_cast<std::size_t>(s) * count + i;
-                        const std::size_t m = mode_at(d * D.j1 + s * D.k1, d * D.j2 + s * D.k2, N);
-                        const std::size_t mirror = mode_at(-(d * D.j1 + s * D.k1), -(d * D.j2 + s * D.k2), N);
-                        assert_memory_equal(&x[2 * e], &w[2 * m], 2 * sizeof(double));
-                        increment[2 * e] = random.next();
-                        increment[2 * e + 1] = random.next();
-                        expected[2 * m] = w[2 * m] + increment[2 * e];
-                        expected[2 * m + 1] = w[2 * m + 1] + increment[2 * e + 1];
-                        expected[2 * mirror] = expected[2 * m];
-                        expected[2 * mirror + 1] = -expected[2 * m + 1];
-                        assert_int_equal(moved[m] + moved[mirror], 0);  // each mode once
-                        moved[m] = moved[mirror] = 1;
-                    }
-                std::vector<double> scattered = w;
-                scatter_block(D, N, d0, count, blocks.first_lane(b), increment.data(), scattered.data());
-                assert_memory_equal(scattered.data(), expected.data(), sizeof(double) * w.size());
+    for (const Kernels &kernels : kKernels)
+        for (int N : kGatherSizes) {
+            const LineBlocks blocks(N);
+            int layouts[3] = {0, 0, 0};
+            for (const Direction &D : projective_line(N)) {
+                ++layouts[D.layout];
+                for (int b = 0; b < blocks.count(); ++b) {
+                    const int d0 = blocks.first_line(b), count = blocks.lines(b);
+                    const std::vector<double> w = hermitian_field(N, random);
+                    std::vector<double> x(2 * static_cast<std::size_t>(N) * count);
+                    kernels.gather(D, N, d0, count, blocks.first_lane(b), w.data(), x.data());
+                    std::vector<double> increment(x.size()), expected = w;
+                    std::vector<char> moved(static_cast<std::size_t>(N) * N, 0);
+                    for (int s = 0; s < N; ++s)
+                        for (int i = 0; i < count; ++i) {
+                            const int d = d0 + i;
+                            const std::size_t e = static_cast<std::size_t>(s) * count + i;
+                            const std::size_t m = mode_at(d * D.j1 + s * D.k1, d * D.j2 + s * D.k2, N);
+                            const std::size_t mirror =
+                                mode_at(-(d * D.j1 + s * D.k1), -(d * D.j2 + s * D.k2), N);
+                            assert_memory_equal(&x[2 * e], &w[2 * m], 2 * sizeof(double));
+                            increment[2 * e] = random.next();
+                            increment[2 * e + 1] = random.next();
+                            expected[2 * m] = w[2 * m] + increment[2 * e];
+                            expected[2 * m + 1] = w[2 * m + 1] + increment[2 * e + 1];
+                            expected[2 * mirror] = expected[2 * m];
+                            expected[2 * mirror + 1] = -expected[2 * m + 1];
+                            assert_int_equal(moved[m] + moved[mirror], 0);  // each mode once
+                            moved[m] = moved[mirror] = 1;
+                        }
+                    std::vector<double> scattered = w;
+                    kernels.scatter(D, N, d0, count, blocks.first_lane(b), increment.data(), scattered.data());
+                    assert_memory_equal(scattered.data(), expected.data(), sizeof(double) * w.size());
+                }
             }
+            std::printf("%-8s N = %2d: %3d Row, %3d Column, %3d General directions, %d blocks each\n",
+                        kernels.name, N, layouts[Direction::Row], layouts[Direction::Column],
+                        layouts[Direction::General], blocks.count());
         }
-        std::printf("N = %2d: %3d Row, %3d Column, %3d General directions, %d blocks each\n", N,
-                    layouts[Direction::Row], layouts[Direction::Column], layouts[Direction::General],
-                    blocks.count());
-    }
 }
 
 const int kPhaseSizes[] = {7, 35, 49, 125};
 
 void test_phase_is_the_complex_arithmetic(void **) {
     Random random{7};
-    for (int N : kPhaseSizes) {
-        const LineBlocks blocks(N);
-        // A line spectrum of angles up to about 1 radian (factor B_l).
-        std::vector<double> spectrum(2 * static_cast<std::size_t>(N));
-        for (double &b : spectrum) b = random.next();
-        const double factor = 0.9;
-        std::vector<double> tables(phase_table_doubles(N));
-        for (int l = 0; l < N; ++l) write_phase(N, l, factor, spectrum.data(), tables.data());
-        // v_j = exp(i phi_j) - 1 as write_phase forms it, and u_j = exp(i phi_j).
-        std::vector<std::complex<double>> v(N), u(N);
-        for (int j = 0; j < N; ++j) {
-            const double phi = factor * spectrum[2 * j], half = std::sin(0.5 * phi);
-            v[j] = {-2.0 * half * half, std::sin(phi)};
-            u[j] = std::polar(1.0, phi);
-        }
-        double worst = 0.0;
-        for (double sign : {-1.0, 1.0})
-            for (int b = 0; b < blocks.count(); ++b) {
-                const int d0 = blocks.first_line(b), count = blocks.lines(b);
-                std::vector<double> x(2 * static_cast<std::size_t>(N) * count);
-                for (double &z : x) z = random.next();
-                std::vector<double> expected(x.size());
-                for (int l = 0; l < N; ++l)
-                    for (int i = 0; i < count; ++i) {
-                        const int d = d0 + i;
-                        const std::size_t e = 2 * (static_cast<std::size_t>(l) * count + i);
-                        const std::complex<double> p = v[(l + d) % N], q = v[((l - d) % N + N) % N];
-                        const double n = N, pr = p.real() / n, pi = p.imag() / n, Qr = q.real() / n,
-                                     Qi = q.imag() / n, qr = q.real(), qi = q.imag();
-                        const double er = (pr + Qr) + (pr * qr + pi * qi);
-                        const double ei = sign * ((pi - Qi) + (pi * qr - pr * qi));
-                        const double zr = x[e], zi = x[e + 1];
-                        expected[e] = er * zr - ei * zi;
-                        expected[e + 1] = er * zi + ei * zr;
-                        // exp(t Lambda_l) = u_{l+d} conj(u_{l-d}), conjugated for sign = -1.
-                        std::complex<double> exact = u[(l + d) % N] * std::conj(u[((l - d) % N + N) % N]);
-                        if (sign < 0) exact = std::conj(exact);
-                        const std::complex<double> reference = (exact - 1.0) / n * std::complex<double>(zr, zi);
-                        worst = std::max(worst, std::abs(reference - std::complex<double>(expected[e], expected[e + 1])));
-                    }
-                apply_phase(N, d0, count, tables.data(), sign, x.data());
-                assert_memory_equal(x.data(), expected.data(), sizeof(double) * x.size());
+    for (const Kernels &kernels : kKernels)
+        for (int N : kPhaseSizes) {
+            const LineBlocks blocks(N);
+            // A line spectrum of angles up to about 1 radian (factor B_l).
+            std::vector<double> spectrum(2 * static_cast<std::size_t>(N));
+            for (double &b : spectrum) b = random.next();
+            const double factor = 0.9;
+            std::vector<double> tables(phase_table_doubles(N));
+            for (int l = 0; l < N; ++l) write_phase(N, l, factor, spectrum.data(), tables.data());
+            // v_j = exp(i phi_j) - 1 as write_phase forms it, and u_j = exp(i phi_j).
+            std::vector<std::complex<double>> v(N), u(N);
+            for (int j = 0; j < N; ++j) {
+                const double phi = factor * spectrum[2 * j], half = std::sin(0.5 * phi);
+                v[j] = {-2.0 * half * half, std::sin(phi)};
+                u[j] = std::polar(1.0, phi);
             }
-        std::printf("N = %3d: phase to the bit; against exp(i phi) - 1: %.1e\n", N, worst);
-        assert_true(worst < 1e-15);
-    }
+            double worst = 0.0;
+            for (double sign : {-1.0, 1.0})
+                for (int b = 0; b < blocks.count(); ++b) {
+                    const int d0 = blocks.first_line(b), count = blocks.lines(b);
+                    std::vector<double> x(2 * static_cast<std::size_t>(N) * count);
+                    for (double &z : x) z = random.next();
+                    std::vector<double> expected(x.size());
+                    for (int l = 0; l < N; ++l)
+                        for (int i = 0; i < count; ++i) {
+                            const int d = d0 + i;
+                            const std::size_t e = 2 * (static_cast<std::size_t>(l) * count + i);
+                            const std::complex<double> p = v[(l + d) % N], q = v[((l - d) % N + N) % N];
+                            const double n = N, pr = p.real() / n, pi = p.imag() / n, Qr = q.real() / n,
+                                         Qi = q.imag() / n, qr = q.real(), qi = q.imag();
+                            const double er = (pr + Qr) + (pr * qr + pi * qi);
+                            const double ei = sign * ((pi - Qi) + (pi * qr - pr * qi));
+                            const double zr = x[e], zi = x[e + 1];
+                            expected[e] = er * zr - ei * zi;
+                            expected[e + 1] = er * zi + ei * zr;
+                            // exp(t Lambda_l) = u_{l+d} conj(u_{l-d}), conjugated for sign = -1.
+                            std::complex<double> exact = u[(l + d) % N] * std::conj(u[((l - d) % N + N) % N]);
+                            if (sign < 0) exact = std::conj(exact);
+                            const std::complex<double> reference =
+                                (exact - 1.0) / n * std::complex<double>(zr, zi);
+                            const std::complex<double> computed(expected[e], expected[e + 1]);
+                            worst = std::max(worst, std::abs(reference - computed));
+                        }
+                    kernels.phase(N, d0, count, tables.data(), sign, x.data());
+                    assert_memory_equal(x.data(), expected.data(), sizeof(double) * x.size());
+                }
+            std::printf("%-8s N = %3d: phase to the bit; against exp(i phi) - 1: %.1e\n", kernels.name, N, worst);
+            assert_true(worst < 1e-15);
+        }
 }
 
 }  // namespace

@@ -11,12 +11,15 @@
 // bench_sine_euler exceeds 1 by), the serial part's share of the flow, and
 // the gather and scatter of each layout's directions by themselves, per mode
 // those directions move (Column blocks read one mode from each of 16 rows a
-// lane, General blocks one mode at a time: composite N pay for them).
+// lane, General blocks one mode at a time: composite N pay for them). The
+// table is printed for the kernels this CPU runs, then (where those are AVX2)
+// for the baseline ones that CPUs without AVX2, and all but x86-64, run.
 // Prints figures; asserts nothing.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <vector>
 
 #include "models/sine_euler/hamiltonian.hpp"
@@ -53,7 +56,16 @@ std::vector<double> field(int N) {
     return w;
 }
 
-void measure(int N) {
+// The kernels timed: those this CPU runs, or the baseline ones (which every
+// CPU without AVX2 runs, and every CPU but x86-64).
+struct Kernels {
+    const char *name;
+    decltype(&gather_block) gather;
+    decltype(&scatter_block) scatter;
+    decltype(&apply_phase) phase;
+};
+
+void measure(int N, const Kernels &kernels) {
     const std::vector<Direction> directions = projective_line(N);
     const LineBlocks blocks(N);
     LineTransforms T(N, blocks.M, lpi::FftPlanning::Measure);
@@ -78,17 +90,17 @@ void measure(int N) {
                 const int d0 = blocks.first_line(block), count = blocks.lines(block);
                 double *x = T.block(0);
                 clock = Clock::now();
-                gather_block(D, N, d0, count, blocks.first_lane(block), w.data(), x);
+                kernels.gather(D, N, d0, count, blocks.first_lane(block), w.data(), x);
                 const double gather = seconds_since(clock);
                 sum[Gather] += gather;
                 moves[D.layout] += gather;
                 T.forward(count, x);
                 sum[Transforms] += seconds_since(clock);
-                apply_phase(N, d0, count, T.phase(), -D.sigma, x);
+                kernels.phase(N, d0, count, T.phase(), -D.sigma, x);
                 sum[Phase] += seconds_since(clock);
                 T.backward(count, x);
                 sum[Transforms] += seconds_since(clock);
-                scatter_block(D, N, d0, count, blocks.first_lane(block), x, w.data());
+                kernels.scatter(D, N, d0, count, blocks.first_lane(block), x, w.data());
                 const double scatter = seconds_since(clock);
                 sum[Scatter] += scatter;
                 moves[D.layout] += scatter;
@@ -113,10 +125,9 @@ void measure(int N) {
     std::fflush(stdout);
 }
 
-}  // namespace
-
-int main() {
-    std::printf("sine-Euler, one thread: a flow's parts in ns per mode moved, summed over every direction\n");
+void table(const Kernels &kernels) {
+    std::printf("sine-Euler, one thread: a flow's parts in ns per mode moved, summed over every direction"
+                " (%s kernels)\n", kernels.name);
     std::printf("%5s %5s %5s %5s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s %20s\n", "N", "rows", "cols", "other",
                 "FFTs", "spectrum", "sines", "gather", "phase", "scatter", "rest", "rest/", "moves/", "serial",
                 "moves by layout");
@@ -124,6 +135,17 @@ int main() {
                 "", "", "", "", "FFTs", "FFTs", "", "row", "column", "other");
     const std::vector<int> Ns = bench_quick() ? std::vector<int>{15, 27, 61}  // General, Column, Row
                                               : std::vector<int>{61, 125, 127, 243, 251, 375, 509, 625};
-    for (int N : Ns) measure(N);
+    for (int N : Ns) measure(N, kernels);
+}
+
+}  // namespace
+
+int main() {
+    const Kernels here = {kernel_instruction_set(), gather_block, scatter_block, apply_phase};
+    table(here);
+    if (std::strcmp(here.name, "baseline") != 0) {
+        std::printf("\n");
+        table({"baseline", baseline::gather_block, baseline::scatter_block, baseline::apply_phase});
+    }
     return 0;
 }

@@ -13,16 +13,22 @@ namespace sine_euler {
 
 namespace {
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__) && \
-    !defined(LPI_NO_SIMD_CLONES)
-#define LPI_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
+// The AVX2 variants are compiled with the target attribute and chosen at run
+// time (x86-64 with GCC or Clang; elsewhere the baseline alone).
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define LPI_AVX2_KERNELS 1
 #else
-#define LPI_SIMD_CLONES
+#define LPI_AVX2_KERNELS 0
 #endif
+// Every helper is inlined into the function of its instruction set: one not
+// inlined would be compiled for the baseline alone.
+#define LPI_KERNEL inline __attribute__((always_inline))
 
-// One or two complex numbers, interleaved (GCC's and Clang's vector
-// extensions: one instruction per operation where the target has it, pairs
-// of them where not). Every function taking them is inlined, so the warning
+// One complex number (Complex1) or two (Complex2), interleaved (GCC's and
+// Clang's vector extensions). Complex2 is used in the AVX2 variants only: GCC
+// builds a 256-bit vector's shuffles element by element where the target has
+// no such vectors (the baseline's phase took 9 ns a mode at N = 125 with it,
+// 1 with Complex1). Every function taking them is inlined, so the warning
 // that their passing differs with and without AVX does not apply; they are
 // passed by reference all the same, as GCC notes values regardless.
 #if defined(__GNUC__)
@@ -33,33 +39,43 @@ typedef double Complex2 __attribute__((vector_size(32)));
 #if defined(__clang__)
 #define LPI_SHUFFLE(v, ...) __builtin_shufflevector(v, v, __VA_ARGS__)
 #define LPI_SHUFFLE2(a, b, ...) __builtin_shufflevector(a, b, __VA_ARGS__)
+#define LPI_SHUFFLE1(a, b, ...) __builtin_shufflevector(a, b, __VA_ARGS__)
 #else
+typedef std::int64_t Mask1 __attribute__((vector_size(16)));
 typedef std::int64_t Mask2 __attribute__((vector_size(32)));
 #define LPI_SHUFFLE(v, ...) __builtin_shuffle(v, Mask2{__VA_ARGS__})
 #define LPI_SHUFFLE2(a, b, ...) __builtin_shuffle(a, b, Mask2{__VA_ARGS__})
+#define LPI_SHUFFLE1(a, b, ...) __builtin_shuffle(a, b, Mask1{__VA_ARGS__})
 #endif
 
-inline Complex2 reversed(const Complex2 &v) { return LPI_SHUFFLE(v, 2, 3, 0, 1); }
+LPI_KERNEL Complex2 reversed(const Complex2 &v) { return LPI_SHUFFLE(v, 2, 3, 0, 1); }
+// (a0, b0) and (a1, b1): the real and the imaginary parts of a and b, and back.
+LPI_KERNEL Complex1 even_parts(const Complex1 &a, const Complex1 &b) { return LPI_SHUFFLE1(a, b, 0, 2); }
+LPI_KERNEL Complex1 odd_parts(const Complex1 &a, const Complex1 &b) { return LPI_SHUFFLE1(a, b, 1, 3); }
+#if LPI_AVX2_KERNELS
 // (a0, b0, a2, b2) and (a1, b1, a3, b3): with a = (z0, z2) and b = (z1, z3)
 // the real and the imaginary parts of z0 .. z3, and back.
-inline Complex2 even_parts(const Complex2 &a, const Complex2 &b) { return LPI_SHUFFLE2(a, b, 0, 4, 2, 6); }
-inline Complex2 odd_parts(const Complex2 &a, const Complex2 &b) { return LPI_SHUFFLE2(a, b, 1, 5, 3, 7); }
+LPI_KERNEL Complex2 even_parts(const Complex2 &a, const Complex2 &b) { return LPI_SHUFFLE2(a, b, 0, 4, 2, 6); }
+LPI_KERNEL Complex2 odd_parts(const Complex2 &a, const Complex2 &b) { return LPI_SHUFFLE2(a, b, 1, 5, 3, 7); }
+#endif
+#undef LPI_SHUFFLE1
 #undef LPI_SHUFFLE2
 #undef LPI_SHUFFLE
 
 template <class V>
-inline V load(const double *p) {
+LPI_KERNEL V load(const double *p) {
     V v;
     std::memcpy(&v, p, sizeof v);
     return v;
 }
 template <class V>
-inline void store(double *p, const V &v) {
+LPI_KERNEL void store(double *p, const V &v) {
     std::memcpy(p, &v, sizeof v);
 }
+#if LPI_AVX2_KERNELS
 // Two complex numbers from (to) two places. GCC before 12 has no
 // __builtin_shufflevector; built element by element the pair is the same.
-inline Complex2 load_pair(const double *low, const double *high) {
+LPI_KERNEL Complex2 load_pair(const double *low, const double *high) {
     const Complex1 a = load<Complex1>(low), b = load<Complex1>(high);
 #if defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 12)
     return __builtin_shufflevector(a, b, 0, 1, 2, 3);
@@ -67,10 +83,11 @@ inline Complex2 load_pair(const double *low, const double *high) {
     return Complex2{a[0], a[1], b[0], b[1]};
 #endif
 }
-inline void store_pair(double *low, double *high, const Complex2 &v) {
+LPI_KERNEL void store_pair(double *low, double *high, const Complex2 &v) {
     std::memcpy(low, &v, sizeof(Complex1));
     std::memcpy(high, reinterpret_cast<const char *>(&v) + sizeof(Complex1), sizeof(Complex1));
 }
+#endif
 
 // ---- Row and Column directions: runs along lanes --------------------------
 // A Row or Column direction's lines cross each lane (row s, or column s) in a
@@ -80,7 +97,7 @@ inline void store_pair(double *low, double *high, const Complex2 &v) {
 // 1; columns: lane s starts at s and positions step by N.
 // Calls f(s, o) for the N lanes, from first_lane on, cyclically.
 template <class F>
-inline void for_each_lane(int N, int slope, int d0, int first_lane, F &&f) {
+LPI_KERNEL void for_each_lane(int N, int slope, int d0, int first_lane, F &&f) {
     int o = modulo(d0 + static_cast<std::int64_t>(first_lane) * slope, N);
     for (int k = 0, s = first_lane; k < N; ++k, s = s + 1 < N ? s + 1 : 0) {
         f(s, o);
@@ -91,8 +108,8 @@ inline void for_each_lane(int N, int slope, int d0, int first_lane, F &&f) {
 
 // Count > 0: the block size, known at compile time (full blocks); 0: count.
 template <bool Rows, int Count>
-inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
-                        const double *__restrict w, double *__restrict x) {
+LPI_KERNEL void gather_runs(int N, int slope, int d0, int count, int first_lane,
+                            const double *__restrict w, double *__restrict x) {
     const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
     const int n = Count > 0 ? Count : count;
     for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
@@ -115,9 +132,9 @@ inline void gather_runs(int N, int slope, int d0, int count, int first_lane,
 // mirror lane, in one pass (the sums are not stored twice). In a row the
 // mirrors of positions p, p + 1 are the pair N - p - 1, N - p: two sums are
 // stored at once, reversed and conjugated (exact) for the mirror.
-template <bool Rows>
-inline void put_run(int N, int p0, int n, const double *__restrict increment, double *lane,
-                    double *mirror) {
+template <bool Rows, bool Wide>
+LPI_KERNEL void put_run(int N, int p0, int n, const double *__restrict increment, double *lane,
+                        double *mirror) {
     if (n <= 0) return;
     const std::size_t step = Rows ? 1 : N;
     int r = 0;
@@ -127,7 +144,7 @@ inline void put_run(int N, int p0, int n, const double *__restrict increment, do
         store(mirror, sum * Complex1{1.0, -1.0});
         r = 1;
     }
-    if (Rows) {
+    if (Rows && Wide) {
         for (; r + 2 <= n; r += 2) {
             double *z = lane + 2 * (p0 + r), *m = mirror + 2 * (N - p0 - r - 1);
             const Complex2 sum = load<Complex2>(z) + load<Complex2>(increment + 2 * r);
@@ -143,20 +160,20 @@ inline void put_run(int N, int p0, int n, const double *__restrict increment, do
     }
 }
 
-template <bool Rows, int Count>
-inline void scatter_runs(int N, int slope, int d0, int count, int first_lane,
-                         const double *__restrict x, double *w) {
+template <bool Rows, int Count, bool Wide>
+LPI_KERNEL void scatter_runs(int N, int slope, int d0, int count, int first_lane,
+                             const double *__restrict x, double *w) {
     const std::size_t lane = Rows ? N : 1;
     const int n = Count > 0 ? Count : count;
     for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
         const double *src = x + 2 * static_cast<std::size_t>(s) * n;
         double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
         if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
-            put_run<Rows>(N, o, n, src, dst, mirror);
+            put_run<Rows, Wide>(N, o, n, src, dst, mirror);
         } else {
             const int first = std::min(n, N - o);
-            put_run<Rows>(N, o, first, src, dst, mirror);
-            put_run<Rows>(N, 0, n - first, src + 2 * first, dst, mirror);
+            put_run<Rows, Wide>(N, o, first, src, dst, mirror);
+            put_run<Rows, Wide>(N, 0, n - first, src + 2 * first, dst, mirror);
         }
     });
 }
@@ -169,7 +186,7 @@ inline void scatter_runs(int N, int slope, int d0, int count, int first_lane,
 // the mirror's, -(a, b), is N^2 + N - mode, less N^2 where a = 0 and N where
 // b = 0.
 template <class F>
-inline void for_each_block_mode(const Direction &D, int N, int d0, int count, F &&f) {
+LPI_KERNEL void for_each_block_mode(const Direction &D, int N, int d0, int count, F &&f) {
     const std::size_t n = N, square = n * n, stride = D.j1 * n + D.j2;
     int a0 = modulo(static_cast<std::int64_t>(d0) * D.j1, N), b0 = modulo(static_cast<std::int64_t>(d0) * D.j2, N);
     for (int s = 0; s < N; ++s) {
@@ -192,13 +209,13 @@ inline void for_each_block_mode(const Direction &D, int N, int d0, int count, F 
     }
 }
 
-inline void gather_general(const Direction &D, int N, int d0, int count, const double *w, double *x) {
+LPI_KERNEL void gather_general(const Direction &D, int N, int d0, int count, const double *w, double *x) {
     for_each_block_mode(D, N, d0, count, [&](std::size_t e, std::size_t mode, std::size_t) {
         store(x + 2 * e, load<Complex1>(w + 2 * mode));
     });
 }
 
-inline void scatter_general(const Direction &D, int N, int d0, int count, const double *x, double *w) {
+LPI_KERNEL void scatter_general(const Direction &D, int N, int d0, int count, const double *x, double *w) {
     for_each_block_mode(D, N, d0, count, [&](std::size_t e, std::size_t mode, std::size_t mirror) {
         const Complex1 sum = load<Complex1>(w + 2 * mode) + load<Complex1>(x + 2 * e);
         store(w + 2 * mode, sum);
@@ -206,13 +223,11 @@ inline void scatter_general(const Direction &D, int N, int d0, int count, const 
     });
 }
 
-}  // namespace
-
-// These move numbers, negate and add one increment per mode: every clone
-// gives the same bits.
-LPI_SIMD_CLONES
-void gather_block(const Direction &D, int N, int d0, int count, int first_lane, const double *w,
-                  double *x) {
+// A block's moves: numbers copied, negated and added one increment per mode,
+// so every instruction set gives the same bits. Wide: two sums at once in
+// the runs along rows (AVX2).
+LPI_KERNEL void gather_lines(const Direction &D, int N, int d0, int count, int first_lane, const double *w,
+                             double *x) {
     switch (D.layout) {
         case Direction::Row:
             if (count == kBlock) gather_runs<true, kBlock>(N, D.k2, d0, count, first_lane, w, x);
@@ -226,17 +241,17 @@ void gather_block(const Direction &D, int N, int d0, int count, int first_lane, 
     }
 }
 
-LPI_SIMD_CLONES
-void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
-                   double *w) {
+template <bool Wide>
+LPI_KERNEL void scatter_lines(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
+                              double *w) {
     switch (D.layout) {
         case Direction::Row:
-            if (count == kBlock) scatter_runs<true, kBlock>(N, D.k2, d0, count, first_lane, x, w);
-            else scatter_runs<true, 0>(N, D.k2, d0, count, first_lane, x, w);
+            if (count == kBlock) scatter_runs<true, kBlock, Wide>(N, D.k2, d0, count, first_lane, x, w);
+            else scatter_runs<true, 0, Wide>(N, D.k2, d0, count, first_lane, x, w);
             break;
         case Direction::Column:
-            if (count == kBlock) scatter_runs<false, kBlock>(N, D.k1, d0, count, first_lane, x, w);
-            else scatter_runs<false, 0>(N, D.k1, d0, count, first_lane, x, w);
+            if (count == kBlock) scatter_runs<false, kBlock, Wide>(N, D.k1, d0, count, first_lane, x, w);
+            else scatter_runs<false, 0, Wide>(N, D.k1, d0, count, first_lane, x, w);
             break;
         case Direction::General: scatter_general(D, N, d0, count, x, w); break;
     }
@@ -253,15 +268,15 @@ void scatter_block(const Direction &D, int N, int d0, int count, int first_lane,
 // N fl(1/N) != 1). Every sum and product is the one the complex arithmetic
 // written out would form, in the same order. P_{l+d} is entry d + l of its
 // arrays, (Q, q)_{l-d} entry N + d - l of theirs: both run forwards along a
-// row of x, four lines at a time, with the parts of x split into vectors of
+// row of x, four lines at a time (two in the baseline), with the parts of x split into vectors of
 // their own on the way in and joined on the way out.
-namespace {
 
 // Parts of (e - 1) / N for the lines at table entries up and down onward,
-// and their product with z = (zr, zi): n = 1 line (double) or 4 (Complex2).
+// and their product with z = (zr, zi): 1 line (double), 2 (Complex1) or 4
+// (Complex2).
 template <class V>
-inline void phase_product(const double *const arrays[kPhaseArrays], std::size_t up, std::size_t down,
-                          double sign, V &zr, V &zi) {
+LPI_KERNEL void phase_product(const double *const arrays[kPhaseArrays], std::size_t up, std::size_t down,
+                              double sign, V &zr, V &zi) {
     const V Pr = load<V>(arrays[0] + up), Pi = load<V>(arrays[1] + up);
     const V Qr = load<V>(arrays[2] + down), Qi = load<V>(arrays[3] + down);
     const V qr = load<V>(arrays[4] + down), qi = load<V>(arrays[5] + down);
@@ -272,24 +287,45 @@ inline void phase_product(const double *const arrays[kPhaseArrays], std::size_t 
     zi = imaginary;
 }
 
+// Lines i .. i + lanes - 1 of a row of x as vectors of their real and of
+// their imaginary parts (lanes = 4, in the AVX2 variant, or 2), and back.
+#if LPI_AVX2_KERNELS
+LPI_KERNEL void split(const double *z, Complex2 &re, Complex2 &im) {
+    const Complex2 z02 = load_pair(z, z + 4), z13 = load_pair(z + 2, z + 6);
+    re = even_parts(z02, z13), im = odd_parts(z02, z13);
+}
+LPI_KERNEL void join(double *z, const Complex2 &re, const Complex2 &im) {
+    store_pair(z, z + 4, even_parts(re, im));
+    store_pair(z + 2, z + 6, odd_parts(re, im));
+}
+#endif
+LPI_KERNEL void split(const double *z, Complex1 &re, Complex1 &im) {
+    const Complex1 z0 = load<Complex1>(z), z1 = load<Complex1>(z + 2);
+    re = even_parts(z0, z1), im = odd_parts(z0, z1);
+}
+LPI_KERNEL void join(double *z, const Complex1 &re, const Complex1 &im) {
+    store(z, even_parts(re, im));
+    store(z + 2, odd_parts(re, im));
+}
+
 // Count > 0: the block size, known at compile time (full blocks); 0: count.
-template <int Count>
-inline void phase_rows(int N, int d0, int count, const double *const arrays[kPhaseArrays], double sign,
-                       double *x) {
-    const std::size_t n = Count > 0 ? Count : count, fours = n / 4 * 4;
+// V: Complex2 (four lines at a time) or Complex1 (two).
+template <int Count, class V>
+LPI_KERNEL void phase_rows(int N, int d0, int count, const double *const arrays[kPhaseArrays], double sign,
+                           double *x) {
+    constexpr std::size_t lanes = sizeof(V) / sizeof(double);
+    const std::size_t n = Count > 0 ? Count : count, vectors = n / lanes * lanes;
     for (std::size_t l = 0; l < static_cast<std::size_t>(N); ++l) {
         double *z = x + 2 * l * n;
         const std::size_t up = d0 + l, down = N + d0 - l;
-        for (std::size_t i = 0; i < fours; i += 4) {
-            double *z4 = z + 2 * i;
-            const Complex2 z02 = load_pair(z4, z4 + 4), z13 = load_pair(z4 + 2, z4 + 6);
-            Complex2 zr = even_parts(z02, z13), zi = odd_parts(z02, z13);
+        for (std::size_t i = 0; i < vectors; i += lanes) {
+            V zr, zi;
+            split(z + 2 * i, zr, zi);
             phase_product(arrays, up + i, down + i, sign, zr, zi);
-            store_pair(z4, z4 + 4, even_parts(zr, zi));
-            store_pair(z4 + 2, z4 + 6, odd_parts(zr, zi));
+            join(z + 2 * i, zr, zi);
         }
-        if (Count > 0 && Count % 4 == 0) continue;
-        for (std::size_t i = fours; i < n; ++i) {
+        if (Count > 0 && Count % lanes == 0) continue;
+        for (std::size_t i = vectors; i < n; ++i) {
             double zr = z[2 * i], zi = z[2 * i + 1];
             phase_product(arrays, up + i, down + i, sign, zr, zi);
             z[2 * i] = zr;
@@ -298,15 +334,76 @@ inline void phase_rows(int N, int d0, int count, const double *const arrays[kPha
     }
 }
 
-}  // namespace
-
-LPI_SIMD_CLONES
-void apply_phase(int N, int d0, int count, const double *tables, double sign, double *x) {
+template <class V>
+LPI_KERNEL void phase_lines(int N, int d0, int count, const double *tables, double sign, double *x) {
     const std::size_t array = 2 * static_cast<std::size_t>(N);
     const double *const arrays[kPhaseArrays] = {tables,             tables + array,     tables + 2 * array,
                                                 tables + 3 * array, tables + 4 * array, tables + 5 * array};
-    if (count == kBlock) phase_rows<kBlock>(N, d0, count, arrays, sign, x);
-    else phase_rows<0>(N, d0, count, arrays, sign, x);
+    if (count == kBlock) phase_rows<kBlock, V>(N, d0, count, arrays, sign, x);
+    else phase_rows<0, V>(N, d0, count, arrays, sign, x);
+}
+
+#if LPI_AVX2_KERNELS
+// The same templates compiled for AVX2 (without FMA: the same operations).
+__attribute__((target("avx2"))) void gather_avx2(const Direction &D, int N, int d0, int count, int first_lane,
+                                                 const double *w, double *x) {
+    gather_lines(D, N, d0, count, first_lane, w, x);
+}
+__attribute__((target("avx2"))) void scatter_avx2(const Direction &D, int N, int d0, int count, int first_lane,
+                                                  const double *x, double *w) {
+    scatter_lines<true>(D, N, d0, count, first_lane, x, w);
+}
+__attribute__((target("avx2"))) void phase_avx2(int N, int d0, int count, const double *tables, double sign,
+                                                double *x) {
+    phase_lines<Complex2>(N, d0, count, tables, sign, x);
+}
+
+bool cpu_has_avx2() {
+    static const bool avx2 = __builtin_cpu_supports("avx2");
+    return avx2;
+}
+#endif
+
+}  // namespace
+
+namespace baseline {
+void gather_block(const Direction &D, int N, int d0, int count, int first_lane, const double *w, double *x) {
+    gather_lines(D, N, d0, count, first_lane, w, x);
+}
+void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x, double *w) {
+    scatter_lines<false>(D, N, d0, count, first_lane, x, w);
+}
+void apply_phase(int N, int d0, int count, const double *tables, double sign, double *x) {
+    phase_lines<Complex1>(N, d0, count, tables, sign, x);
+}
+}  // namespace baseline
+
+const char *kernel_instruction_set() {
+#if LPI_AVX2_KERNELS
+    if (cpu_has_avx2()) return "avx2";
+#endif
+    return "baseline";
+}
+
+void gather_block(const Direction &D, int N, int d0, int count, int first_lane, const double *w, double *x) {
+#if LPI_AVX2_KERNELS
+    if (cpu_has_avx2()) return gather_avx2(D, N, d0, count, first_lane, w, x);
+#endif
+    baseline::gather_block(D, N, d0, count, first_lane, w, x);
+}
+
+void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x, double *w) {
+#if LPI_AVX2_KERNELS
+    if (cpu_has_avx2()) return scatter_avx2(D, N, d0, count, first_lane, x, w);
+#endif
+    baseline::scatter_block(D, N, d0, count, first_lane, x, w);
+}
+
+void apply_phase(int N, int d0, int count, const double *tables, double sign, double *x) {
+#if LPI_AVX2_KERNELS
+    if (cpu_has_avx2()) return phase_avx2(N, d0, count, tables, sign, x);
+#endif
+    baseline::apply_phase(N, d0, count, tables, sign, x);
 }
 
 }  // namespace sine_euler

@@ -1,9 +1,9 @@
 // The hot loops of a line flow: moving a block of lines between the mode
 // array and a transform buffer, and multiplying the transformed lines by
-// their flows' increments. On x86-64 with GCC each is compiled for AVX2 and
-// for the baseline, and the loader picks one for the CPU (FFTW does the same
-// for its own codelets). AVX2 without FMA: the same IEEE operations, the same
-// bits.
+// their flows' increments. On x86-64 (GCC or Clang) each is compiled for
+// AVX2 and for the baseline, and the first call picks one for the CPU (FFTW
+// does the same for its own codelets). AVX2 without FMA: the same IEEE
+// operations, the same bits.
 #pragma once
 
 #include <cmath>
@@ -32,6 +32,17 @@ inline std::size_t phase_table_doubles(int N) { return 2 * static_cast<std::size
 // d0+count-1) by the line flows' increments (exp(t Lambda_l) - 1) / N read
 // from the phase tables (see the definition).
 void apply_phase(int N, int d0, int count, const double *tables, double sign, double *x);
+
+// "avx2" or "baseline": the kernels that gather_block, scatter_block and
+// apply_phase run on this CPU.
+const char *kernel_instruction_set();
+
+// The baseline kernels whatever the CPU has, for the tests to compare.
+namespace baseline {
+void gather_block(const Direction &D, int N, int d0, int count, int first_lane, const double *w, double *x);
+void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x, double *w);
+void apply_phase(int N, int d0, int count, const double *tables, double sign, double *x);
+}  // namespace baseline
 
 // v_l = u_l - 1 = exp(i phi_l) - 1 = (-2 sin^2(phi_l / 2), sin phi_l), phi_l =
 // factor B_l (B: the transformed line spectrum, factor = t / (2 eps)), as
