@@ -268,8 +268,8 @@ LPI_KERNEL void scatter_lines(const Direction &D, int N, int d0, int count, int 
 // N fl(1/N) != 1). Every sum and product is the one the complex arithmetic
 // written out would form, in the same order. P_{l+d} is entry d + l of its
 // arrays, (Q, q)_{l-d} entry N + d - l of theirs: both run forwards along a
-// row of x, four lines at a time (two in the baseline), with the parts of x split into vectors of
-// their own on the way in and joined on the way out.
+// row of x, four lines at a time (two in the baseline), with the parts of x
+// split into vectors of their own on the way in and joined on the way out.
 
 // Parts of (e - 1) / N for the lines at table entries up and down onward,
 // and their product with z = (zr, zi): 1 line (double), 2 (Complex1) or 4
