@@ -112,8 +112,20 @@ F90
 
 needed() { readelf -d "$1" | grep -c "NEEDED.*libliepoisson" || true; }
 
-# pkg-config: the staged tree is found through the sysroot.
-export PKG_CONFIG_PATH="$root/$libdir/pkgconfig" PKG_CONFIG_SYSROOT_DIR="$stage"
+# pkg-config: the staged tree is a moved prefix, and its .pc files are moved
+# with it by their first line alone (prefix=), so every path of ours must
+# follow from ${prefix}. A sysroot would not do: it moves every -L, also those
+# into the system a build names outside the prefix (Clang's libomp).
+pc_moved_to() {  # pc_moved_to ROOT: a directory of the .pc files under ROOT, with prefix=ROOT
+    mkdir -p "$work/pc$1"
+    for pc in "$1/$libdir"/pkgconfig/*.pc; do
+        [ "$(sed -n 1p "$pc")" = "prefix=$prefix" ] || fail "$(basename "$pc") does not begin with prefix=$prefix" >&2
+        sed "1s|.*|prefix=$1|" "$pc" >"$work/pc$1/$(basename "$pc")"
+    done
+    echo "$work/pc$1"
+}
+PKG_CONFIG_PATH=$(pc_moved_to "$root")
+export PKG_CONFIG_PATH
 # shellcheck disable=SC2046
 "$cc" -o "$work/prog_pc" "$work/prog.c" $(pkg-config --cflags --libs liepoisson) \
     -Wl,-rpath,"$root/$libdir" || fail "pkg-config shared build failed"
@@ -132,7 +144,7 @@ export PKG_CONFIG_PATH="$root/$libdir/pkgconfig" PKG_CONFIG_SYSROOT_DIR="$stage"
 # check above proves nothing about Libs.private and Requires.private.
 cp -R "$stage" "$work/stage-static"
 rm -f "$work/stage-static$prefix/$libdir"/libliepoisson.so*
-export PKG_CONFIG_PATH="$work/stage-static$prefix/$libdir/pkgconfig" PKG_CONFIG_SYSROOT_DIR="$work/stage-static"
+PKG_CONFIG_PATH=$(pc_moved_to "$work/stage-static$prefix")
 # shellcheck disable=SC2046
 "$cc" -o "$work/prog_static" "$work/prog.c" $(pkg-config --static --cflags --libs liepoisson) >"$work/static.log" 2>&1 ||
     { cat "$work/static.log"; fail "pkg-config static build failed: pkg-config gave: $(pkg-config --static --libs liepoisson)"; }
@@ -142,7 +154,7 @@ export PKG_CONFIG_PATH="$work/stage-static$prefix/$libdir/pkgconfig" PKG_CONFIG_
 if "$cc" -o "$work/prog_no_private" "$work/prog.c" $(pkg-config --cflags --libs liepoisson) >/dev/null 2>&1; then
     fail "the archive links without its private dependencies: the static check is void"
 fi
-unset PKG_CONFIG_PATH PKG_CONFIG_SYSROOT_DIR
+unset PKG_CONFIG_PATH
 
 # CMake: the installed static target's link needs are plain flags, with no -L
 # into a directory the compiler searches anyway.
@@ -190,11 +202,12 @@ if [ $with_fortran = ON ]; then "$work/cmake/build/prog_f" || fail "CMake Fortra
 # RUNPATH reaches libliepoisson_fortran only; libliepoisson is found through
 # the Fortran library's own.
 if [ "$have_fortran" = 1 ] && [ -n "$fc" ]; then
-    export PKG_CONFIG_PATH="$root/$libdir/pkgconfig" PKG_CONFIG_SYSROOT_DIR="$stage"
+    PKG_CONFIG_PATH=$(pc_moved_to "$root")
+    export PKG_CONFIG_PATH
     # shellcheck disable=SC2046
     "$fc" -o "$work/prog_f" "$work/prog.f90" $(pkg-config --cflags --libs liepoisson-fortran) \
         -Wl,-rpath,"$root/$libdir" || fail "Fortran build through liepoisson-fortran.pc failed"
-    unset PKG_CONFIG_PATH PKG_CONFIG_SYSROOT_DIR
+    unset PKG_CONFIG_PATH
     [ "$(resolved "$work/prog_f")" = "$staged_lib" ] ||
         fail "the Fortran program loads libliepoisson from '$(resolved "$work/prog_f")'"
     "$work/prog_f" || fail "Fortran program failed"

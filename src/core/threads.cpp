@@ -42,6 +42,16 @@ void check_thread_count(int n) {
 namespace {
 
 #if LPI_HAVE_OPENMP
+#if defined(KMP_VERSION_MAJOR)
+// LLVM's (or Intel's) runtime, libomp: its own stack size (KMP_STACKSIZE,
+// OMP_STACKSIZE, else its default), plus 128 bytes for each global thread
+// number below the worker's (KMP_STACKOFFSET, doubled). The probe asks a
+// MiB more, enough for 8192 thread numbers: a thread stack that glibc keeps
+// cached after the probe serves only a request no larger than itself, and a
+// probe that passed on cached stacks the runtime cannot use would not stop
+// libomp from ending the process.
+std::size_t openmp_stack_size() { return kmp_get_stacksize_s() + (std::size_t{1} << 20); }
+#else
 // The stack size libgomp gives its threads: OMP_STACKSIZE, else
 // GOMP_STACKSIZE ("<number>[B|K|M|G]", kilobytes by default), read once as
 // libgomp does when it loads; 0 when neither is set (default attributes).
@@ -71,6 +81,7 @@ std::size_t openmp_stack_size() {
     }();
     return size;
 }
+#endif
 #endif
 
 // Probe threads wait until every one of them exists: an exited thread no
