@@ -159,15 +159,21 @@ namespace {
 // the threads of the last team started on a thread (a team of one starts
 // none) and lets the surplus go when a smaller team starts.
 thread_local int ready = 1;
-// libgomp does not rebuild a thread's pool in a child of fork(2): a team
-// started there on the forking thread waits forever for threads that were
-// not copied. The child handler marks the forking thread's pool lost when it
-// had one; a new thread of the child starts a pool of its own.
+// In a child of fork(2) no thread of the parent's teams exists. libgomp does
+// not rebuild a thread's pool there: a team started on the forking thread
+// waits forever for threads that were not copied, so the child handler marks
+// that thread's pool lost when it had one (a new thread of the child starts a
+// pool of its own). libomp starts afresh in a child, and its teams need new
+// threads, which the probe is to check first.
 thread_local bool pool_lost = false;
-void mark_pool_lost_in_child() {
+void forget_pool_in_child() {
+#if defined(KMP_VERSION_MAJOR)
+    ready = 1;
+#else
     if (ready > 1) pool_lost = true;
+#endif
 }
-[[maybe_unused]] const int fork_handler = pthread_atfork(nullptr, nullptr, mark_pool_lost_in_child);
+[[maybe_unused]] const int fork_handler = pthread_atfork(nullptr, nullptr, forget_pool_in_child);
 
 }  // namespace
 
