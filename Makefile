@@ -6,6 +6,7 @@
 #   make abi-baseline   rewrite abi/ from this build (an intended ABI change)
 #   make check-asan      every test under AddressSanitizer + UBSan (build-asan)
 #   make check-tsan      the threads test under ThreadSanitizer (build-tsan)
+#   make check-clang     the threads test built by Clang with libomp (build-clang)
 #   make check-valgrind  the cmocka tests under valgrind, no leaks allowed
 #   make check-build-alone  with cmocka hidden: -DBUILD_TESTING=OFF builds the
 #                        library, lpi and the bindings (build-alone)
@@ -32,7 +33,7 @@ else
 endif
 
 .PHONY: all build deps configure check run bench bench-quick install clean version abi-baseline \
-        check-asan check-tsan check-valgrind check-build-alone fuzz
+        check-asan check-tsan check-clang check-valgrind check-build-alone fuzz
 
 all: build
 
@@ -94,6 +95,17 @@ check-tsan: deps
 	@cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLPI_TSAN=ON -DLPI_WITH_OPENMP=OFF $(OUTPUT_ARGS) $(CMAKE_ARGS) $(STATUS_OUT)
 	@cmake --build build-tsan -j $(JOBS) $(BUILD_ARGS) --target test_threads
 	@cd build-tsan && TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -R '^test_threads$$'
+
+# Clang with LLVM's OpenMP runtime, libomp, where the library's guards of the
+# runtime (src/core/threads.cpp: the thread probe, fork) differ from libgomp's:
+# the threads test (build-clang). Needs clang and libomp-dev
+# (scripts/install-deps --ci).
+check-clang: deps
+	@cmake -S . -B build-clang -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ $(OUTPUT_ARGS) $(CMAKE_ARGS) $(STATUS_OUT)
+	@grep -q 'LPI_HAVE_OPENMP 1' build-clang/generated/lpi_config.h || \
+	    { echo "check-clang: clang found no OpenMP runtime (apt-get install libomp-dev)"; exit 1; }
+	@cmake --build build-clang -j $(JOBS) $(BUILD_ARGS) --target test_threads
+	@cd build-clang && ctest --output-on-failure -R '^test_threads$$'
 
 # The cmocka tests of $(BUILD) under valgrind, $(JOBS) at a time
 # (tests/check_valgrind.sh). VALGRIND_SKIP leaves out the
