@@ -1,8 +1,11 @@
 // White-box: the hot loops of a sine-Euler line flow against independent
-// computations. gather_block reads element s of line d at d j + s k and
-// scatter_block adds the increments there and writes the conjugates at the
-// mirror modes, touching nothing else, for every direction (Row, Column and
-// General layouts) and block, full and remainder; apply_phase multiplies by
+// computations. The flows keep one half of the modes (rows 1 .. M, row 0 up
+// to column M) and leave the other out of date: gather_block reads element s
+// of line d, at d j + s k, from that half (a mode outside it as its mirror's
+// conjugate), whatever the other half holds; scatter_block adds the
+// increments in that half, touching nothing else; and write_conjugate_half
+// then gives the Hermitian field of the sums, for every direction (Row,
+// Column and General layouts) and block, full and remainder; apply_phase multiplies by
 // the written-out complex arithmetic of (e - 1) / N to the bit (the tables'
 // layout and the two-at-a-time evaluation change no operation), and that is
 // (exp(t Lambda_l) - 1) / N computed from the angles with std::polar. Both
@@ -52,6 +55,21 @@ std::vector<double> hermitian_field(int N, Random &random) {
     return w;
 }
 
+// The half of the modes the flows keep, by index: rows 1 .. M, row 0 up to
+// column M.
+bool kept(std::size_t m, int N) {
+    const std::size_t a = m / N, b = m % N, M = (N - 1) / 2;
+    return (a >= 1 && a <= M) || (a == 0 && b <= M);
+}
+
+// w with the other half overwritten by numbers no flow may read or write.
+std::vector<double> out_of_date(const std::vector<double> &w, int N, Random &random) {
+    std::vector<double> stale = w;
+    for (std::size_t m = 0; m < w.size() / 2; ++m)
+        if (!kept(m, N)) stale[2 * m] = 10.0 + random.next(), stale[2 * m + 1] = 10.0 + random.next();
+    return stale;
+}
+
 // The kernels this CPU runs, and the baseline ones.
 struct Kernels {
     const char *name;
@@ -74,9 +92,9 @@ void test_gather_scatter_follow_the_lines(void **) {
                 ++layouts[D.layout];
                 for (int b = 0; b < blocks.count(); ++b) {
                     const int d0 = blocks.first_line(b), count = blocks.lines(b);
-                    const std::vector<double> w = hermitian_field(N, random);
+                    const std::vector<double> w = hermitian_field(N, random), stale = out_of_date(w, N, random);
                     std::vector<double> x(2 * static_cast<std::size_t>(N) * count);
-                    kernels.gather(D, N, d0, count, blocks.first_lane(b), w.data(), x.data());
+                    kernels.gather(D, N, d0, count, blocks.first_lane(b), stale.data(), x.data());
                     std::vector<double> increment(x.size()), expected = w;
                     std::vector<char> moved(static_cast<std::size_t>(N) * N, 0);
                     for (int s = 0; s < N; ++s)
@@ -96,8 +114,12 @@ void test_gather_scatter_follow_the_lines(void **) {
                             assert_int_equal(moved[m] + moved[mirror], 0);  // each mode once
                             moved[m] = moved[mirror] = 1;
                         }
-                    std::vector<double> scattered = w;
+                    std::vector<double> scattered = stale, expected_kept = expected;
+                    for (std::size_t m = 0; m < w.size() / 2; ++m)
+                        if (!kept(m, N)) expected_kept[2 * m] = stale[2 * m], expected_kept[2 * m + 1] = stale[2 * m + 1];
                     kernels.scatter(D, N, d0, count, blocks.first_lane(b), increment.data(), scattered.data());
+                    assert_memory_equal(scattered.data(), expected_kept.data(), sizeof(double) * w.size());
+                    write_conjugate_half(N, scattered.data());
                     assert_memory_equal(scattered.data(), expected.data(), sizeof(double) * w.size());
                 }
             }

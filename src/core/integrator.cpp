@@ -90,6 +90,7 @@ public:
                 }
             }
             const bool checked = observed || final || step % kFiniteCheckInterval == 0;
+            if (checked) model.settle(state);
             if (checked && !model.finite(state)) return {RunOutcome::NonFinite, step};
             if (observed && observer.observe(step)) return {RunOutcome::Stopped, step};
             if (merge_seam_ && observed && !final) {

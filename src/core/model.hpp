@@ -35,7 +35,12 @@ public:
     virtual std::size_t piece_count() const = 0;
 
     // Exact flow of piece k for time t, in place on the working layout.
+    // Flows may leave out of date the part of the state that follows from
+    // the rest (sine-Euler: the conjugate half of the modes), which they
+    // never read; settle writes it. The integrator settles the state before
+    // anything but a flow reads it.
     virtual void flow(std::size_t piece, double t, double *state) = 0;
+    virtual void settle(double * /*state*/) const {}
 
     virtual double energy(const double *state) const = 0;
     virtual std::size_t casimir_count() const = 0;

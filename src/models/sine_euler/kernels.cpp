@@ -106,74 +106,138 @@ LPI_KERNEL void for_each_lane(int N, int slope, int d0, int first_lane, F &&f) {
     }
 }
 
+// The half of the modes the flows keep (kept_mode): rows 1 .. M, and row 0
+// up to column M. Every other mode is the conjugate of its mirror, which the
+// flows read and write in its place; write_conjugate_half (SineEuler::settle)
+// writes the conjugates once the flows are done. The two are exact conjugates (a negated imaginary
+// part), so a sum formed from either has the same bits.
+LPI_KERNEL bool kept_mode(int row, int column, int M) {
+    return static_cast<unsigned>(row - 1) < static_cast<unsigned>(M) || (row == 0 && column <= M);
+}
+LPI_KERNEL int mirror_position(int p, int N) { return p == 0 ? 0 : N - p; }
+LPI_KERNEL Complex1 conjugate(const Complex1 &z) { return z * Complex1{1.0, -1.0}; }
+// What z is multiplied by to conjugate it, or not (exact either way).
+LPI_KERNEL Complex1 conjugating(bool yes) { return Complex1{1.0, yes ? -1.0 : 1.0}; }
+
+// Positions p0 .. p0+n-1 (p0 + n <= N) of a row kept as its mirror: the
+// conjugates of the mirror row's positions -(p0 + r) mod N.
+// Wide: two at once, the pair N - p - 1, N - p reversed.
+template <bool Wide>
+LPI_KERNEL void copy_mirrored_run(int N, int p0, int n, const double *__restrict mirror, double *__restrict dst) {
+    if (n <= 0) return;
+    int r = 0;
+    if (p0 == 0) store(dst, conjugate(load<Complex1>(mirror))), r = 1;
+    if (Wide)
+        for (; r + 2 <= n; r += 2)
+            store(dst + 2 * r, reversed(load<Complex2>(mirror + 2 * (N - p0 - r - 1))) * Complex2{1.0, -1.0, 1.0, -1.0});
+    for (; r < n; ++r) store(dst + 2 * r, conjugate(load<Complex1>(mirror + 2 * (N - p0 - r))));
+}
+
 // Count > 0: the block size, known at compile time (full blocks); 0: count.
-template <bool Rows, int Count>
+template <bool Rows, int Count, bool Wide>
 LPI_KERNEL void gather_runs(int N, int slope, int d0, int count, int first_lane,
                             const double *__restrict w, double *__restrict x) {
     const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
-    const int n = Count > 0 ? Count : count;
+    const int n = Count > 0 ? Count : count, M = (N - 1) / 2;
     for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
         const double *src = w + 2 * lane * s;
         double *dst = x + 2 * static_cast<std::size_t>(s) * n;
+        // Position p of lane s is (s, p) in a row, (p, s) in a column; the
+        // mirror is at position -p of lane -s.
+        const double *mirror = w + 2 * lane * mirror_position(s, N);
         const int first = o <= N - n ? n : N - o;  // the run wraps at most once
-        for (int i = 0; i < first; ++i) {
-            dst[2 * i] = src[2 * step * (o + i)];
-            dst[2 * i + 1] = src[2 * step * (o + i) + 1];
+        if (Rows && s >= 1 && s <= M) {  // a kept row
+            for (int i = 0; i < first; ++i) {
+                dst[2 * i] = src[2 * step * (o + i)];
+                dst[2 * i + 1] = src[2 * step * (o + i) + 1];
+            }
+            for (int i = first; i < n; ++i) {
+                dst[2 * i] = src[2 * step * (o + i - N)];
+                dst[2 * i + 1] = src[2 * step * (o + i - N) + 1];
+            }
+            return;
         }
-        for (int i = first; i < n; ++i) {
-            dst[2 * i] = src[2 * step * (o + i - N)];
-            dst[2 * i + 1] = src[2 * step * (o + i - N) + 1];
+        if (Rows && s > M) {  // a row kept as its mirror
+            copy_mirrored_run<Wide>(N, o, first, mirror, dst);
+            copy_mirrored_run<Wide>(N, 0, n - first, mirror, dst + 2 * first);
+            return;
+        }
+        for (int i = 0, p = o; i < n; ++i, p = p + 1 < N ? p + 1 : 0) {
+            const bool kept = Rows ? kept_mode(s, p, M) : kept_mode(p, s, M);
+            const double *z = kept ? src + 2 * step * p : mirror + 2 * step * mirror_position(p, N);
+            store(dst + 2 * i, load<Complex1>(z) * conjugating(!kept));
         }
     });
 }
 
-// Adds n increments to positions p0 .. p0+n-1 (p0 + n <= N) of a lane and
-// writes the conjugates of the sums at positions -(p0 + r) mod N of the
-// mirror lane, in one pass (the sums are not stored twice). In a row the
-// mirrors of positions p, p + 1 are the pair N - p - 1, N - p: two sums are
-// stored at once, reversed and conjugated (exact) for the mirror.
-template <bool Rows, bool Wide>
-LPI_KERNEL void put_run(int N, int p0, int n, const double *__restrict increment, double *lane,
-                        double *mirror) {
-    if (n <= 0) return;
-    const std::size_t step = Rows ? 1 : N;
+// Adds n increments to positions p0 .. p0+n-1 (p0 + n <= N) of a kept row.
+// Wide: two at once.
+template <bool Wide>
+LPI_KERNEL void add_run(int p0, int n, const double *__restrict increment, double *lane) {
     int r = 0;
+    if (n <= 0) return;
+    if (Wide)
+        for (; r + 2 <= n; r += 2) {
+            double *z = lane + 2 * (p0 + r);
+            store(z, load<Complex2>(z) + load<Complex2>(increment + 2 * r));
+        }
+    for (; r < n; ++r) {
+        double *z = lane + 2 * (p0 + r);
+        store(z, load<Complex1>(z) + load<Complex1>(increment + 2 * r));
+    }
+}
+
+// The same where the row's modes are kept as their mirrors, at positions
+// -(p0 + r) mod N of the mirror row: each sum is formed from the mirror's
+// conjugate and stored conjugated there. The mirrors of positions p, p + 1
+// are the pair N - p - 1, N - p: two at once, reversed (Wide).
+template <bool Wide>
+LPI_KERNEL void add_mirrored_run(int N, int p0, int n, const double *__restrict increment, double *mirror) {
+    int r = 0;
+    if (n <= 0) return;
     if (p0 == 0) {  // position 0 is its own mirror position
-        const Complex1 sum = load<Complex1>(lane) + load<Complex1>(increment);
-        store(lane, sum);
-        store(mirror, sum * Complex1{1.0, -1.0});
+        const Complex1 sum = conjugate(load<Complex1>(mirror)) + load<Complex1>(increment);
+        store(mirror, conjugate(sum));
         r = 1;
     }
-    if (Rows && Wide) {
+    if (Wide)
         for (; r + 2 <= n; r += 2) {
-            double *z = lane + 2 * (p0 + r), *m = mirror + 2 * (N - p0 - r - 1);
-            const Complex2 sum = load<Complex2>(z) + load<Complex2>(increment + 2 * r);
-            store(z, sum);
-            store(m, reversed(sum) * Complex2{1.0, -1.0, 1.0, -1.0});
+            double *m = mirror + 2 * (N - p0 - r - 1);
+            const Complex2 flip{1.0, -1.0, 1.0, -1.0};
+            const Complex2 sum = reversed(load<Complex2>(m)) * flip + load<Complex2>(increment + 2 * r);
+            store(m, reversed(sum) * flip);
         }
-    }
     for (; r < n; ++r) {
-        double *z = lane + 2 * step * (p0 + r), *m = mirror + 2 * step * (N - p0 - r);
-        const Complex1 sum = load<Complex1>(z) + load<Complex1>(increment + 2 * r);
-        store(z, sum);
-        store(m, sum * Complex1{1.0, -1.0});
+        double *m = mirror + 2 * (N - p0 - r);
+        const Complex1 sum = conjugate(load<Complex1>(m)) + load<Complex1>(increment + 2 * r);
+        store(m, conjugate(sum));
     }
 }
 
 template <bool Rows, int Count, bool Wide>
 LPI_KERNEL void scatter_runs(int N, int slope, int d0, int count, int first_lane,
                              const double *__restrict x, double *w) {
-    const std::size_t lane = Rows ? N : 1;
-    const int n = Count > 0 ? Count : count;
+    const std::size_t lane = Rows ? N : 1, step = Rows ? 1 : N;
+    const int n = Count > 0 ? Count : count, M = (N - 1) / 2;
     for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
         const double *src = x + 2 * static_cast<std::size_t>(s) * n;
-        double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * (s == 0 ? 0 : N - s);
-        if (o >= 1 && o <= N - n) {  // most lanes: one run, away from position 0
-            put_run<Rows, Wide>(N, o, n, src, dst, mirror);
-        } else {
-            const int first = std::min(n, N - o);
-            put_run<Rows, Wide>(N, o, first, src, dst, mirror);
-            put_run<Rows, Wide>(N, 0, n - first, src + 2 * first, dst, mirror);
+        double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * mirror_position(s, N);
+        if (Rows && s != 0) {  // a whole row kept, or a whole row mirrored
+            const int first = std::min(n, N - o);  // the run wraps at most once
+            if (s <= M) {
+                add_run<Wide>(o, first, src, dst);
+                add_run<Wide>(0, n - first, src + 2 * first, dst);
+            } else {
+                add_mirrored_run<Wide>(N, o, first, src, mirror);
+                add_mirrored_run<Wide>(N, 0, n - first, src + 2 * first, mirror);
+            }
+            return;
+        }
+        for (int i = 0, p = o; i < n; ++i, p = p + 1 < N ? p + 1 : 0) {
+            const bool kept = Rows ? kept_mode(s, p, M) : kept_mode(p, s, M);
+            double *z = kept ? dst + 2 * step * p : mirror + 2 * step * mirror_position(p, N);
+            const Complex1 sign = conjugating(!kept);
+            store(z, (load<Complex1>(z) * sign + load<Complex1>(src + 2 * i)) * sign);
         }
     });
 }
@@ -209,33 +273,42 @@ LPI_KERNEL void for_each_block_mode(const Direction &D, int N, int d0, int count
     }
 }
 
+// kept_mode by the index a N + b: row 0 up to column M, or rows 1 .. M.
+LPI_KERNEL bool kept_index(std::size_t mode, int N) {
+    const std::size_t n = N, M = (n - 1) / 2;
+    return mode <= M || (mode >= n && mode < (M + 1) * n);
+}
+
 LPI_KERNEL void gather_general(const Direction &D, int N, int d0, int count, const double *w, double *x) {
-    for_each_block_mode(D, N, d0, count, [&](std::size_t e, std::size_t mode, std::size_t) {
-        store(x + 2 * e, load<Complex1>(w + 2 * mode));
+    for_each_block_mode(D, N, d0, count, [&](std::size_t e, std::size_t mode, std::size_t mirror) {
+        const bool kept = kept_index(mode, N);
+        store(x + 2 * e, load<Complex1>(w + 2 * (kept ? mode : mirror)) * conjugating(!kept));
     });
 }
 
 LPI_KERNEL void scatter_general(const Direction &D, int N, int d0, int count, const double *x, double *w) {
     for_each_block_mode(D, N, d0, count, [&](std::size_t e, std::size_t mode, std::size_t mirror) {
-        const Complex1 sum = load<Complex1>(w + 2 * mode) + load<Complex1>(x + 2 * e);
-        store(w + 2 * mode, sum);
-        store(w + 2 * mirror, sum * Complex1{1.0, -1.0});
+        const bool kept = kept_index(mode, N);
+        double *z = w + 2 * (kept ? mode : mirror);
+        const Complex1 sign = conjugating(!kept);
+        store(z, (load<Complex1>(z) * sign + load<Complex1>(x + 2 * e)) * sign);
     });
 }
 
 // A block's moves: numbers copied, negated and added one increment per mode,
-// so every instruction set gives the same bits. Wide: two sums at once in
-// the runs along rows (AVX2).
+// so every instruction set gives the same bits. Wide: two at once in the
+// runs along rows (AVX2).
+template <bool Wide>
 LPI_KERNEL void gather_lines(const Direction &D, int N, int d0, int count, int first_lane, const double *w,
                              double *x) {
     switch (D.layout) {
         case Direction::Row:
-            if (count == kBlock) gather_runs<true, kBlock>(N, D.k2, d0, count, first_lane, w, x);
-            else gather_runs<true, 0>(N, D.k2, d0, count, first_lane, w, x);
+            if (count == kBlock) gather_runs<true, kBlock, Wide>(N, D.k2, d0, count, first_lane, w, x);
+            else gather_runs<true, 0, Wide>(N, D.k2, d0, count, first_lane, w, x);
             break;
         case Direction::Column:
-            if (count == kBlock) gather_runs<false, kBlock>(N, D.k1, d0, count, first_lane, w, x);
-            else gather_runs<false, 0>(N, D.k1, d0, count, first_lane, w, x);
+            if (count == kBlock) gather_runs<false, kBlock, Wide>(N, D.k1, d0, count, first_lane, w, x);
+            else gather_runs<false, 0, Wide>(N, D.k1, d0, count, first_lane, w, x);
             break;
         case Direction::General: gather_general(D, N, d0, count, w, x); break;
     }
@@ -347,7 +420,7 @@ LPI_KERNEL void phase_lines(int N, int d0, int count, const double *tables, doub
 // The same templates compiled for AVX2 (without FMA: the same operations).
 __attribute__((target("avx2"))) void gather_avx2(const Direction &D, int N, int d0, int count, int first_lane,
                                                  const double *w, double *x) {
-    gather_lines(D, N, d0, count, first_lane, w, x);
+    gather_lines<true>(D, N, d0, count, first_lane, w, x);
 }
 __attribute__((target("avx2"))) void scatter_avx2(const Direction &D, int N, int d0, int count, int first_lane,
                                                   const double *x, double *w) {
@@ -368,7 +441,7 @@ bool cpu_has_avx2() {
 
 namespace baseline {
 void gather_block(const Direction &D, int N, int d0, int count, int first_lane, const double *w, double *x) {
-    gather_lines(D, N, d0, count, first_lane, w, x);
+    gather_lines<false>(D, N, d0, count, first_lane, w, x);
 }
 void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x, double *w) {
     scatter_lines<false>(D, N, d0, count, first_lane, x, w);
@@ -377,6 +450,18 @@ void apply_phase(int N, int d0, int count, const double *tables, double sign, do
     phase_lines<Complex1>(N, d0, count, tables, sign, x);
 }
 }  // namespace baseline
+
+void write_conjugate_half(int N, double *w) {
+    const int M = (N - 1) / 2;
+    const std::size_t n = N;
+    for (int b = M + 1; b < N; ++b) store(w + 2 * b, conjugate(load<Complex1>(w + 2 * (n - b))));
+    for (int a = M + 1; a < N; ++a) {
+        double *row = w + 2 * n * a;
+        const double *mirror = w + 2 * n * (n - a);
+        store(row, conjugate(load<Complex1>(mirror)));
+        for (int b = 1; b < N; ++b) store(row + 2 * b, conjugate(load<Complex1>(mirror + 2 * (n - b))));
+    }
+}
 
 const char *kernel_instruction_set() {
 #if LPI_AVX2_KERNELS

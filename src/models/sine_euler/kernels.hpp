@@ -14,15 +14,21 @@
 namespace lpi {
 namespace sine_euler {
 
+// During the flows the modes w are kept in one half: rows 1 .. M (M =
+// (N - 1) / 2) and row 0 up to column M. Every other mode is read as the
+// conjugate of its mirror and left out of date, so that each flow writes a
+// mode once; write_conjugate_half brings the other half up to date.
+
 // Copies lines d0 .. d0+count-1 of D out of the modes w: element s of line
 // d0 + i goes to x[s * count + i] (complex entries).
 void gather_block(const Direction &D, int N, int d0, int count, int first_lane, const double *w,
                   double *x);
-// Adds the increments x (as gathered) to those lines of w, in place, and
-// writes the conjugates of the sums to the mirror lines -d (which no block
-// gathers), so every mode is written once.
+// Adds the increments x (as gathered) to those lines of w, in place: to the
+// kept half (a mode outside it through its mirror, which is kept).
 void scatter_block(const Direction &D, int N, int d0, int count, int first_lane, const double *x,
                    double *w);
+// Writes every mode outside the kept half as the conjugate of its mirror.
+void write_conjugate_half(int N, double *w);
 // The phase tables of one flow: kPhaseArrays arrays of 2N doubles, array a
 // at tables + 2 N a, written by write_phase and read by apply_phase.
 constexpr int kPhaseArrays = 6;

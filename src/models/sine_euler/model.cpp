@@ -130,6 +130,7 @@ public:
         require_fftw_execution_headroom(N_, threads_);
     }
     void flow(std::size_t piece, double t, double *state) override;
+    void settle(double *state) const override { write_conjugate_half(N_, state); }
 
     double energy(const double *state) const override { return hamiltonian_.energy(state); }
     double enstrophy(const double *state) const override {
@@ -197,7 +198,8 @@ void SineEuler::flow(std::size_t piece, double t, double *state) {
     // Block b, lines d = d0 .. d0+count-1 of D: gather z_s = w_{d j + s k}
     // into x[s * count + (d - d0)], transform along s, multiply by the line's
     // (exp(t Lambda_l) - 1) / N, transform back, add the increments to the
-    // modes and write the conjugates of the sums to the lines -d.
+    // modes, in the half of them the flows keep (kernels.hpp; settle writes
+    // the other).
     run_line_flows(
         *transforms_, N_, blocks_.M, threads_, t / (2.0 * eps_),
         [&](int b, double *x) {

@@ -154,9 +154,13 @@ bool line_stream(const Direction &D, const Hamiltonian &H, const double *modes, 
     bool active = false;
     for (int s = 0; s < N; ++s) {
         if (D.owned[s]) {
+            // A mode outside the half the flows keep is its mirror's
+            // conjugate (kernels.cpp): the same bits.
             const std::size_t m = mode_index(a, c, N);
-            b[2 * s] = modes[2 * m] * lambda[m];
-            b[2 * s + 1] = modes[2 * m + 1] * lambda[m];
+            const bool kept = (a >= 1 && a <= N / 2) || (a == 0 && c <= N / 2);
+            const std::size_t k = kept ? m : mirror_index(a, c, N);
+            b[2 * s] = modes[2 * k] * lambda[m];
+            b[2 * s + 1] = (kept ? modes[2 * k + 1] : -modes[2 * k + 1]) * lambda[m];
             if (f) {
                 b[2 * s] += f[2 * m];
                 b[2 * s + 1] += f[2 * m + 1];

@@ -56,7 +56,8 @@ double piece_energy(const Direction &D, const Hamiltonian &H, const double *mode
 
 // The stream function on piece D's own line, b_s = lambda_sk w_sk + f_sk for
 // the modes D owns and 0 elsewhere (N complex, interleaved), the input of
-// the line spectrum. Returns false when every b_s is zero.
+// the line spectrum, read from the half of the modes the flows keep
+// (kernels.hpp). Returns false when every b_s is zero.
 bool line_stream(const Direction &D, const Hamiltonian &H, const double *modes, double *b);
 
 // Lines d = 1 .. M of a direction, in blocks of kBlock. The block size is
