@@ -18,9 +18,19 @@ inline int modulo(std::int64_t a, int N) {
 // The representative of a residue in -(N-1)/2 .. (N-1)/2.
 inline int signed_residue(int a, int N) { return a > N / 2 ? a - N : a; }
 inline std::size_t mode_index(int a, int b, int N) { return static_cast<std::size_t>(a) * N + b; }
+// -a mod N for a residue a in 0 .. N-1.
+inline int negated_residue(int a, int N) { return a ? N - a : 0; }
 // Entry of the conjugate mode -(a, b).
 inline std::size_t mirror_index(int a, int b, int N) {
-    return mode_index(a ? N - a : 0, b ? N - b : 0, N);
+    return mode_index(negated_residue(a, N), negated_residue(b, N), N);
+}
+// The half of the modes the line flows keep during a run: rows a = 1 ..
+// (N-1)/2, and row 0 up to column (N-1)/2. Every other mode is its mirror's
+// conjugate, read from there and written once the flows are done
+// (kernels.hpp).
+inline bool kept_mode(int a, int b, int N) {
+    const int M = (N - 1) / 2;
+    return static_cast<unsigned>(a - 1) < static_cast<unsigned>(M) || (a == 0 && b <= M);
 }
 // The mean of a mode's value and the one its mirror implies, which a
 // symmetric field makes equal: kept as is when they are (such a field is

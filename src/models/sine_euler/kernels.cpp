@@ -106,15 +106,11 @@ LPI_KERNEL void for_each_lane(int N, int slope, int d0, int first_lane, F &&f) {
     }
 }
 
-// The half of the modes the flows keep (kept_mode): rows 1 .. M, and row 0
-// up to column M. Every other mode is the conjugate of its mirror, which the
-// flows read and write in its place; write_conjugate_half (SineEuler::settle)
-// writes the conjugates once the flows are done. The two are exact conjugates (a negated imaginary
-// part), so a sum formed from either has the same bits.
-LPI_KERNEL bool kept_mode(int row, int column, int M) {
-    return static_cast<unsigned>(row - 1) < static_cast<unsigned>(M) || (row == 0 && column <= M);
-}
-LPI_KERNEL int mirror_position(int p, int N) { return p == 0 ? 0 : N - p; }
+// The half of the modes the flows keep (kept_mode, indexing.hpp): every
+// other mode is the conjugate of its mirror, which the flows read and write
+// in its place; write_conjugate_half (SineEuler::settle) writes the
+// conjugates once the flows are done. The two are exact conjugates (a
+// negated imaginary part), so a sum formed from either has the same bits.
 LPI_KERNEL Complex1 conjugate(const Complex1 &z) { return z * Complex1{1.0, -1.0}; }
 // What z is multiplied by to conjugate it, or not (exact either way).
 LPI_KERNEL Complex1 conjugating(bool yes) { return Complex1{1.0, yes ? -1.0 : 1.0}; }
@@ -144,7 +140,7 @@ LPI_KERNEL void gather_runs(int N, int slope, int d0, int count, int first_lane,
         double *dst = x + 2 * static_cast<std::size_t>(s) * n;
         // Position p of lane s is (s, p) in a row, (p, s) in a column; the
         // mirror is at position -p of lane -s.
-        const double *mirror = w + 2 * lane * mirror_position(s, N);
+        const double *mirror = w + 2 * lane * negated_residue(s, N);
         const int first = o <= N - n ? n : N - o;  // the run wraps at most once
         if (Rows && s >= 1 && s <= M) {  // a kept row
             for (int i = 0; i < first; ++i) {
@@ -163,8 +159,8 @@ LPI_KERNEL void gather_runs(int N, int slope, int d0, int count, int first_lane,
             return;
         }
         for (int i = 0, p = o; i < n; ++i, p = p + 1 < N ? p + 1 : 0) {
-            const bool kept = Rows ? kept_mode(s, p, M) : kept_mode(p, s, M);
-            const double *z = kept ? src + 2 * step * p : mirror + 2 * step * mirror_position(p, N);
+            const bool kept = Rows ? kept_mode(s, p, N) : kept_mode(p, s, N);
+            const double *z = kept ? src + 2 * step * p : mirror + 2 * step * negated_residue(p, N);
             store(dst + 2 * i, load<Complex1>(z) * conjugating(!kept));
         }
     });
@@ -221,7 +217,7 @@ LPI_KERNEL void scatter_runs(int N, int slope, int d0, int count, int first_lane
     const int n = Count > 0 ? Count : count, M = (N - 1) / 2;
     for_each_lane(N, slope, d0, first_lane, [&](int s, int o) {
         const double *src = x + 2 * static_cast<std::size_t>(s) * n;
-        double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * mirror_position(s, N);
+        double *dst = w + 2 * lane * s, *mirror = w + 2 * lane * negated_residue(s, N);
         if (Rows && s != 0) {  // a whole row kept, or a whole row mirrored
             const int first = std::min(n, N - o);  // the run wraps at most once
             if (s <= M) {
@@ -234,8 +230,8 @@ LPI_KERNEL void scatter_runs(int N, int slope, int d0, int count, int first_lane
             return;
         }
         for (int i = 0, p = o; i < n; ++i, p = p + 1 < N ? p + 1 : 0) {
-            const bool kept = Rows ? kept_mode(s, p, M) : kept_mode(p, s, M);
-            double *z = kept ? dst + 2 * step * p : mirror + 2 * step * mirror_position(p, N);
+            const bool kept = Rows ? kept_mode(s, p, N) : kept_mode(p, s, N);
+            double *z = kept ? dst + 2 * step * p : mirror + 2 * step * negated_residue(p, N);
             const Complex1 sign = conjugating(!kept);
             store(z, (load<Complex1>(z) * sign + load<Complex1>(src + 2 * i)) * sign);
         }
@@ -243,9 +239,10 @@ LPI_KERNEL void scatter_runs(int N, int slope, int d0, int count, int first_lane
 }
 
 // ---- General directions: one mode at a time -------------------------------
-// Calls f(x_entry, mode, mirror) for element s of line d0 + i, at (d0 + i) j
-// + s k: x_entry = s count + i, mode and mirror the indices of that mode and
-// of its conjugate in the mode array. Along a row of the block the mode moves
+// Calls f(x_entry, mode, mirror, kept) for element s of line d0 + i, at
+// (d0 + i) j + s k: x_entry = s count + i, mode and mirror the indices of
+// that mode and of its conjugate in the mode array, kept whether the flows
+// keep the mode itself (kept_mode). Along a row of the block the mode moves
 // by j: its index by j1 N + j2, less N^2 where a wraps and N where b does;
 // the mirror's, -(a, b), is N^2 + N - mode, less N^2 where a = 0 and N where
 // b = 0.
@@ -259,7 +256,7 @@ LPI_KERNEL void for_each_block_mode(const Direction &D, int N, int d0, int count
         const std::size_t row = static_cast<std::size_t>(s) * count;
         for (int i = 0; i < count; ++i) {
             const std::size_t mirror = square + n - mode - (a == 0 ? square : 0) - (b == 0 ? n : 0);
-            f(row + i, mode, mirror);
+            f(row + i, mode, mirror, kept_mode(a, b, N));
             mode += stride;
             a += D.j1;
             if (a >= N) a -= N, mode -= square;
@@ -273,22 +270,14 @@ LPI_KERNEL void for_each_block_mode(const Direction &D, int N, int d0, int count
     }
 }
 
-// kept_mode by the index a N + b: row 0 up to column M, or rows 1 .. M.
-LPI_KERNEL bool kept_index(std::size_t mode, int N) {
-    const std::size_t n = N, M = (n - 1) / 2;
-    return mode <= M || (mode >= n && mode < (M + 1) * n);
-}
-
 LPI_KERNEL void gather_general(const Direction &D, int N, int d0, int count, const double *w, double *x) {
-    for_each_block_mode(D, N, d0, count, [&](std::size_t e, std::size_t mode, std::size_t mirror) {
-        const bool kept = kept_index(mode, N);
+    for_each_block_mode(D, N, d0, count, [&](std::size_t e, std::size_t mode, std::size_t mirror, bool kept) {
         store(x + 2 * e, load<Complex1>(w + 2 * (kept ? mode : mirror)) * conjugating(!kept));
     });
 }
 
 LPI_KERNEL void scatter_general(const Direction &D, int N, int d0, int count, const double *x, double *w) {
-    for_each_block_mode(D, N, d0, count, [&](std::size_t e, std::size_t mode, std::size_t mirror) {
-        const bool kept = kept_index(mode, N);
+    for_each_block_mode(D, N, d0, count, [&](std::size_t e, std::size_t mode, std::size_t mirror, bool kept) {
         double *z = w + 2 * (kept ? mode : mirror);
         const Complex1 sign = conjugating(!kept);
         store(z, (load<Complex1>(z) * sign + load<Complex1>(x + 2 * e)) * sign);
@@ -452,15 +441,10 @@ void apply_phase(int N, int d0, int count, const double *tables, double sign, do
 }  // namespace baseline
 
 void write_conjugate_half(int N, double *w) {
-    const int M = (N - 1) / 2;
-    const std::size_t n = N;
-    for (int b = M + 1; b < N; ++b) store(w + 2 * b, conjugate(load<Complex1>(w + 2 * (n - b))));
-    for (int a = M + 1; a < N; ++a) {
-        double *row = w + 2 * n * a;
-        const double *mirror = w + 2 * n * (n - a);
-        store(row, conjugate(load<Complex1>(mirror)));
-        for (int b = 1; b < N; ++b) store(row + 2 * b, conjugate(load<Complex1>(mirror + 2 * (n - b))));
-    }
+    for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b)
+            if (!kept_mode(a, b, N))
+                store(w + 2 * mode_index(a, b, N), conjugate(load<Complex1>(w + 2 * mirror_index(a, b, N))));
 }
 
 const char *kernel_instruction_set() {

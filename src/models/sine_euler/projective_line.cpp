@@ -157,7 +157,7 @@ bool line_stream(const Direction &D, const Hamiltonian &H, const double *modes, 
             // A mode outside the half the flows keep is its mirror's
             // conjugate (kernels.cpp): the same bits.
             const std::size_t m = mode_index(a, c, N);
-            const bool kept = (a >= 1 && a <= N / 2) || (a == 0 && c <= N / 2);
+            const bool kept = kept_mode(a, c, N);
             const std::size_t k = kept ? m : mirror_index(a, c, N);
             b[2 * s] = modes[2 * k] * lambda[m];
             b[2 * s + 1] = (kept ? modes[2 * k + 1] : -modes[2 * k + 1]) * lambda[m];
