@@ -1,9 +1,9 @@
 /* lpi_set_observer: the observer sees, at every k-th step, exactly the state
  * and time of a fresh system stepped that many steps in one call (its whole
  * checkpoint, compensated carry included, bit for bit), for a merging
- * splitting method and for baselines; observing changes no bit of the
- * trajectory; a non-zero return stops lpi_step with LPI_STOPPED at that
- * step; inside the observer the handle can be read but not changed
+ * splitting method and for baselines, and every mode of a sine-Euler system;
+ * observing changes no bit of the trajectory; a non-zero return stops
+ * lpi_step with LPI_STOPPED at that step; inside the observer the handle can be read but not changed
  * (LPI_ERR_BUSY, nothing changed); a failing step names the step and time. */
 #include "lpi_test.h"
 
@@ -97,6 +97,57 @@ static void test_observed_states_are_those_of_fresh_runs(void **state) {
         assert_int_equal(r.count, n / every);
         lpi_destroy(sys);
     }
+}
+
+/* Sine-Euler: the flows keep one half of the modes during a run; the
+ * observer still sees every mode, as a fresh run of that many steps leaves
+ * them (the other half written before it is called). */
+enum { kSineN = 15, kSineModes = 2 * kSineN * kSineN, kSineObservations = 4 };
+static double sine_observed[kSineObservations][kSineModes];
+static int sine_observed_count, sine_read_status;
+
+static int sine_modes_observer(const lpi_system *sys, int64_t step, double t, void *user) {
+    (void)step, (void)t, (void)user;
+    if (sine_observed_count >= kSineObservations) return 1;
+    const int status = lpi_sine_euler_get_modes(sys, sine_observed[sine_observed_count++], kSineModes);
+    if (status != LPI_OK) sine_read_status = status;
+    return 0;
+}
+
+/* A sine-Euler system of N = 15 with a few modes set; NULL without FFTW. */
+static lpi_system *sine_euler_15(void) {
+    lpi_system *sys = NULL;
+    if (lpi_sine_euler_create(&sys, kSineN) != LPI_OK) return NULL;
+    double w[kSineModes] = {0};
+    w[2 * (2 * kSineN + 1)] = 1.0, w[2 * (13 * kSineN + 14)] = 1.0;  /* (2, 1), (-2, -1) */
+    w[2 * 3] = 0.5, w[2 * 12] = 0.5;                                  /* (0, 3), (0, -3) */
+    w[2 * (kSineN + 4) + 1] = 0.3, w[2 * (14 * kSineN + 11) + 1] = -0.3; /* (1, 4), (-1, -4) */
+    assert_int_equal(lpi_sine_euler_set_modes(sys, w, kSineModes), LPI_OK);
+    return sys;
+}
+
+static void test_observed_sine_euler_modes_are_those_of_fresh_runs(void **state) {
+    (void)state;
+    lpi_system *sys = sine_euler_15();
+    if (!sys) LPI_SKIP("built without FFTW: no sine-Euler system");
+    const double dt = 0.05;
+    const int64_t every = 3;
+    sine_observed_count = 0, sine_read_status = LPI_OK;
+    assert_int_equal(lpi_set_observer(sys, every, sine_modes_observer, NULL), LPI_OK);
+    assert_int_equal(lpi_step(sys, dt, every * kSineObservations + 1), LPI_OK);
+    assert_int_equal(sine_read_status, LPI_OK);
+    assert_int_equal(sine_observed_count, kSineObservations);
+    for (int i = 0; i < kSineObservations; ++i) {
+        lpi_system *fresh = sine_euler_15();
+        assert_int_equal(lpi_step(fresh, dt, every * (i + 1)), LPI_OK);
+        double expected[kSineModes];
+        assert_int_equal(lpi_sine_euler_get_modes(fresh, expected, kSineModes), LPI_OK);
+        if (memcmp(sine_observed[i], expected, sizeof expected) != 0)
+            fail_msg("the modes observed at step %lld differ from a run of that many steps",
+                     (long long)(every * (i + 1)));
+        lpi_destroy(fresh);
+    }
+    lpi_destroy(sys);
 }
 
 static void test_stop_gives_the_state_of_that_many_steps(void **state) {
@@ -306,6 +357,7 @@ static void test_observer_arguments(void **state) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_observed_states_are_those_of_fresh_runs),
+        cmocka_unit_test(test_observed_sine_euler_modes_are_those_of_fresh_runs),
         cmocka_unit_test(test_stop_gives_the_state_of_that_many_steps),
         cmocka_unit_test(test_observer_cannot_change_the_handle),
         cmocka_unit_test(test_failing_step_names_step_and_time),
