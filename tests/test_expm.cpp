@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
 // Before cmocka.h (through lpi_test.h), whose fail() macro would rewrite lpi::fail.
@@ -332,6 +333,72 @@ void test_plane_closed_form(void **) {
     exponential.apply(&g, 0.5, z);
     assert_true(z[0] == 4.0);
     assert_true(std::fabs(z[1] - 3.0 * std::exp(-0.75)) < 4 * 2.2e-16 * 3.0);
+}
+
+// A rotation, t A = [[0, b], [-b, 0]] from one parameter, is applied without
+// forming t A (SparseExponential::rotate): the same bits as the plane's
+// general closed form, which takes it where b comes from two parameters
+// equal in value, and the same refusals. Includes half turns and more (the
+// shears of -M), a b whose square underflows (the general path, whose delta
+// is then 0), and a b that is not a number.
+void test_rotation_takes_the_plane_bits(void **) {
+    std::mt19937_64 random(20261130);
+    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+    const double coefficients[] = {1.0, -1.0, 0.75, 3.0, 0.3};
+    const double scales[] = {1e-170, 1e-3, 0.4, 1.5, 3.0, 7.0};
+    int rotations = 0;
+    for (double c : coefficients) {
+        // Entries listed lower first: the plan finds the upper one itself.
+        const std::vector<lpi::SparseTerm> one = {{3, 1, 0, -c}, {1, 3, 0, c}};
+        const std::vector<lpi::SparseTerm> two = {{3, 1, 1, -c}, {1, 3, 0, c}};
+        lpi::SparseExponential rotation(4, one), plane(4, two);
+        assert_int_equal(static_cast<int>(rotation.path()), static_cast<int>(lpi::ExpmPath::Plane));
+        for (double scale : scales)
+            for (int sample = 0; sample < 200; ++sample) {
+                const double g = scale * uniform(random), t = uniform(random);
+                const double g_twice[2] = {g, g};
+                std::vector<double> x = {uniform(random), uniform(random), uniform(random),
+                                         uniform(random)};
+                std::vector<double> y = x;
+                rotation.apply(&g, t, x.data());
+                plane.apply(g_twice, t, y.data());
+                for (std::size_t i = 0; i < x.size(); ++i)
+                    if (std::memcmp(&x[i], &y[i], sizeof(double)) != 0)
+                        fail_msg("c = %g, g = %.17g, t = %.17g: component %zu %.17g, general "
+                                 "plane %.17g", c, g, t, i, x[i], y[i]);
+                ++rotations;
+            }
+        // Refusals: the same status and message, x untouched.
+        const std::vector<double> edge = {1.5e308, 1.5e308, 1.5e308, 1.5e308};
+        const double huge = 1e11, nan = std::nan(""), turn = 0.5 / std::fabs(c);  // 1.5e308 (cos + sin) > DBL_MAX
+        const double huge2[2] = {huge, huge}, nan2[2] = {nan, nan}, turn2[2] = {turn, turn};
+        const struct {
+            const double *g, *g2;
+            const std::vector<double> &x;
+        } refused[] = {{&huge, huge2, edge}, {&nan, nan2, edge}, {&turn, turn2, edge}};
+        for (const auto &r : refused) {
+            std::string first, second;
+            int status[2] = {LPI_OK, LPI_OK};
+            for (int which = 0; which < 2; ++which) {
+                std::vector<double> x = r.x;
+                try {
+                    if (which == 0)
+                        rotation.apply(r.g, 1.0, x.data());
+                    else
+                        plane.apply(r.g2, 1.0, x.data());
+                } catch (const lpi::Error &e) {
+                    status[which] = e.status();
+                    (which == 0 ? first : second) = e.what();
+                }
+                for (std::size_t i = 0; i < x.size(); ++i)
+                    if (!(x[i] == r.x[i])) fail_msg("c = %g, g = %g, %s: x[%zu] = %g", c, *r.g, which ? "plane" : "rotation", i, x[i]);
+            }
+            assert_int_not_equal(status[0], LPI_OK);
+            assert_int_equal(status[0], status[1]);
+            assert_string_equal(first.c_str(), second.c_str());
+        }
+    }
+    std::printf("rotations: %d flows with the general plane's bits\n", rotations);
 }
 
 // Every path refuses, x unchanged bit for bit: a flow whose result is not
@@ -718,6 +785,7 @@ int main() {
         cmocka_unit_test(test_nilpotent_matrices),
         cmocka_unit_test(test_sparse_nilpotent_scales_with_nonzeros),
         cmocka_unit_test(test_plane_closed_form),
+        cmocka_unit_test(test_rotation_takes_the_plane_bits),
         cmocka_unit_test(test_refusals_leave_x_unchanged),
         cmocka_unit_test(test_shear),
         cmocka_unit_test(test_diagonal_series),

@@ -306,7 +306,16 @@ private:
     void apply_scalings(double *x);  // DiagonalSeries: exp(tD) after N, from times_
     bool shear(double *x);  // depth 1, x untouched on failure
     void apply_plane(double t, double *x);  // a block of order 1 or 2
-    void apply_shears(const double A[4], double x0, double x1, double *x);  // the plane's elliptic flows
+    // The plane's elliptic flows: M = exp(t A) as three shears (see
+    // elliptic_shears), applied to x0, x1.
+    struct Shears {
+        double first, lower, last;
+        bool turned;  // past a quarter turn: the shears of -M
+    };
+    static Shears rotation_shears(double b);  // t A = [[0, b], [-b, 0]]
+    static Shears elliptic_shears(const double A[4]);
+    void apply_shears(const Shears &M, double x0, double x1, double *x);
+    bool rotate(double t, double *x);  // rotation_: see the definition
     void apply_pade(double t, double *x);
     void check_norm(double norm, double t) const;
     // Throws LPI_ERR_NONFINITE naming the first moved index whose entry of
@@ -316,6 +325,11 @@ private:
     ExpmPath path_ = ExpmPath::Nilpotent;
     std::size_t depth_ = 0;
     bool shear_ = false;  // depth 1, one term a position: shear() applies it
+    // A plane whose t A is [[0, b], [-b, 0]], b = rotation_coefficient_ s_p
+    // (so(3)'s axes, e(2)'s rotation): rotate() applies it.
+    bool rotation_ = false;
+    std::uint32_t rotation_parameter_ = 0;
+    double rotation_coefficient_ = 0.0;
     // The increments' indices, local -> global (nilpotent: the nodes; block:
     // every index the pattern touches).
     std::vector<std::uint32_t> moved_;

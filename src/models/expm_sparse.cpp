@@ -366,6 +366,18 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
     scaled_.resize(positions.size());
     increment_.resize(moved_.size());
     shear_ = path_ == ExpmPath::Nilpotent && depth_ == 1 && further_terms_.empty();
+    // A rotation: t A = [[0, b], [-b, 0]] with b = c s_p, one term a position.
+    rotation_ = path_ == ExpmPath::Plane && moved_.size() == 2 && first_terms_.size() == 2 &&
+                further_terms_.empty() && block_[0].row != block_[0].col &&
+                block_[1].row != block_[1].col &&
+                first_terms_[0].parameter == first_terms_[1].parameter &&
+                first_terms_[1].coefficient == -first_terms_[0].coefficient;
+    if (rotation_) {
+        // b is the entry at (0, 1) of the block.
+        const std::size_t upper = block_[0].row == 0 ? 0 : 1;
+        rotation_parameter_ = first_terms_[upper].parameter;
+        rotation_coefficient_ = first_terms_[upper].coefficient;
+    }
 }
 
 // z e^a where e^a overflows or is subnormal: 0 for z = 0 (the exact flow of
@@ -508,6 +520,7 @@ void SparseExponential::apply(const double *g, double t, double *x) {
         if (!shear(x)) fail_nonfinite();
         return;
     }
+    if (rotation_ && rotate(t, x)) return;
     scale_entries();
     switch (path_) {
         case ExpmPath::Plane: apply_plane(t, x); return;
@@ -583,37 +596,52 @@ void SparseExponential::apply_scalings(double *x) {
 // (m00 + m11 < 0) the shears of -M are applied and x negated. A rotation
 // [[0, b], [-b, 0]] takes a = c = tan(b / 2) (or -cot(b / 2)) and m10 = -sin b
 // from the half angle's sine and cosine.
-void SparseExponential::apply_shears(const double A[4], double x0, double x1, double *x) {
-    double first, lower, last;
-    bool turned;
-    if (A[0] == 0.0 && A[2] == -A[1]) {
-        const double sine = std::sin(0.5 * A[1]), cosine = std::cos(0.5 * A[1]);
-        turned = std::fabs(cosine) < std::fabs(sine);
-        first = last = turned ? -cosine / sine : sine / cosine;
-        lower = turned ? 2.0 * sine * cosine : -2.0 * sine * cosine;
-    } else {
-        // M = C I + S N, N = [[p, b], [c, -p]], N^2 = -r^2 I, C = cos r, S =
-        // sin r / r, in half angles h = r / 2 (no difference of nearly equal
-        // values, where (2 + m00 - 1) / m10, near a half turn, had lost every
-        // digit: 3.8e-2 wrong at r = pi): (m00 - 1) / m10 = (p cos h - r sin
-        // h) / (c cos h) and, for -M, (m00 + 1) / m10 = (r cos h + p sin h) /
-        // (c sin h); m10 = 2 sin h cos h c / r.
-        const double p = A[0], c = A[2], r = std::sqrt(-(p * p + A[1] * c));
-        const double sine = std::sin(0.5 * r), cosine = std::cos(0.5 * r);
-        turned = std::fabs(cosine) < std::fabs(sine);
-        lower = (turned ? -2.0 : 2.0) * sine * cosine * c / r;
-        first = turned ? (r * cosine + p * sine) / (c * sine) : (p * cosine - r * sine) / (c * cosine);
-        last = turned ? (r * cosine - p * sine) / (c * sine) : (-p * cosine - r * sine) / (c * cosine);
-    }
-    double y0 = x0 + last * x1;
-    const double y1 = x1 + lower * y0;
-    y0 = y0 + first * y1;
-    const double z0 = turned ? -y0 : y0, z1 = turned ? -y1 : y1;
+SparseExponential::Shears SparseExponential::rotation_shears(double b) {
+    const double sine = std::sin(0.5 * b), cosine = std::cos(0.5 * b);
+    const bool turned = std::fabs(cosine) < std::fabs(sine);
+    const double outer = turned ? -cosine / sine : sine / cosine;
+    return {outer, turned ? 2.0 * sine * cosine : -2.0 * sine * cosine, outer, turned};
+}
+
+SparseExponential::Shears SparseExponential::elliptic_shears(const double A[4]) {
+    if (A[0] == 0.0 && A[2] == -A[1]) return rotation_shears(A[1]);
+    // M = C I + S N, N = [[p, b], [c, -p]], N^2 = -r^2 I, C = cos r, S =
+    // sin r / r, in half angles h = r / 2 (no difference of nearly equal
+    // values, where (2 + m00 - 1) / m10, near a half turn, had lost every
+    // digit: 3.8e-2 wrong at r = pi): (m00 - 1) / m10 = (p cos h - r sin
+    // h) / (c cos h) and, for -M, (m00 + 1) / m10 = (r cos h + p sin h) /
+    // (c sin h); m10 = 2 sin h cos h c / r.
+    const double p = A[0], c = A[2], r = std::sqrt(-(p * p + A[1] * c));
+    const double sine = std::sin(0.5 * r), cosine = std::cos(0.5 * r);
+    const bool turned = std::fabs(cosine) < std::fabs(sine);
+    return {turned ? (r * cosine + p * sine) / (c * sine) : (p * cosine - r * sine) / (c * cosine),
+            (turned ? -2.0 : 2.0) * sine * cosine * c / r,
+            turned ? (r * cosine - p * sine) / (c * sine) : (-p * cosine - r * sine) / (c * cosine),
+            turned};
+}
+
+void SparseExponential::apply_shears(const Shears &M, double x0, double x1, double *x) {
+    double y0 = x0 + M.last * x1;
+    const double y1 = x1 + M.lower * y0;
+    y0 = y0 + M.first * y1;
+    const double z0 = M.turned ? -y0 : y0, z1 = M.turned ? -y1 : y1;
     increment_[0] = z0 - x0;  // only to name a non-finite component
     increment_[1] = z1 - x1;
     if (!std::isfinite(z0) || !std::isfinite(z1)) fail_nonfinite();
     x[moved_[0]] = z0;
     x[moved_[1]] = z1;
+}
+
+// The rotation's flow without forming t A: the operations apply_plane takes
+// for it (the same bits), in a third of its instructions. false, nothing
+// done, where b^2 underflows (apply_plane's delta is then 0, not < 0, and it
+// takes another path).
+bool SparseExponential::rotate(double t, double *x) {
+    const double b = rotation_coefficient_ * times_[rotation_parameter_];
+    if (!(b * b > 0.0)) return false;
+    check_norm(std::fabs(b), t);
+    apply_shears(rotation_shears(b), x[moved_[0]], x[moved_[1]], x);
+    return true;
 }
 
 void SparseExponential::apply_plane(double t, double *x) {
@@ -632,7 +660,7 @@ void SparseExponential::apply_plane(double t, double *x) {
     const double tau = 0.5 * (A[0] + A[3]), p = 0.5 * (A[0] - A[3]);
     const double delta = p * p + A[1] * A[2];
     if (tau == 0.0 && delta < 0.0) {
-        apply_shears(A, x0, x1, x);
+        apply_shears(elliptic_shears(A), x0, x1, x);
         return;
     }
     const bool apart = delta > 0.0 && std::sqrt(delta) > kIncrementFormLimit;
