@@ -633,7 +633,7 @@ void SparseExponential::apply_shears(const Shears &M, double x0, double x1, doub
 }
 
 // The rotation's flow without forming t A: the operations apply_plane takes
-// for it (the same bits), in a third of its instructions. false, nothing
+// for it (the same bits), in less than half its instructions. false, nothing
 // done, where b^2 underflows (apply_plane's delta is then 0, not < 0, and it
 // takes another path).
 bool SparseExponential::rotate(double t, double *x) {
