@@ -6,7 +6,9 @@
 #   make abi-baseline   rewrite abi/ from this build (an intended ABI change)
 #   make check-asan      every test under AddressSanitizer + UBSan (build-asan)
 #   make check-tsan      the threads test under ThreadSanitizer (build-tsan)
-#   make check-clang     the threads test built by Clang with libomp (build-clang)
+#   make check-clang     the threads test built by Clang with libomp (build-clang),
+#                        and in hosts of the other compiler and runtime than
+#                        the library's (tests/check_mixed_openmp.sh)
 #   make check-valgrind  the cmocka tests under valgrind, no leaks allowed
 #   make check-build-alone  with cmocka hidden: -DBUILD_TESTING=OFF builds the
 #                        library, lpi and the bindings (build-alone)
@@ -100,12 +102,15 @@ check-tsan: deps
 # runtime (src/core/threads.cpp: the thread probe, fork) differ from libgomp's:
 # the threads test (build-clang). Needs clang and libomp-dev
 # (scripts/install-deps --ci).
-check-clang: deps
+check-clang: build
 	@cmake -S . -B build-clang -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ $(OUTPUT_ARGS) $(CMAKE_ARGS) $(STATUS_OUT)
 	@grep -q 'LPI_HAVE_OPENMP 1' build-clang/generated/lpi_config.h || \
 	    { echo "check-clang: clang found no OpenMP runtime (apt-get install libomp-dev)"; exit 1; }
 	@cmake --build build-clang -j $(JOBS) $(BUILD_ARGS) --target test_threads
 	@cd build-clang && ctest --output-on-failure -R '^test_threads$$'
+	@tests/check_mixed_openmp.sh $(BUILD) build-clang >build-clang/check_mixed_openmp.log 2>&1 || \
+	    { cat build-clang/check_mixed_openmp.log; exit 1; }
+	@grep '^check_mixed_openmp' build-clang/check_mixed_openmp.log
 
 # The cmocka tests of $(BUILD) under valgrind, $(JOBS) at a time
 # (tests/check_valgrind.sh). VALGRIND_SKIP leaves out the

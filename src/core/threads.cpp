@@ -12,6 +12,7 @@
 #include "error.hpp"
 #include "lpi_config.h"
 
+#include <dlfcn.h>
 #include <pthread.h>
 
 #if LPI_HAVE_OPENMP
@@ -42,19 +43,47 @@ void check_thread_count(int n) {
 namespace {
 
 #if LPI_HAVE_OPENMP
+// The runtime the library's OpenMP calls are bound to is the one that
+// counts, not the one it was compiled for: a GCC build calls GOMP_parallel,
+// which LLVM's libomp and Intel's libiomp5 also define, and a host program
+// built with Clang's -fopenmp (or one that loaded libiomp5 first) binds the
+// library's calls to its own runtime. There libomp's thread stacks and
+// fork(2) apply, and with libgomp's the probe passed where libomp then
+// ended the process ("OMP: Error #34").
+using StackSizeQuery = std::size_t (*)();
 #if defined(KMP_VERSION_MAJOR)
-// LLVM's (or Intel's) runtime, libomp: its own stack size (KMP_STACKSIZE,
-// OMP_STACKSIZE, else its default), plus 128 bytes for each global thread
-// number below the worker's (KMP_STACKOFFSET, doubled). The probe asks a
-// MiB more, enough for 8192 thread numbers: a thread stack that glibc keeps
-// cached after the probe serves only a request no larger than itself, and a
-// probe that passed on cached stacks the runtime cannot use would not stop
-// libomp from ending the process.
-std::size_t openmp_stack_size() { return kmp_get_stacksize_s() + (std::size_t{1} << 20); }
+// A Clang build calls __kmpc_* entries, which only libomp's kind defines.
+StackSizeQuery kmp_stack_size_query() { return &kmp_get_stacksize_s; }
 #else
-// The stack size libgomp gives its threads: OMP_STACKSIZE, else
-// GOMP_STACKSIZE ("<number>[B|K|M|G]", kilobytes by default), read once as
-// libgomp does when it loads; 0 when neither is set (default attributes).
+// kmp_get_stacksize_s of the object that defines the omp_get_num_procs the
+// library is bound to (dladdr of its address, the bound definition), or
+// nullptr: libgomp, which has none. Found when the library is loaded, so
+// that the fork handler below reads a value and calls nothing.
+StackSizeQuery find_kmp_stack_size_query() {
+    Dl_info info;
+    if (!dladdr(reinterpret_cast<void *>(&omp_get_num_procs), &info) || !info.dli_fname) return nullptr;
+    void *runtime = dlopen(info.dli_fname, RTLD_LAZY | RTLD_NOLOAD);
+    if (!runtime) return nullptr;
+    void *query = dlsym(runtime, "kmp_get_stacksize_s");
+    dlclose(runtime);  // the reference RTLD_NOLOAD took; the runtime stays loaded
+    return reinterpret_cast<StackSizeQuery>(query);
+}
+const StackSizeQuery kmp_query = find_kmp_stack_size_query();
+StackSizeQuery kmp_stack_size_query() { return kmp_query; }
+#endif
+bool kmp_runtime() { return kmp_stack_size_query() != nullptr; }
+
+// libomp (or libiomp5): its own stack size (KMP_STACKSIZE, OMP_STACKSIZE,
+// else its default), plus 128 bytes for each global thread number below the
+// worker's (KMP_STACKOFFSET, doubled). The probe asks a MiB more, enough for
+// 8192 thread numbers: a thread stack that glibc keeps cached after the
+// probe serves only a request no larger than itself, and a probe that
+// passed on cached stacks the runtime cannot use would not stop libomp from
+// ending the process.
+//
+// libgomp: OMP_STACKSIZE, else GOMP_STACKSIZE ("<number>[B|K|M|G]",
+// kilobytes by default), read once as libgomp does when it loads; 0 when
+// neither is set (default attributes).
 std::size_t parse_stack_size(const char *text) {
     if (!text) return 0;
     while (std::isspace(static_cast<unsigned char>(*text))) ++text;
@@ -75,13 +104,13 @@ std::size_t parse_stack_size(const char *text) {
 }
 
 std::size_t openmp_stack_size() {
+    if (const StackSizeQuery kmp = kmp_stack_size_query()) return kmp() + (std::size_t{1} << 20);
     static const std::size_t size = [] {
         const std::size_t omp = parse_stack_size(std::getenv("OMP_STACKSIZE"));
         return omp ? omp : parse_stack_size(std::getenv("GOMP_STACKSIZE"));
     }();
     return size;
 }
-#endif
 #endif
 
 // Probe threads wait until every one of them exists: an exited thread no
@@ -167,11 +196,10 @@ thread_local int ready = 1;
 // threads, which the probe is to check first.
 thread_local bool pool_lost = false;
 void forget_pool_in_child() {
-#if defined(KMP_VERSION_MAJOR)
-    ready = 1;
-#else
-    if (ready > 1) pool_lost = true;
-#endif
+    if (kmp_runtime())
+        ready = 1;
+    else if (ready > 1)
+        pool_lost = true;
 }
 [[maybe_unused]] const int fork_handler = pthread_atfork(nullptr, nullptr, forget_pool_in_child);
 
