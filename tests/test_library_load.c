@@ -3,12 +3,31 @@
  * thread per further processor when it is loaded, and under a process limit
  * printed and ended every program that merely linked the library). The
  * threads are counted before anything else runs (/proc/self/task); then the
- * spectrum that loads LAPACK is computed. */
+ * spectrum that loads LAPACK is computed. With the argument "thread-limit"
+ * (test_library_load_thread_limit): in a child process whose address space
+ * has no room for another thread's stack, the spectrum that would load
+ * LAPACK must fail with LPI_ERR_NO_MEMORY, the threads refused by the
+ * library's own check, whatever LAPACK it was built against (a threaded
+ * OpenBLAS, which liblapack.so.3 may be, would end or hang the process). */
+#define _GNU_SOURCE
 #include <dirent.h>
+#include <sched.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <liepoisson.h>
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define UNDER_A_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define UNDER_A_SANITIZER 1
+#endif
+#endif
 
 static int thread_count(void) {
     DIR *tasks = opendir("/proc/self/task");
@@ -19,7 +38,98 @@ static int thread_count(void) {
     return n;
 }
 
-int main(void) {
+/* The Casimir spectrum of a sine-Euler field, N = 5 (LAPACK's zheevd). */
+static int spectrum_status(char *message, size_t size) {
+    lpi_system *sys = NULL;
+    if (lpi_sine_euler_create(&sys, 5) != LPI_OK) return LPI_ERR_UNSUPPORTED; /* no FFTW */
+    double x[25] = {0.0, 1.0, 0.5, -0.25};
+    double spectrum[5];
+    const int status = lpi_set_state(sys, x, 25) == LPI_OK ? lpi_casimirs(sys, spectrum, 5) : -1;
+    snprintf(message, size, "%s", status == LPI_OK ? "computed" : lpi_last_error(sys));
+    lpi_destroy(sys);
+    return status;
+}
+
+/* In a child: 0 when the spectrum is refused with LPI_ERR_NO_MEMORY for the
+ * threads LAPACK may start, 77 where nothing can be checked, else 1 .. 3. */
+static int spectrum_under_a_thread_limit(void) {
+    /* As OpenBLAS counts them, without the variables that ask it for fewer. */
+    unsetenv("OPENBLAS_NUM_THREADS");
+    unsetenv("GOTO_NUM_THREADS");
+    unsetenv("OMP_NUM_THREADS");
+    FILE *f = fopen("/proc/self/statm", "r");
+    unsigned long pages = 0;
+    if (!f || fscanf(f, "%lu", &pages) != 1) return 77;
+    fclose(f);
+    struct rlimit low;
+    if (getrlimit(RLIMIT_AS, &low) != 0) return 77;
+    /* Room for FFTW's plans of the matrix form (the library asks 4 MiB for
+     * them first), none for a thread's stack (8 MiB by default). */
+    low.rlim_cur = (rlim_t)pages * (rlim_t)sysconf(_SC_PAGESIZE) + (6u << 20);
+    if (setrlimit(RLIMIT_AS, &low) != 0) return 77;
+    char message[1024];
+    const int status = spectrum_status(message, sizeof message);
+    printf("under a low address-space limit, the Casimir spectrum: %s\n", message);
+    fflush(stdout);
+    /* Without LAPACK in the build: nothing to load. A LAPACK that could not
+     * be loaded under the limit was not checked for its threads first. */
+    if (status == LPI_ERR_UNSUPPORTED && !strstr(message, "cannot be loaded")) return 77;
+    if (status != LPI_ERR_NO_MEMORY) return 1;
+    if (!strstr(message, "refused to start thread")) return 2;
+    if (!strstr(message, "OPENBLAS_NUM_THREADS=1")) return 3;
+    return 0;
+}
+
+/* The spectrum under a thread limit, in a child: 0 passed, 77 skipped (the
+ * reason printed), 1 failed. */
+static int check_thread_limit(void) {
+#ifdef UNDER_A_SANITIZER
+    printf("skipped: a low address-space limit does not mix with a sanitizer\n");
+    return 77;
+#else
+    cpu_set_t set;
+    const int processors = sched_getaffinity(0, sizeof set, &set) == 0 ? CPU_COUNT(&set) : 1;
+    const char *preload = getenv("LD_PRELOAD");
+    struct rlimit stack;
+    const int small_stacks = getrlimit(RLIMIT_STACK, &stack) == 0 && stack.rlim_cur != RLIM_INFINITY &&
+                             stack.rlim_cur < (7u << 20);
+    if (processors < 2) {
+        printf("skipped: one processor, no thread to refuse\n");
+        return 77;
+    }
+    if (small_stacks) {
+        printf("skipped: thread stacks of %lu bytes (ulimit -s) fit in the room left for FFTW's plans\n",
+               (unsigned long)stack.rlim_cur);
+        return 77;
+    }
+    if (preload && strstr(preload, "vgpreload")) {
+        printf("skipped: a low address-space limit does not mix with valgrind\n");
+        return 77;
+    }
+    fflush(stdout);
+    const pid_t child = fork();
+    if (child < 0) return 1;
+    if (child == 0) _exit(spectrum_under_a_thread_limit());
+    int status = 0;
+    if (waitpid(child, &status, 0) != child) return 1;
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 77) {
+        printf("skipped: no LAPACK in this build, or no limit could be set\n");
+        return 77;
+    }
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        printf("FAILED: under a low address-space limit the child %s %d\n",
+               WIFEXITED(status) ? "failed check" : "was killed by signal",
+               WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
+        return 1;
+    }
+    return 0;
+#endif
+}
+
+/* No argument: loading starts no thread. "thread-limit": the spectrum under
+ * a thread limit (a process of its own, as LAPACK must not be loaded yet). */
+int main(int argc, char **argv) {
+    if (argc > 1 && strcmp(argv[1], "thread-limit") == 0) return check_thread_limit();
     const int threads = thread_count();
     if (threads < 0 || sysconf(_SC_NPROCESSORS_ONLN) < 2) {
         printf("skipped: %s\n", threads < 0 ? "no /proc/self/task to count threads in"
@@ -31,15 +141,9 @@ int main(void) {
         printf("FAILED: loading the library started %d threads\n", threads - 1);
         return 1;
     }
-    lpi_system *sys = NULL;
-    if (lpi_sine_euler_create(&sys, 5) == LPI_OK) {
-        double x[25] = {0.0, 1.0, 0.5, -0.25};
-        double spectrum[5];
-        const int status = lpi_set_state(sys, x, 25) == LPI_OK ? lpi_casimirs(sys, spectrum, 5) : -1;
-        printf("the Casimir spectrum, which loads LAPACK: %s\n",
-               status == LPI_OK ? "computed" : lpi_last_error(sys));
-        lpi_destroy(sys);
-        if (status != LPI_OK && status != LPI_ERR_UNSUPPORTED) return 1;
-    }
+    char message[1024];
+    const int status = spectrum_status(message, sizeof message);
+    printf("the Casimir spectrum, which loads LAPACK: %s\n", message);
+    if (status != LPI_OK && status != LPI_ERR_UNSUPPORTED) return 1;
     return 0;
 }

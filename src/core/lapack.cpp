@@ -33,10 +33,12 @@ struct Routines {
 // process may run on, or per thread its environment asks for (the first of
 // OPENBLAS_NUM_THREADS, GOTO_NUM_THREADS, OMP_NUM_THREADS set to a positive
 // number, as OpenBLAS reads them), at most one per processor, less the
-// calling thread. Another LAPACK starts none; counting them all the same
-// only asks the system for threads it will give back at once.
+// calling thread. Counted whatever LAPACK the library was built against:
+// which one a name such as liblapack.so.3 loads is the system's choice when
+// the library runs (Debian's alternatives), and OpenBLAS's is one of them.
+// Another LAPACK starts none, and the count only asks the system for threads
+// it gives back at once.
 int threads_started_on_loading() {
-    if (std::string(LPI_LAPACK_LIBRARY).find("openblas") == std::string::npos) return 0;
     cpu_set_t set;
     const int processors = sched_getaffinity(0, sizeof set, &set) == 0 ? CPU_COUNT(&set) : 1;
     int asked = 0;
@@ -53,7 +55,9 @@ const Routines &routines() {
     std::lock_guard<std::mutex> lock(mutex);
     if (loaded.zheevd) return loaded;
     const std::string name = LPI_LAPACK_LIBRARY;
-    require_threads_can_start(threads_started_on_loading(), "loading " + name);
+    require_threads_can_start(threads_started_on_loading(), "loading " + name,
+                              "a threaded OpenBLAS starts them as it loads, and ends the process where it "
+                              "cannot; OPENBLAS_NUM_THREADS=1 asks for none");
     void *library = ::dlopen(name.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (!library) {
         const char *why = ::dlerror();

@@ -171,13 +171,15 @@ std::string thread_limit_text(int error) {
 
 }  // namespace
 
-void require_threads_can_start(int count, const std::string &for_what) {
+void require_threads_can_start(int count, const std::string &for_what, const std::string &advice) {
     if (count < 1) return;
     int failed = 0;
     if (const int error = probe_threads(count, 0, &failed))
         fail(LPI_ERR_NO_MEMORY, for_what + " needs " + std::to_string(count) +
-                                    " threads, and the system refused to start thread " +
-                                    std::to_string(failed + 1) + thread_limit_text(error));
+                                    (count == 1 ? " thread" : " threads") +
+                                    ", and the system refused to start thread " +
+                                    std::to_string(failed + 1) + thread_limit_text(error) + "; " +
+                                    advice);
 }
 
 #if LPI_HAVE_OPENMP

@@ -30,7 +30,8 @@ void prepare_thread_team(int n);
 // Starts `count` threads (default stack size) that all exist at once and
 // joins them: for a library that starts as many when it is loaded, and ends
 // the process when the system refuses one (a threaded OpenBLAS). Throws
-// LPI_ERR_NO_MEMORY, saying that for_what needs them, when the system refuses.
-void require_threads_can_start(int count, const std::string &for_what);
+// LPI_ERR_NO_MEMORY, saying that for_what needs them, when the system refuses,
+// with `advice` (what starts them, how to ask for fewer) at the end.
+void require_threads_can_start(int count, const std::string &for_what, const std::string &advice);
 
 }  // namespace lpi
