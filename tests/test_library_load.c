@@ -50,6 +50,7 @@ static int spectrum_status(char *message, size_t size) {
     return status;
 }
 
+#ifndef UNDER_A_SANITIZER
 /* In a child: 0 when the spectrum is refused with LPI_ERR_NO_MEMORY for the
  * threads LAPACK may start, 77 where nothing can be checked, else 1 .. 3. */
 static int spectrum_under_a_thread_limit(void) {
@@ -79,6 +80,7 @@ static int spectrum_under_a_thread_limit(void) {
     if (!strstr(message, "OPENBLAS_NUM_THREADS=1")) return 3;
     return 0;
 }
+#endif
 
 /* The spectrum under a thread limit, in a child: 0 passed, 77 skipped (the
  * reason printed), 1 failed. */
