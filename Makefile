@@ -100,7 +100,9 @@ check-tsan: deps
 
 # Clang with LLVM's OpenMP runtime, libomp, where the library's guards of the
 # runtime (src/core/threads.cpp: the thread probe, fork) differ from libgomp's:
-# the threads test (build-clang). Needs clang and libomp-dev
+# the threads test (build-clang), then in hosts built by the other compiler,
+# each with its own runtime (tests/check_mixed_openmp.sh: a Clang host's
+# libomp takes the GCC build's OpenMP calls). Needs clang and libomp-dev
 # (scripts/install-deps --ci).
 check-clang: build
 	@cmake -S . -B build-clang -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ $(OUTPUT_ARGS) $(CMAKE_ARGS) $(STATUS_OUT)
