@@ -370,8 +370,9 @@ void test_rotation_takes_the_plane_bits(void **) {
             }
         // Refusals: the same status and message, x untouched.
         const std::vector<double> edge = {1.5e308, 1.5e308, 1.5e308, 1.5e308};
-        // Too large a step, not a number, and 1.5e308 (cos + sin) > DBL_MAX.
-        const double refused[] = {1e11, std::nan(""), 0.5 / std::fabs(c)};
+        // Too large a step, an infinite one (the message names t), not a
+        // number, and 1.5e308 (cos + sin) > DBL_MAX.
+        const double refused[] = {1e11, INFINITY, std::nan(""), 0.5 / std::fabs(c)};
         for (const double g : refused) {
             const double g_twice[2] = {g, g};
             std::string first, second;
