@@ -244,14 +244,33 @@ for format in $formats; do
     "$lpi" "$@" --steps 1000000000 --out "$out/killed" --checkpoint "$out/killed.lpi" \
         --checkpoint-every 1 >/dev/null 2>&1 &
     pid=$!  # lpi's own (SIGKILL to a wrapper such as timeout would leave lpi running)
-    waited=0
-    until [ "$(cat "$out/killed/rigid-body.csv" 2>/dev/null | wc -l)" -ge 6 ] || [ $waited -ge 600 ]; do
-        sleep 0.05; waited=$((waited + 1))
-    done
+    rows_at_least() {
+        waited=0
+        until [ "$(cat "$out/killed/rigid-body.csv" 2>/dev/null | wc -l)" -ge "$1" ] || [ $waited -ge 600 ]; do
+            sleep 0.05; waited=$((waited + 1))
+        done
+    }
+    # The files a checkpoint writes grow in place (a whole rewrite at each
+    # checkpoint made n rows cost n^2): a hard link taken early names the
+    # same file, grown, at the end.
+    rows_at_least 3
+    grown="$out/killed/rigid-body.csv"; [ "$format" = h5 ] || grown="$grown $out/killed/rigid-body/state.npy"
+    for f in $grown; do ln -f "$f" "$f.early"; done
+    rows_at_least 6
     kill -KILL $pid 2>/dev/null || true
     wait $pid 2>/dev/null || true
+    for f in $grown; do
+        [ "$f" -ef "$f.early" ] || fail "SIGKILL ($format): $f was replaced at a checkpoint, not grown in place"
+        rm -f "$f.early"
+    done
     stop=$(tail -n 1 "$out/killed/rigid-body.csv" | cut -d, -f1)
     [ "$stop" -ge 400000 ] || fail "SIGKILL: the run was not killed mid-run (last row at step $stop)"
+    # A kill within a growth leaves bytes past what the files account for (a
+    # line cut short, values past an array's header): resumed, they go.
+    printf '%s' "$((stop + 100000)),4" >>"$out/killed/rigid-body.csv"
+    for f in "$out/killed/rigid-body/"*.npy "$out/killed/rigid-body.h5-pending/"*.npy; do
+        [ ! -f "$f" ] || printf 'cut' >>"$f"
+    done
     "$lpi" "$@" --steps $((stop + 300000)) --out "$out/killed" --checkpoint "$out/killed.lpi" \
         --checkpoint-every 1 --resume "$out/killed.lpi" >"$out/stdout"
     ! grep -q "no data there" "$out/stdout" || { cat "$out/stdout"; fail "SIGKILL ($format): no data left"; }
@@ -305,21 +324,30 @@ cmp -s "$out/mixed-ref/rigid-body.csv" "$out/mixed/rigid-body.csv" &&
 # file size limit, the CSV still within it) stops the run as a CSV does,
 # leaving the data of the last checkpoint: resumed, the run is the
 # uninterrupted one.
+# With HDF5 the file is the one that grows past the limit (its journal of
+# the snapshots since its last whole write holds at most as many): resumed
+# from the file and its journal, the run is the uninterrupted one.
 if [ "$have_se" = 1 ]; then
-    rm -rf "$out/dck" "$out/dck-ref" "$out/dck.lpi"
-    set -- run sine-euler --N 31 --every 1 --snapshots 1 --steps 8 --format npy
-    "$lpi" "$@" --out "$out/dck-ref" >/dev/null
-    rc=0; limited "$@" --out "$out/dck" --checkpoint "$out/dck.lpi" --checkpoint-every 1 \
-        >"$out/stdout" 2>"$out/stderr" || rc=$?
-    [ "$rc" -eq 1 ] && grep -q "vorticity.npy.*File too large" "$out/stderr" && ! grep -q "^done" "$out/stdout" ||
-        { cat "$out/stderr"; fail "data that cannot be written with a checkpoint: exit status $rc, expected 1 at once"; }
-    no_temporaries "$out/dck/sine-euler"
-    "$lpi" "$@" --out "$out/dck" --checkpoint "$out/dck.lpi" --checkpoint-every 1 --resume "$out/dck.lpi" \
-        >"$out/stdout"
-    ! grep -q "no data there" "$out/stdout" || { cat "$out/stdout"; fail "data stopped at a checkpoint: none left"; }
-    cmp -s "$out/dck-ref/sine-euler.csv" "$out/dck/sine-euler.csv" &&
-        diff -r "$out/dck-ref/sine-euler" "$out/dck/sine-euler" >/dev/null ||
-        fail "a run stopped by data it could not write, resumed: not the uninterrupted run"
+    for format in $formats; do
+        rm -rf "$out/dck" "$out/dck-ref" "$out/dck.lpi"
+        set -- run sine-euler --N 15 --every 1 --snapshots 1 --steps 24 --format $format
+        "$lpi" "$@" --out "$out/dck-ref" >/dev/null
+        rc=0; limited "$@" --out "$out/dck" --checkpoint "$out/dck.lpi" --checkpoint-every 1 \
+            >"$out/stdout" 2>"$out/stderr" || rc=$?
+        data=sine-euler.h5; grown=sine-euler.h5; [ "$format" = h5 ] || data=sine-euler grown=vorticity.npy
+        [ "$rc" -eq 1 ] && grep -q "$grown.*File too large" "$out/stderr" && ! grep -q "^done" "$out/stdout" ||
+            { cat "$out/stderr"; fail "data that cannot be written with a checkpoint ($format): exit status $rc, expected 1 at once"; }
+        no_temporaries "$out/dck"
+        [ "$format" = npy ] || [ -f "$out/dck/sine-euler.h5-pending/vorticity.npy" ] ||
+            fail "HDF5 data that cannot be written whole: no journal of the snapshots since left"
+        "$lpi" "$@" --out "$out/dck" --checkpoint "$out/dck.lpi" --checkpoint-every 1 --resume "$out/dck.lpi" \
+            >"$out/stdout"
+        ! grep -q "no data there" "$out/stdout" || { cat "$out/stdout"; fail "data stopped at a checkpoint: none left"; }
+        [ ! -e "$out/dck/sine-euler.h5-pending" ] || fail "a run ended with its HDF5 journal left"
+        cmp -s "$out/dck-ref/sine-euler.csv" "$out/dck/sine-euler.csv" &&
+            diff -r "$out/dck-ref/$data" "$out/dck/$data" >/dev/null ||
+            fail "a run stopped by data it could not write ($format), resumed: not the uninterrupted run"
+    done
 fi
 
 # --checkpoint: refused up front when it cannot work or would overwrite an

@@ -192,26 +192,26 @@ std::string npy_header(const Array &a) {
     return header + dict;
 }
 
-std::string npy_file(const Array &a) {
-    std::string file = npy_header(a);
-    const std::size_t at = file.size();
-    file.resize(at + 8 * a.values.size());
-    for (std::size_t i = 0; i < a.values.size(); ++i) {
+std::string npy_values(const std::vector<double> &values, bool integer, std::size_t from, std::size_t to) {
+    std::string bytes(8 * (to - from), '\0');
+    for (std::size_t i = from; i < to; ++i) {
         std::uint64_t bits;
-        if (a.integer) {
-            bits = static_cast<std::uint64_t>(static_cast<std::int64_t>(a.values[i]));
+        if (integer) {
+            bits = static_cast<std::uint64_t>(static_cast<std::int64_t>(values[i]));
         } else {
-            std::memcpy(&bits, &a.values[i], 8);
+            std::memcpy(&bits, &values[i], 8);
         }
-        put_le(bits, reinterpret_cast<unsigned char *>(&file[at + 8 * i]));
+        put_le(bits, reinterpret_cast<unsigned char *>(&bytes[8 * (i - from)]));
     }
-    return file;
+    return bytes;
 }
+
+std::string npy_file(const Array &a) { return npy_header(a) + npy_values(a.values, a.integer, 0, a.values.size()); }
 
 namespace {
 
 // read_npy of an opened file.
-std::string parse_npy(RegularFileReader &f, Array &a) {
+std::string parse_npy(RegularFileReader &f, Array &a, bool tail_allowed) {
     unsigned char start[12];
     if (f.read(start, 10) != 10 || std::memcmp(start, "\x93NUMPY", 6) != 0)
         return "not a NumPy .npy file (no \\x93NUMPY magic)";
@@ -253,7 +253,7 @@ std::string parse_npy(RegularFileReader &f, Array &a) {
     if (f.read(bytes.data(), bytes.size()) != bytes.size())
         return "truncated: the data is shorter than its shape says";
     unsigned char extra;
-    if (f.read(&extra, 1) != 0) return "bytes after the data its shape says";
+    if (!tail_allowed && f.read(&extra, 1) != 0) return "bytes after the data its shape says";
     out.values.resize(count);
     for (std::size_t i = 0; i < count; ++i) {
         const std::uint64_t bits = get_le(&bytes[i * item], item);
@@ -287,11 +287,11 @@ std::string parse_npy(RegularFileReader &f, Array &a) {
 
 }  // namespace
 
-std::string read_npy(const std::string &path, Array &a) {
+std::string read_npy(const std::string &path, Array &a, bool tail_allowed) {
     std::string why;
     const std::string unreadable = failure_of([&] {
         RegularFileReader f(path);
-        why = parse_npy(f, a);
+        why = parse_npy(f, a, tail_allowed);
     });
     return unreadable.empty() ? why : unreadable;
 }

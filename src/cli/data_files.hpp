@@ -30,10 +30,17 @@ std::string npy_header(const Array &a);
 // The bytes of `a` as a .npy file: its header, then the values.
 std::string npy_file(const Array &a);
 
+// The bytes of values [from, to), as npy_file stores them (64-bit integers
+// where `integer`, else doubles, little-endian).
+std::string npy_values(const std::vector<double> &values, bool integer, std::size_t from, std::size_t to);
+
 // Reads a .npy file (format 1.0, 2.0 or 3.0) of little-endian float64,
 // float32, int64 or int32, in C or Fortran order, into C order. Returns "" or
-// what is wrong with the file.
-std::string read_npy(const std::string &path, Array &a);
+// what is wrong with the file. Bytes after the values its shape says are
+// refused, unless `tail_allowed` (data lpi grows in place: the tail of a
+// growth that a kill cut short, before the header took the new length;
+// NumPy reads past it too).
+std::string read_npy(const std::string &path, Array &a, bool tail_allowed = false);
 
 // One dataset of an HDF5 file. `dims` names, per axis, the dataset that is the
 // dimension scale of that axis ("" for none); a dataset that is itself a

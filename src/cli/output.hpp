@@ -15,6 +15,8 @@
 
 namespace lpi_cli {
 
+using lpi::FileGrowth;
+using lpi::FileIdentity;
 using lpi::FileReplacement;
 using lpi::RegularFileReader;
 
@@ -35,6 +37,24 @@ std::string failure_of(Write &&write) {
 inline std::string write_output(const std::string &path, const std::string &text) {
     return failure_of([&] {
         lpi::write_file_atomically(path, reinterpret_cast<const unsigned char *>(text.data()), text.size());
+    });
+}
+
+// A file that only ever gains bytes at its end (a CSV's rows): grown in place
+// by `tail` where it is the file lpi left (`written`, FileGrowth), else
+// replaced whole by `whole()`; `written` then describes it. "" or why not
+// (the file then keeps its old contents).
+template <class Whole>
+std::string grow_output(const std::string &path, FileIdentity &written, const std::string &tail, Whole &&whole) {
+    return failure_of([&] {
+        FileGrowth growth(path, written);
+        if (growth.possible()) {
+            growth.append(reinterpret_cast<const unsigned char *>(tail.data()), tail.size());
+            written = growth.commit();
+            return;
+        }
+        const std::string text = whole();
+        written = lpi::write_file_atomically(path, reinterpret_cast<const unsigned char *>(text.data()), text.size());
     });
 }
 

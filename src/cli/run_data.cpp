@@ -1,6 +1,8 @@
 #include "run_data.hpp"
 
+#include <dirent.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -65,15 +67,33 @@ std::vector<Dataset> datasets_of(const RunData &d) {
 }
 
 
-// One array of a run's earlier data, in this run's format.
+// One array of a run's earlier data, in this run's format: for HDF5, the
+// file's and, after it, its journal's (when the journal continues the file:
+// its base is the rows, or snapshots, the file's array holds).
 std::string read_data_array(const RunOptions &o, const std::string &name, Array &a) {
     const std::string path = data_path(o);
-    if (o.format == "npy") {
-        const std::string why = read_npy(path + "/" + name + ".npy", a);
+    auto read_grown = [](const std::string &file, const std::string &name, Array &a) {
+        const std::string why = read_npy(file, a, /*tail_allowed=*/true);
         return why.empty() ? "" : name + ".npy: " + why;
-    }
+    };
+    if (o.format == "npy") return read_grown(path + "/" + name + ".npy", name, a);
     bool found = false;
-    return read_hdf5(path, name, a, &found);
+    std::string why = read_hdf5(path, name, a, &found);
+    const std::string journal = journal_path(o);
+    struct stat st;
+    if (!why.empty() || a.shape.empty() || stat(journal.c_str(), &st) != 0) return why;
+    Array base, tail;
+    if (!read_grown(journal + "/base.npy", "base", base).empty() || base.values.size() != 2) return "";
+    const bool snapshots = name.compare(0, 9, "snapshot_") == 0 || name == "vorticity" || name == "state";
+    if (base.values[snapshots ? 1 : 0] != static_cast<double>(a.shape[0])) return "";  // not this file's
+    why = read_grown(journal + "/" + name + ".npy", journal_path(o) + "/" + name, tail);
+    if (!why.empty()) return why;
+    if (tail.shape.size() != a.shape.size() || !std::equal(a.shape.begin() + 1, a.shape.end(), tail.shape.begin() + 1))
+        return journal + "/" + name + ".npy: not shaped as " + path + "'s " + name;
+    if (a.values.size() + tail.values.size() > kMaxArrayValues) return name + ": more than 2^28 values";
+    a.shape[0] += tail.shape[0];
+    a.values.insert(a.values.end(), tail.values.begin(), tail.values.end());
+    return "";
 }
 
 }  // namespace
@@ -87,25 +107,208 @@ std::string data_path(const RunOptions &o) {
 std::vector<std::string> data_files(const RunOptions &o, const RunData &d) {
     if (o.format == "h5") return {data_path(o)};
     std::vector<std::string> files;
-    for (const Dataset &set : datasets_of(d)) files.push_back(data_path(o) + "/" + set.name + ".npy");
+    for (const Dataset &set : datasets_of(RunData::shaped_like(d))) files.push_back(data_path(o) + "/" + set.name + ".npy");
     files.push_back(data_path(o) + "/attributes.json");
     return files;
 }
 
+std::string journal_path(const RunOptions &o) { return data_path(o) + "-pending"; }
+
+namespace {
+
+// An array of the data that grows with the run (rows along "time",
+// snapshots along "snapshot_time"), seen where RunData holds it: a write
+// that adds the values since the last one copies nothing else.
+struct GrowingArray {
+    std::string name;
+    const std::vector<double> *values;
+    std::vector<std::size_t> row_shape;  // the shape of one row or snapshot
+    bool integer, snapshots;
+    std::size_t width() const {
+        std::size_t n = 1;
+        for (std::size_t k : row_shape) n *= k;
+        return n;
+    }
+};
+
+// datasets_of's growing arrays, by the same names.
+std::vector<GrowingArray> growing_arrays(const RunData &d) {
+    const std::vector<std::size_t> row = {}, casimirs = {d.casimir_count};
+    return {
+        {"time", &d.time, row, false, false},
+        {"step", &d.step, row, true, false},
+        {"energy", &d.energy, row, false, false},
+        {"energy_error", &d.energy_error, row, false, false},
+        {"casimirs", &d.casimirs, casimirs, false, false},
+        {"casimir_drift", &d.casimir_drift, row, false, false},
+        {"snapshot_time", &d.snapshot_time, row, false, true},
+        {"snapshot_step", &d.snapshot_step, row, true, true},
+        {d.vorticity ? "vorticity" : "state", &d.snapshots, d.snapshot_shape, false, true},
+    };
+}
+
+// The .npy header of `a` holding `count` rows or snapshots.
+std::string header_of(const GrowingArray &a, std::size_t count) {
+    Array shape;
+    shape.shape = {count};
+    shape.shape.insert(shape.shape.end(), a.row_shape.begin(), a.row_shape.end());
+    shape.integer = a.integer;
+    return npy_header(shape);
+}
+
+// Where a set of .npy files holds the rows and snapshots of `d` from
+// (first_row, first_shot) on: the run's data (both 0), or the journal of an
+// HDF5 file that holds those before them.
+struct NpyRange {
+    std::string dir;
+    std::size_t first_row = 0, first_shot = 0;
+    std::size_t rows(const RunData &d) const { return d.step.size() - first_row; }
+    std::size_t shots(const RunData &d) const { return d.snapshot_step.size() - first_shot; }
+};
+
+std::string array_file(const NpyRange &range, const GrowingArray &a) { return range.dir + "/" + a.name + ".npy"; }
+
+// The bytes of a's rows or snapshots [from, to) of the range.
+std::string values_of(const NpyRange &range, const GrowingArray &a, std::size_t from, std::size_t to) {
+    const std::size_t first = a.snapshots ? range.first_shot : range.first_row;
+    return npy_values(*a.values, a.integer, (first + from) * a.width(), (first + to) * a.width());
+}
+
+// Grows the .npy set that `set` describes by the rows and snapshots of `d`
+// since: every growing file is checked to be as it was left (FileGrowth),
+// its new values appended after the old and flushed, then each header
+// rewritten with the new length (the same size: a header is padded to 64
+// bytes, which the length's digits fit). false, nothing touched, where a
+// file is not as it was left or a header would change size: the set is then
+// replaced whole. A failure puts every file back and throws. A kill between
+// two files' headers leaves arrays of two writes, of different lengths, as
+// a kill between two renames of a whole write does.
+bool grow_npy_set(const NpyRange &range, const RunData &d, NpySet &set) {
+    const std::vector<GrowingArray> arrays = growing_arrays(d);
+    const std::size_t rows = range.rows(d), shots = range.shots(d);
+    if (set.files.size() != arrays.size() || set.rows > rows || set.shots > shots) return false;
+    std::vector<std::unique_ptr<FileGrowth>> growing;
+    std::vector<std::string> headers;
+    for (std::size_t i = 0; i < arrays.size(); ++i) {
+        const GrowingArray &a = arrays[i];
+        const std::size_t old_count = a.snapshots ? set.shots : set.rows, count = a.snapshots ? shots : rows;
+        growing.push_back(std::make_unique<FileGrowth>(array_file(range, a), set.files[i]));
+        const std::string old_header = header_of(a, old_count);
+        headers.push_back(header_of(a, count));
+        if (!growing.back()->possible() || old_header.size() != headers.back().size() ||
+            growing.back()->old_size() != old_header.size() + 8 * a.width() * old_count)
+            return false;
+    }
+    for (std::size_t i = 0; i < arrays.size(); ++i) {
+        const GrowingArray &a = arrays[i];
+        const std::string values = values_of(range, a, a.snapshots ? set.shots : set.rows, a.snapshots ? shots : rows);
+        growing[i]->append(reinterpret_cast<const unsigned char *>(values.data()), values.size());
+        growing[i]->sync();
+    }
+    for (std::size_t i = 0; i < arrays.size(); ++i) {
+        growing[i]->overwrite(0, reinterpret_cast<const unsigned char *>(headers[i].data()), headers[i].size());
+        growing[i]->sync();
+    }
+    for (std::size_t i = 0; i < arrays.size(); ++i) set.files[i] = growing[i]->commit();
+    set.rows = rows;
+    set.shots = shots;
+    return true;
+}
+
+// Replaces the files of a set as a whole: every file is written and flushed
+// beside its target first, and renamed into place only once all of them are,
+// so that a failed write leaves the old set, never old and new files mixed.
+// Only a kill between two renames can mix them: keep_snapshots then reads
+// what the two sets share, the rows and snapshots up to the checkpoint.
+// Records in `set` what the growing arrays' files are. Throws on failure.
+void replace_npy_set(const NpyRange &range, const RunData &d,
+                     const std::vector<std::pair<std::string, std::string>> &contents, NpySet &set) {
+    if (mkdir(range.dir.c_str(), 0777) != 0 && errno != EEXIST)
+        lpi::fail(LPI_ERR_IO, "cannot make the folder " + range.dir + ": " + std::strerror(errno));
+    std::vector<std::unique_ptr<FileReplacement>> replacing;
+    for (const auto &file : contents) {
+        replacing.push_back(std::make_unique<FileReplacement>(range.dir + "/" + file.first));
+        replacing.back()->write(reinterpret_cast<const unsigned char *>(file.second.data()), file.second.size());
+        replacing.back()->sync();
+    }
+    set = NpySet();
+    std::vector<FileIdentity> identities;
+    for (auto &file : replacing) identities.push_back(file->commit());
+    for (const GrowingArray &a : growing_arrays(d))
+        for (std::size_t i = 0; i < contents.size(); ++i)
+            if (contents[i].first == a.name + ".npy") set.files.push_back(identities[i]);
+    set.rows = range.rows(d);
+    set.shots = range.shots(d);
+}
+
+// The journal of an HDF5 file: the rows and snapshots after those the file
+// holds, as .npy files, with base.npy giving how many rows and snapshots the
+// HDF5 file holds that it continues (a journal left beside a later file, by
+// a kill between the file's rename and the journal's removal, is ignored).
+void write_journal(const NpyRange &range, const RunData &d, NpySet &set) {
+    if (grow_npy_set(range, d, set)) return;
+    std::vector<std::pair<std::string, std::string>> contents;
+    Array base;
+    base.shape = {2};
+    base.values = {static_cast<double>(range.first_row), static_cast<double>(range.first_shot)};
+    base.integer = true;
+    contents.push_back({"base.npy", npy_file(base)});
+    for (const GrowingArray &a : growing_arrays(d))
+        contents.push_back({a.name + ".npy", header_of(a, a.snapshots ? range.shots(d) : range.rows(d)) +
+                                                 values_of(range, a, 0, a.snapshots ? range.shots(d) : range.rows(d))});
+    replace_npy_set(range, d, contents, set);
+}
+
+// Removes the journal (after the HDF5 file that holds its rows is in
+// place). Best effort: one left behind is ignored, its base not the file's.
+void remove_journal(const std::string &dir) {
+    DIR *folder = opendir(dir.c_str());
+    if (!folder) return;
+    while (const dirent *entry = readdir(folder)) {
+        const std::string name = entry->d_name;
+        if (name != "." && name != "..") unlink((dir + "/" + name).c_str());
+    }
+    closedir(folder);
+    rmdir(dir.c_str());
+}
+
+std::size_t values_held(const RunData &d, std::size_t rows, std::size_t shots) {
+    std::size_t n = 0;
+    for (const GrowingArray &a : growing_arrays(d)) n += a.width() * (a.snapshots ? shots : rows);
+    return n;
+}
+
+}  // namespace
+
 std::string write_data(const RunOptions &o, const RunData &d, const std::vector<Attribute> &attributes,
-                       SnapshotBytes &bytes) {
-    const std::vector<Dataset> sets = datasets_of(d);
+                       WrittenData &written, bool final) {
     const std::string path = data_path(o);
-    // gnuplot, run in the output directory, reads the snapshots by this name.
-    const std::string in_out_dir = o.scene + (o.format == "h5" ? ".h5" : "/" + sets.back().name + ".npy");
+    const std::size_t rows = d.step.size(), shots = d.snapshot_step.size();
     if (o.format == "h5") {
+        // The file is written whole the first time, at the end, and once the
+        // rows and snapshots since its last write hold as many values as it
+        // does: n values cost at most 2n written so. In between they grow
+        // its journal in place.
+        const bool whole = final || !written.h5_written || written.h5_rows > rows || written.h5_shots > shots ||
+                           values_held(d, rows, shots) >= 2 * values_held(d, written.h5_rows, written.h5_shots);
+        const NpyRange journal{journal_path(o), written.h5_rows, written.h5_shots};
+        if (!whole) return failure_of([&] { write_journal(journal, d, written.npy); });
         std::vector<std::uint64_t> offsets;
+        const std::vector<Dataset> sets = datasets_of(d);
         const std::string why = write_hdf5(path, sets, attributes, &offsets);
         if (!why.empty()) return why;
-        bytes = {in_out_dir, offsets.back()};
+        written.bytes = {o.scene + ".h5", offsets.back()};
+        written.h5_written = true;
+        written.h5_rows = rows;
+        written.h5_shots = shots;
+        written.npy = NpySet();
+        remove_journal(journal.dir);
         return "";
     }
-    if (mkdir(path.c_str(), 0777) != 0 && errno != EEXIST) return std::strerror(errno);
+    const NpyRange range{path, 0, 0};
+    bool grown = false;
+    std::string why = failure_of([&] { grown = grow_npy_set(range, d, written.npy); });
+    if (!why.empty() || grown) return why;
     // The attributes as JSON (json.load reads them).
     auto quoted = [](const std::string &text) {
         std::string q = "\"";
@@ -120,24 +323,14 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
         json += (json.size() > 1 ? ", \"" : "\"") + a.name + "\": " + (a.is_text ? quoted(a.text) : number);
     }
     json += "}\n";
-    // The set is replaced as a whole: every file is written and flushed beside
-    // its target first, and renamed into place only once all of them are, so
-    // that a failed write leaves the old set, never old and new files mixed.
-    // Only a kill between two renames can mix them: keep_snapshots then reads
-    // what the two sets share, the rows and snapshots up to the checkpoint.
-    const std::vector<std::string> files = data_files(o, d);
-    std::vector<std::unique_ptr<FileReplacement>> written;
-    const std::string why = failure_of([&] {
-        for (std::size_t i = 0; i < files.size(); ++i) {
-            const std::string content = i < sets.size() ? npy_file(sets[i].array) : json;
-            written.push_back(std::make_unique<FileReplacement>(files[i]));
-            written.back()->write(reinterpret_cast<const unsigned char *>(content.data()), content.size());
-            written.back()->sync();
-        }
-        for (auto &file : written) file->commit();
-    });
+    const std::vector<Dataset> sets = datasets_of(d);
+    std::vector<std::pair<std::string, std::string>> contents;
+    for (const Dataset &set : sets) contents.push_back({set.name + ".npy", npy_file(set.array)});
+    contents.push_back({"attributes.json", json});
+    why = failure_of([&] { replace_npy_set(range, d, contents, written.npy); });
     if (!why.empty()) return why;
-    bytes = {in_out_dir, npy_header(sets.back().array).size()};
+    // gnuplot, run in the output directory, reads the snapshots by this name.
+    written.bytes = {o.scene + "/" + sets.back().name + ".npy", npy_header(sets.back().array).size()};
     return "";
 }
 

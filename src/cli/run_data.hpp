@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "../core/files.hpp"
 #include "data_files.hpp"
 #include "plots.hpp"
 #include "run_options.hpp"
@@ -29,6 +30,14 @@ struct RunData {
         for (std::size_t d : snapshot_shape) n *= d;
         return n;
     }
+    // Data of the same shapes (Casimirs, snapshots) without rows or snapshots.
+    static RunData shaped_like(const RunData &d) {
+        RunData shaped;
+        shaped.casimir_count = d.casimir_count;
+        shaped.snapshot_shape = d.snapshot_shape;
+        shaped.vorticity = d.vorticity;
+        return shaped;
+    }
     // Drops the rows and snapshots after `step` (a resumed run's start).
     void keep_up_to(int64_t last) {
         std::size_t rows = 0, shots = 0;
@@ -48,6 +57,22 @@ struct SnapshotBytes {
     std::uint64_t offset = UINT64_MAX;
 };
 
+// A set of .npy files as lpi left it: each growing array's file (in
+// growing_arrays' order, run_data.cpp) and the rows and snapshots it holds.
+struct NpySet {
+    std::vector<lpi::FileIdentity> files;
+    std::size_t rows = 0, shots = 0;
+};
+
+// What the last write_data left: where the snapshots are, the .npy set (the
+// data, or the HDF5 file's journal) and the rows and snapshots the HDF5
+// file holds, so that the next write grows the files in place.
+struct WrittenData {
+    SnapshotBytes bytes;
+    NpySet npy;
+    bool h5_written = false;
+    std::size_t h5_rows = 0, h5_shots = 0;
+};
 
 // Where a run's data lives: DIR/SCENE.h5, or the folder DIR/SCENE of .npy files.
 std::string data_path(const RunOptions &o);
@@ -56,10 +81,22 @@ std::string data_path(const RunOptions &o);
 // attributes.json in DIR/SCENE.
 std::vector<std::string> data_files(const RunOptions &o, const RunData &d);
 
-// Writes the data atomically (output.hpp), the .npy files and their
-// attributes.json as one set; "" or the reason.
+// Writes the data, so that a write costs the rows and snapshots since the
+// last, not all of them again (which made a run of n checkpoints cost n^2):
+//  - .npy: the files and their attributes.json as one set, replaced whole
+//    the first time, then grown in place (each growing array's values
+//    appended, then its header's length; a failure puts every file back);
+//  - HDF5: the file atomically (output.hpp) the first time, when `final`
+//    (the run's end, however it ends), and whenever the rows and snapshots
+//    since hold as many values as it does; in between, those are its journal
+//    (journal_path), .npy files grown in place, which keep_snapshots reads
+//    with the file, and which the next whole write removes.
+// "" or the reason.
 std::string write_data(const RunOptions &o, const RunData &d, const std::vector<Attribute> &attributes,
-                       SnapshotBytes &bytes);
+                       WrittenData &written, bool final);
+
+// The folder of an HDF5 file's journal: DIR/SCENE.h5-pending.
+std::string journal_path(const RunOptions &o);
 
 // The snapshots of the interrupted run up to `start`, from its data; a note
 // on stdout (not an error) when there is no data or its rows are not the

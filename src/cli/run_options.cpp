@@ -42,7 +42,8 @@ void run_usage(FILE *to) {
                  "  --out DIR         output directory (default ./lpi-run)\n"
                  "  --checkpoint FILE save a checkpoint (atomically) at the start, every 10 rows\n"
                  "                    and at the end, the CSV and the data with it (so a run\n"
-                 "                    killed outright resumes with its snapshots); a failed save\n"
+                 "                    killed outright resumes with its snapshots; they grow in\n"
+                 "                    place, HDF5 through DIR/SCENE.h5-pending); a failed save\n"
                  "                    stops the run (exit status 1); not for moments, nor a FILE\n"
                  "                    the run writes\n"
                  "  --checkpoint-every K   ... every K rows instead (0: at the start and end only)\n"
@@ -55,7 +56,7 @@ void run_usage(FILE *to) {
                  "  are refused for a scene that does not take them.\n"
                  "  writes DIR/SCENE.csv: step, time, energy, relative energy error (to the energy\n"
                  "  at step 0; absolute where that is 0), Casimirs; and the data (rows and\n"
-                 "  snapshots) as --format says, each file atomically (lpi(1)); a\n"
+                 "  snapshots) as --format says; a failed write keeps the old files (lpi(1)); a\n"
                  "  progress bar with the time left is shown on a terminal only. Ctrl-C (SIGINT) or\n"
                  "  SIGTERM stops within a few steps, writes a row at that step, the data and the\n"
                  "  checkpoint of the last row on the --every grid, and exits with status 130 (143).\n");

@@ -96,6 +96,33 @@ bool within_file_size_limit(int fd, std::size_t size) {
     return end <= limit.rlim_cur && size <= limit.rlim_cur - end;
 }
 
+FileIdentity identity_of(int fd) {
+    FileIdentity id;
+    struct stat st;
+    if (::fstat(fd, &st) != 0) return id;
+    id.known = true;
+    id.device = static_cast<unsigned long long>(st.st_dev);
+    id.inode = static_cast<unsigned long long>(st.st_ino);
+    id.size = static_cast<unsigned long long>(st.st_size);
+    id.modified_s = static_cast<long long>(st.st_mtim.tv_sec);
+    id.modified_ns = static_cast<long long>(st.st_mtim.tv_nsec);
+    return id;
+}
+
+// Writes all of bytes at offset (pwrite until done); false with errno set.
+bool write_all_at(int fd, const unsigned char *bytes, std::size_t size, unsigned long long offset) {
+    std::size_t done = 0;
+    while (done < size) {
+        const ssize_t n = ::pwrite(fd, bytes + done, size - done, static_cast<off_t>(offset + done));
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            return false;
+        }
+        done += static_cast<std::size_t>(n);
+    }
+    return true;
+}
+
 }  // namespace
 
 FileReplacement::FileReplacement(const std::string &path) : path_(path) {
@@ -151,11 +178,12 @@ void FileReplacement::sync() {
     if (exists_ && ::fchmod(fd_, static_cast<mode_t>(permissions_)) != 0)
         abandon("cannot give " + quoted(temp_) + " the permissions of the old file", errno);
     if (::fsync(fd_) != 0) abandon("cannot flush " + quoted(temp_), errno);
+    identity_ = identity_of(fd_);  // the rename keeps the inode and the times
     close_descriptor();
     synced_ = true;
 }
 
-void FileReplacement::commit() {
+FileIdentity FileReplacement::commit() {
     if (!synced_) sync();
     if (::rename(temp_.c_str(), target_.c_str()) != 0)
         abandon("cannot rename " + quoted(temp_) + " to " + (target_ == path_ ? "it" : quoted(target_)), errno);
@@ -167,12 +195,94 @@ void FileReplacement::commit() {
         ::fsync(dfd);
         ::close(dfd);
     }
+    return identity_;
 }
 
-void write_file_atomically(const std::string &path, const unsigned char *bytes, std::size_t size) {
+FileIdentity write_file_atomically(const std::string &path, const unsigned char *bytes, std::size_t size) {
     FileReplacement file(path);
     file.write(bytes, size);
-    file.commit();
+    return file.commit();
+}
+
+FileGrowth::FileGrowth(const std::string &path, const FileIdentity &known) : path_(path) {
+    if (!known.known) return;
+    // O_NONBLOCK: whatever is there now, opening it must not wait (a FIFO).
+    const int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) return;  // gone or not writable: the writer replaces it and says why
+    const FileIdentity now = identity_of(fd);
+    if (!(now == known)) {
+        ::close(fd);
+        return;
+    }
+    fd_ = fd;
+    old_size_ = end_ = now.size;
+}
+
+FileGrowth::~FileGrowth() {
+    if (fd_ < 0) return;
+    restore();
+    ::close(fd_);
+}
+
+// Best effort: what the file held before, whatever failed on the way here.
+void FileGrowth::restore() {
+    for (auto o = overwritten_.rbegin(); o != overwritten_.rend(); ++o)
+        write_all_at(fd_, reinterpret_cast<const unsigned char *>(o->old_bytes.data()), o->old_bytes.size(),
+                     o->offset);
+    if (end_ != old_size_ || !overwritten_.empty()) {
+        ::ftruncate(fd_, static_cast<off_t>(old_size_));
+        ::fsync(fd_);
+    }
+    overwritten_.clear();
+    end_ = old_size_;
+}
+
+void FileGrowth::abandon(const std::string &what, int error) {
+    restore();
+    ::close(fd_);
+    fd_ = -1;
+    fail(LPI_ERR_IO, "cannot save " + quoted(path_) + ": " + what + ": " + io_reason(error));
+}
+
+void FileGrowth::append(const unsigned char *bytes, std::size_t size) {
+    if (size > 0 && !within_file_size_limit(fd_, size)) abandon("cannot write it", EFBIG);
+    if (!write_all_at(fd_, bytes, size, end_)) {
+        const int error = errno;
+        end_ += size;  // whatever part was written is cut off again
+        abandon("cannot write it", error);
+    }
+    end_ += size;
+    synced_ = false;
+}
+
+void FileGrowth::overwrite(unsigned long long offset, const unsigned char *bytes, std::size_t size) {
+    if (offset > old_size_ || size > old_size_ - offset) abandon("an overwrite past its old end", EINVAL);
+    Overwritten old{offset, std::string(size, '\0')};
+    std::size_t done = 0;
+    while (done < size) {
+        const ssize_t n = ::pread(fd_, &old.old_bytes[done], size - done, static_cast<off_t>(offset + done));
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) abandon("cannot read it", n < 0 ? errno : EIO);
+        done += static_cast<std::size_t>(n);
+    }
+    overwritten_.push_back(std::move(old));
+    if (!write_all_at(fd_, bytes, size, offset)) abandon("cannot write it", errno);
+    synced_ = false;
+}
+
+void FileGrowth::sync() {
+    if (::fsync(fd_) != 0) abandon("cannot flush it", errno);
+    synced_ = true;
+}
+
+FileIdentity FileGrowth::commit() {
+    if (!synced_) sync();
+    const FileIdentity now = identity_of(fd_);
+    overwritten_.clear();
+    old_size_ = end_;
+    ::close(fd_);
+    fd_ = -1;
+    return now;
 }
 
 RegularFileReader::RegularFileReader(const std::string &path) : path_(path) {
