@@ -1,6 +1,5 @@
 #include "run_data.hpp"
 
-#include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -260,15 +259,11 @@ void write_journal(const NpyRange &range, const RunData &d, NpySet &set) {
 }
 
 // Removes the journal (after the HDF5 file that holds its rows is in
-// place). Best effort: one left behind is ignored, its base not the file's.
-void remove_journal(const std::string &dir) {
-    DIR *folder = opendir(dir.c_str());
-    if (!folder) return;
-    while (const dirent *entry = readdir(folder)) {
-        const std::string name = entry->d_name;
-        if (name != "." && name != "..") unlink((dir + "/" + name).c_str());
-    }
-    closedir(folder);
+// place): the files it writes, then the folder if nothing else is there.
+// Best effort: one left behind is ignored, its base not the file's.
+void remove_journal(const std::string &dir, const RunData &d) {
+    unlink((dir + "/base.npy").c_str());
+    for (const GrowingArray &a : growing_arrays(d)) unlink((dir + "/" + a.name + ".npy").c_str());
     rmdir(dir.c_str());
 }
 
@@ -302,7 +297,7 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
         written.h5_rows = rows;
         written.h5_shots = shots;
         written.npy = NpySet();
-        remove_journal(journal.dir);
+        remove_journal(journal.dir, d);
         return "";
     }
     const NpyRange range{path, 0, 0};
