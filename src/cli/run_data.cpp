@@ -247,14 +247,17 @@ void replace_npy_set(const NpyRange &range, const RunData &d,
 void write_journal(const NpyRange &range, const RunData &d, NpySet &set) {
     if (grow_npy_set(range, d, set)) return;
     std::vector<std::pair<std::string, std::string>> contents;
+    for (const GrowingArray &a : growing_arrays(d))
+        contents.push_back({a.name + ".npy", header_of(a, a.snapshots ? range.shots(d) : range.rows(d)) +
+                                                 values_of(range, a, 0, a.snapshots ? range.shots(d) : range.rows(d))});
+    // Renamed last (and removed first): a kill among the renames leaves the
+    // old base, which no longer matches the file, or none; a base that
+    // matches has every array of its journal beside it.
     Array base;
     base.shape = {2};
     base.values = {static_cast<double>(range.first_row), static_cast<double>(range.first_shot)};
     base.integer = true;
     contents.push_back({"base.npy", npy_file(base)});
-    for (const GrowingArray &a : growing_arrays(d))
-        contents.push_back({a.name + ".npy", header_of(a, a.snapshots ? range.shots(d) : range.rows(d)) +
-                                                 values_of(range, a, 0, a.snapshots ? range.shots(d) : range.rows(d))});
     replace_npy_set(range, d, contents, set);
 }
 
