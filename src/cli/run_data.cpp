@@ -81,8 +81,16 @@ std::string read_data_array(const RunOptions &o, const std::string &name, Array 
     const std::string journal = journal_path(o);
     struct stat st;
     if (!why.empty() || a.shape.empty() || stat(journal.c_str(), &st) != 0) return why;
+    // No base: a journal being made or removed when a kill came, ignored. A
+    // base that cannot be read is refused, not ignored: the rows it stands
+    // for would be lost.
     Array base, tail;
-    if (!read_grown(journal + "/base.npy", "base", base).empty() || base.values.size() != 2) return "";
+    const std::string base_file = journal + "/base.npy";
+    if (stat(base_file.c_str(), &st) != 0 && errno == ENOENT) return "";
+    why = read_grown(base_file, journal + "/base", base);
+    if (why.empty() && (base.shape != std::vector<std::size_t>{2} || !base.integer))
+        why = base_file + ": not the two counts of a journal's base";
+    if (!why.empty()) return why;
     const bool snapshots = name.compare(0, 9, "snapshot_") == 0 || name == "vorticity" || name == "state";
     if (base.values[snapshots ? 1 : 0] != static_cast<double>(a.shape[0])) return "";  // not this file's
     why = read_grown(journal + "/" + name + ".npy", journal_path(o) + "/" + name, tail);
