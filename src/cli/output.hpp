@@ -1,7 +1,8 @@
 // Every file lpi writes (CSV, data, gnuplot scripts and images) goes through
 // the library's own writer, src/core/files.* (compiled into lpi as well: the
 // shared library does not export it): a temporary file
-// beside the target, fsync, rename. A failure keeps the old file and says
+// beside the target, fsync, rename; or, for what lpi run grows with each
+// checkpoint, FileGrowth in place. A failure keeps the old file and says
 // why; the permission bits of a file replaced are kept, a new one gets the
 // umask's; a symbolic link is followed and kept; a directory, FIFO or device
 // at the target is refused, not replaced. Files are read the same way, as

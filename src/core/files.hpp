@@ -1,6 +1,7 @@
 // Files the library writes and reads (checkpoints, FFTW wisdom): written
 // atomically, read only when they are regular files, so that no call can
-// hang on a FIFO, replace a device, or leave a partial file behind.
+// hang on a FIFO, replace a device, or leave a partial file behind. Also the
+// in-place growth lpi run uses for the files each checkpoint extends.
 #pragma once
 
 #include <cstddef>
