@@ -206,13 +206,17 @@ bool grow_npy_set(const NpyRange &range, const RunData &d, NpySet &set) {
             growing.back()->old_size() != old_header.size() + 8 * a.width() * old_count)
             return false;
     }
+    // An array with nothing new (the snapshots between two) is not touched.
+    auto grows = [&](const GrowingArray &a) { return a.snapshots ? shots > set.shots : rows > set.rows; };
     for (std::size_t i = 0; i < arrays.size(); ++i) {
         const GrowingArray &a = arrays[i];
+        if (!grows(a)) continue;
         const std::string values = values_of(range, a, a.snapshots ? set.shots : set.rows, a.snapshots ? shots : rows);
         growing[i]->append(reinterpret_cast<const unsigned char *>(values.data()), values.size());
         growing[i]->sync();
     }
     for (std::size_t i = 0; i < arrays.size(); ++i) {
+        if (!grows(arrays[i])) continue;
         growing[i]->overwrite(0, reinterpret_cast<const unsigned char *>(headers[i].data()), headers[i].size());
         growing[i]->sync();
     }
