@@ -68,8 +68,9 @@ std::vector<Dataset> datasets_of(const RunData &d) {
 
 // One array of a run's earlier data, in this run's format: for HDF5, the
 // file's and, after it, its journal's (when the journal continues the file:
-// its base is the rows, or snapshots, the file's array holds).
-std::string read_data_array(const RunOptions &o, const std::string &name, Array &a) {
+// its base is the rows, or the snapshots where `snapshots`, the file's
+// array holds).
+std::string read_data_array(const RunOptions &o, const std::string &name, bool snapshots, Array &a) {
     const std::string path = data_path(o);
     auto read_grown = [](const std::string &file, const std::string &name, Array &a) {
         const std::string why = read_npy(file, a, /*tail_allowed=*/true);
@@ -91,9 +92,8 @@ std::string read_data_array(const RunOptions &o, const std::string &name, Array 
     if (why.empty() && (base.shape != std::vector<std::size_t>{2} || !base.integer))
         why = base_file + ": not the two counts of a journal's base";
     if (!why.empty()) return why;
-    const bool snapshots = name.compare(0, 9, "snapshot_") == 0 || name == "vorticity" || name == "state";
     if (base.values[snapshots ? 1 : 0] != static_cast<double>(a.shape[0])) return "";  // not this file's
-    why = read_grown(journal + "/" + name + ".npy", journal_path(o) + "/" + name, tail);
+    why = read_grown(journal + "/" + name + ".npy", journal + "/" + name, tail);
     if (!why.empty()) return why;
     if (tail.shape.size() != a.shape.size() || !std::equal(a.shape.begin() + 1, a.shape.end(), tail.shape.begin() + 1))
         return journal + "/" + name + ".npy: not shaped as " + path + "'s " + name;
@@ -364,12 +364,14 @@ int keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunDat
                          data_path(o).c_str(), why.c_str(), static_cast<long long>(start));
         return 1;
     };
-    auto read = [&](const char *name, Array &a) { return there ? read_data_array(o, name, a) : std::string(); };
+    auto read = [&](const char *name, bool snapshots, Array &a) {
+        return there ? read_data_array(o, name, snapshots, a) : std::string();
+    };
     Array row_steps, row_times, row_energies;
     std::string why;  // why the data's snapshots are not this run's
     for (auto *array : {&row_steps, &row_times, &row_energies}) {
         const char *name = array == &row_steps ? "step" : array == &row_times ? "time" : "energy";
-        const std::string wrong = read(name, *array);
+        const std::string wrong = read(name, false, *array);
         if (!wrong.empty()) return unreadable(wrong);
     }
     // A set that a kill cut between two of its files' renames (write_data)
@@ -411,7 +413,7 @@ int keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunDat
         const char *name = array == &steps ? "snapshot_step" : array == &times ? "snapshot_time"
                            : d.vorticity                   ? "vorticity"
                                                            : "state";
-        const std::string wrong = read(name, *array);
+        const std::string wrong = read(name, true, *array);
         if (!wrong.empty()) return unreadable(wrong);
     }
     if (!there) why = "no data there";
