@@ -322,6 +322,40 @@ cmp -s "$out/mixed-ref/rigid-body.csv" "$out/mixed/rigid-body.csv" &&
     diff -r "$out/mixed-ref/rigid-body" "$out/mixed/rigid-body" >/dev/null ||
     fail "a .npy set of two writes, resumed: not the uninterrupted run"
 
+# Data moved aside (as a refusal asks) or older than the checkpoint,
+# resumed: the data goes on from the checkpoint's step with the snapshot at
+# that step, taken from the resumed state (the uninterrupted run's, to the
+# bit; the run took none there, and the data said it kept the snapshots
+# "from" that step), and where the kept snapshots end before the grid's
+# last one before the checkpoint, the run says which it lacks.
+npy_words() {  # npy_words FILE: its values after the header, one 8-byte word a line, in hex
+    header=$(head -c 10 "$1" | tail -c 2 | od -An -tu2 --endian=little | tr -d ' ')
+    tail -c +$((header + 11)) "$1" | od -An -v -tx8 -w8
+}
+rm -rf "$out/aside" "$out/aside-ref" "$out/aside-old" "$out/aside.lpi" "$out/aside-later.lpi"
+set -- run rigid-body --every 5 --snapshots 1 --format npy
+"$lpi" "$@" --steps 30 --out "$out/aside-ref" >/dev/null
+ref="$out/aside-ref/rigid-body"
+"$lpi" "$@" --steps 20 --out "$out/aside" --checkpoint "$out/aside.lpi" >/dev/null
+mv "$out/aside/rigid-body" "$out/aside-old"
+"$lpi" "$@" --steps 30 --out "$out/aside" --resume "$out/aside.lpi" >"$out/stdout"
+grep -q "no data there; the data keeps the snapshots from step 20 on" "$out/stdout" || { cat "$out/stdout"; fail "data moved aside, resumed: no note"; }
+[ "$(npy_words "$out/aside/rigid-body/snapshot_step.npy")" = "$(npy_words "$ref/snapshot_step.npy" | tail -n 3)" ] &&
+    [ "$(npy_words "$out/aside/rigid-body/state.npy")" = "$(npy_words "$ref/state.npy" | tail -n 9)" ] ||
+    fail "data moved aside, resumed: not the snapshots from the checkpoint's step (step 20's missing) as the uninterrupted run's"
+rm -rf "$out/aside" "$out/aside-old"
+"$lpi" "$@" --steps 10 --out "$out/aside" --checkpoint "$out/aside.lpi" >/dev/null
+cp -r "$out/aside/rigid-body" "$out/aside-old"
+"$lpi" "$@" --steps 20 --out "$out/aside" --checkpoint "$out/aside-later.lpi" --resume "$out/aside.lpi" >/dev/null
+rm -rf "$out/aside/rigid-body"; mv "$out/aside-old" "$out/aside/rigid-body"
+"$lpi" "$@" --steps 30 --out "$out/aside" --resume "$out/aside-later.lpi" >"$out/stdout"
+grep -q "its snapshots end at step 10: those after it and before step 20 are not in it" "$out/stdout" ||
+    { cat "$out/stdout"; fail "data older than the checkpoint, resumed: no note of the snapshots it lacks"; }
+[ "$(npy_words "$out/aside/rigid-body/snapshot_step.npy")" = "$(npy_words "$ref/snapshot_step.npy" | sed 4d)" ] &&
+    [ "$(npy_words "$out/aside/rigid-body/state.npy")" = "$(npy_words "$ref/state.npy" | sed 10,12d)" ] &&
+    cmp -s "$ref/../rigid-body.csv" "$out/aside/rigid-body.csv" ||
+    fail "data older than the checkpoint, resumed: not its snapshots, the checkpoint step's and later ones as the uninterrupted run's"
+
 # Data that cannot be written with a checkpoint (its snapshots past the
 # file size limit, the CSV still within it) stops the run as a CSV does,
 # leaving the data of the last checkpoint: resumed, the run is the

@@ -256,7 +256,8 @@ done
 # snapshots are not passed off as this run's, whether it has a row at the
 # checkpoint's step (--every 1; it was refused as another --dt) or not
 # (--every 3; its snapshots were spliced in): only this run's, from the
-# checkpoint's step on, are kept.
+# checkpoint's step on, are kept (the checkpoint step's taken from the
+# resumed state).
 for every in 1 3; do
     rm -rf "$out/stale" "$out/stale-b"
     "$lpi" run rigid-body --inertia 1,2,3 --steps 40 --every $every --snapshots 1 --format npy --out "$out/stale" \
@@ -269,7 +270,7 @@ for every in 1 3; do
         { echo "--resume over the data of another run (--every $every): refused"; cat "$out.err"; exit 1; }
     grep -q "another run" "$out.out" ||
         { echo "--resume over the data of another run (--every $every): no note"; cat "$out.out"; exit 1; }
-    head -c 128 "$out/stale/rigid-body/snapshot_step.npy" | grep -q "'shape': (2,)" ||
+    head -c 128 "$out/stale/rigid-body/snapshot_step.npy" | grep -q "'shape': (3,)" ||
         { echo "--resume over the data of another run (--every $every): its snapshots were kept"; exit 1; }
 done
 # A CSV replaced since by another run's (another --inertia, the same steps

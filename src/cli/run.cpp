@@ -503,6 +503,19 @@ int run_command(int argc, char **argv) {
         if (kept.empty())
             std::printf("%s has no row at step %lld: a new file, energy error relative to step %lld\n",
                         csv.c_str(), static_cast<long long>(start), static_cast<long long>(start));
+        // Data that ends before the last snapshot this run's grid puts
+        // before the start (a data file older than the checkpoint, a journal
+        // left out) cannot be completed: say which snapshots it lacks.
+        const int64_t rows_before = row_index(start) - 1;
+        if (!data.snapshot_step.empty() && o.snapshot_every > 0 && rows_before >= 0) {
+            const int64_t due = rows_before / o.snapshot_every * o.snapshot_every * every;
+            const double last = data.snapshot_step.back();
+            if (last < static_cast<double>(due))
+                std::printf("%s: its snapshots end at step %.0f: those after it and before step %lld are not "
+                            "in it, and the data goes on from step %lld\n",
+                            data_path(o).c_str(), last, static_cast<long long>(start),
+                            static_cast<long long>(start));
+        }
     }
     // Every process has read what it keeps before rank 0 rewrites the files.
     synchronize();
@@ -649,7 +662,12 @@ int run_command(int argc, char **argv) {
     // The start's row when the CSV has none, from H0 and C0 (this state's
     // then): the CSV each process read may differ, and energy_of is collective.
     if (kept.empty()) record(start, H0, C0);
-    if (o.resume.empty()) snapshot(0);  // before the checkpoint, whose data then holds it
+    // The start's snapshot, before the checkpoint, whose data then holds it:
+    // step 0's, or, resumed, the checkpoint step's where the data kept none
+    // (no data there, another run's, or one that ends before that step),
+    // taken from this state, the one the interrupted run had there.
+    if (o.resume.empty() || data.snapshot_step.empty() || data.snapshot_step.back() < static_cast<double>(start))
+        snapshot(start);
     save(start, true);
     Watch watch;
     watch.progress = &progress;
