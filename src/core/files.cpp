@@ -118,6 +118,10 @@ bool write_all_at(int fd, const unsigned char *bytes, std::size_t size, unsigned
             if (errno == EINTR) continue;
             return false;
         }
+        if (n == 0) {  // nothing written and no error: no room (as coreutils' full_write reads it)
+            errno = ENOSPC;
+            return false;
+        }
         done += static_cast<std::size_t>(n);
     }
     return true;
@@ -161,6 +165,7 @@ void FileReplacement::write(const unsigned char *bytes, std::size_t size) {
             if (errno == EINTR) continue;
             abandon("cannot write " + quoted(temp_), errno);
         }
+        if (n == 0) abandon("cannot write " + quoted(temp_), ENOSPC);  // no progress: see write_all_at
         done += static_cast<std::size_t>(n);
     }
 }
