@@ -280,6 +280,26 @@ rm -rf "$out/stale"
 "$lpi" run rigid-body --inertia 2,3,5 --steps 10 --every 5 --out "$out/stale" --checkpoint "$out/stale.lpi" >/dev/null
 "$lpi" run rigid-body --inertia 1,2,3 --steps 10 --every 5 --out "$out/stale" >/dev/null
 refused "another run" run rigid-body --inertia 2,3,5 --steps 20 --every 5 --out "$out/stale" --resume "$out/stale.lpi"
+# A CSV with rows but none at the checkpoint's step: a --dt smaller than the
+# interrupted run's puts that step past its rows, and a CSV cut short ends
+# before it. It was started anew there, every row in it lost (exit 0, a
+# note); now refused (2), every file left as it was. Without the CSV, data
+# at another --dt (its rows' times not this --dt's steps) is refused too:
+# its snapshots were kept, spliced to this run's at half the step size.
+rm -rf "$out/dt" "$out/dt-kept"
+set -- run rigid-body --every 10 --snapshots 1 --format npy --out "$out/dt"
+"$lpi" "$@" --steps 40 --checkpoint "$out/dt.lpi" >/dev/null
+cp -r "$out/dt" "$out/dt-kept"
+refused "has no row at step 80" "$@" --steps 100 --dt 0.005 --resume "$out/dt.lpi"
+diff -r "$out/dt-kept" "$out/dt" >/dev/null || { echo "--resume with a smaller --dt: a file was rewritten"; exit 1; }
+sed -i '4,$d' "$out/dt/rigid-body.csv"
+cp "$out/dt/rigid-body.csv" "$out/dt-cut.csv"
+refused "has no row at step 40" "$@" --steps 100 --resume "$out/dt.lpi"
+cmp -s "$out/dt-cut.csv" "$out/dt/rigid-body.csv" || { echo "--resume over a CSV cut short: rewritten"; exit 1; }
+rm "$out/dt/rigid-body.csv"
+refused "another --dt" "$@" --steps 100 --dt 0.005 --resume "$out/dt.lpi"
+diff -r "$out/dt-kept/rigid-body" "$out/dt/rigid-body" >/dev/null ||
+    { echo "--resume with a smaller --dt over data alone: the data was rewritten"; exit 1; }
 # Data that is there but cannot be read back (cut short, not data at all,
 # or a header claiming more than the readers' cap of 2^28 values) is not
 # replaced by the resumed run, which dropped it with a note and lost the

@@ -105,11 +105,13 @@ struct CsvRow {
 // (common.hpp): the header lpi run writes for `casimir_count` Casimirs, then
 // rows of as many fields, each a complete finite decimal number, the steps
 // whole, increasing and below 2^62. Its rows up to and including that of
-// `step`; none when the file is absent or has no row at `step`; a last line
-// cut short is left when it follows the row at `step`. `why` says
-// what is wrong with a file that is there ("PATH:LINE: ..."): a value read
-// wrongly would be the reference of every energy error after it.
-std::vector<CsvRow> csv_up_to(const std::string &path, int64_t step, std::size_t casimir_count, std::string &why) {
+// `step`; none when the file is absent or has no rows, or has rows but none
+// at `step` (then `lacks_step`); a last line cut short is left when it
+// follows the row at `step`. `why` says what is wrong with a file that is
+// there ("PATH:LINE: ..."): a value read wrongly would be the reference of
+// every energy error after it.
+std::vector<CsvRow> csv_up_to(const std::string &path, int64_t step, std::size_t casimir_count, bool &lacks_step,
+                              std::string &why) {
     std::vector<CsvRow> rows;
     struct stat st;
     if (stat(path.c_str(), &st) != 0 && errno == ENOENT) return rows;
@@ -166,6 +168,7 @@ std::vector<CsvRow> csv_up_to(const std::string &path, int64_t step, std::size_t
         rows.push_back(std::move(row));
     }
     if (line_number == 0) return bad("the file is empty");
+    lacks_step = !found && line_number > 1;
     if (!found) rows.clear();
     return rows;
 }
@@ -450,9 +453,20 @@ int run_command(int argc, char **argv) {
     std::vector<CsvRow> kept;
     if (!o.resume.empty()) {
         std::string why;
-        kept = csv_up_to(csv, start, data.casimir_count, why);
+        bool lacks_start = false;
+        kept = csv_up_to(csv, start, data.casimir_count, lacks_start, why);
         int status = why.empty() ? 0 : 1;
         if (status) why = "lpi run: --resume: " + why;
+        // Rows, but none at the checkpoint's step: a --dt smaller than the
+        // interrupted run's puts that step past them, and a CSV cut short or
+        // older than the checkpoint ends before it. Started anew there, the
+        // CSV lost every row it had.
+        if (!status && lacks_start)
+            status = 2, why = format("lpi run: --resume: %s has no row at step %lld, the checkpoint's (t = %.17g "
+                                     "with --dt %g): the CSV of a run with another --dt, or cut short or older "
+                                     "than the checkpoint; resume with the options of the interrupted run, or "
+                                     "move the CSV aside (or remove it) to start it anew at that step",
+                                     csv.c_str(), static_cast<long long>(start), lpi_time(sys), dt);
         // The interrupted run's row at the checkpoint's step holds the
         // checkpoint's time to the bit (both written at the end of the same
         // call): another time there is another --dt (or --every), whose rows
@@ -501,8 +515,8 @@ int run_command(int argc, char **argv) {
         const int status = keep_snapshots(o, start, lpi_time(sys), data, why);
         if (const int agreed = agreed_failure(status, why)) return agreed;
         if (kept.empty())
-            std::printf("%s has no row at step %lld: a new file, energy error relative to step %lld\n",
-                        csv.c_str(), static_cast<long long>(start), static_cast<long long>(start));
+            std::printf("%s has no rows: a new file from step %lld, energy error relative to that step\n",
+                        csv.c_str(), static_cast<long long>(start));
         // Data that ends before the last snapshot this run's grid puts
         // before the start (a data file older than the checkpoint, a journal
         // left out) cannot be completed: say which snapshots it lacks.

@@ -386,13 +386,19 @@ int keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunDat
         if (d.step.empty()) {
             // No CSV: the data's row at the checkpoint's step holds its
             // time, as the CSV's does (run.cpp): another time there is
-            // another --dt.
-            if (step == static_cast<double>(start) && row_times.values[i] != start_time) {
+            // another --dt. Data older than the checkpoint has no such row;
+            // its rows' times are still steps of the run's --dt (to the
+            // rounding of the time's sum), or its snapshots would be spliced
+            // to this run's at another step size.
+            const double time = row_times.values[i];
+            const bool exact = step == static_cast<double>(start);
+            const double expected = start > 0 ? start_time * (step / static_cast<double>(start)) : 0.0;
+            if (exact ? time != start_time : std::fabs(time - expected) > 1e-12 * std::fabs(expected)) {
                 refusal = format("lpi run: --resume: the checkpoint's time %.17g is step %lld of this run's --dt, "
-                                 "but %s has t = %.17g at that step: resume with the options of the interrupted "
-                                 "run",
-                                 start_time, static_cast<long long>(start), data_path(o).c_str(),
-                                 row_times.values[i]);
+                                 "but %s has t = %.17g at step %.17g%s: resume with the options of the "
+                                 "interrupted run",
+                                 start_time, static_cast<long long>(start), data_path(o).c_str(), time, step,
+                                 exact ? "" : format(" (not %.17g: another --dt)", expected).c_str());
                 return 2;
             }
             continue;
