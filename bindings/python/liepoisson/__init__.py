@@ -90,10 +90,11 @@ _C_INTEGER_RANGES = {
 
 def _integer(value, what, ctype):
     """value as an int that fits the C type ctype ("int32", "int64", "size"):
-    TypeError for a non-integer (a float, a string, a bool), OverflowError
-    outside the type's range."""
-    if isinstance(value, bool):
-        raise TypeError("%s must be an integer, not bool" % what)
+    TypeError for a non-integer (a float, a string, a bool, numpy's bool_,
+    which has an __index__ of its own), OverflowError outside the type's
+    range."""
+    if isinstance(value, bool) or type(value).__name__ == "bool_":
+        raise TypeError("%s must be an integer, not %s" % (what, type(value).__name__))
     try:
         v = operator.index(value)
     except TypeError:
@@ -607,7 +608,7 @@ class System:
         self._keep = []        # ctypes callbacks the library holds, until it is destroyed
         self._pending = []     # exception raised inside a callback during the current call
         self._threads = 1
-        self._seconds_per_step = None  # measured by step(), for the SIGINT observer
+        self._seconds_per_step = None  # (what the cost depends on, seconds): step(), for the SIGINT watch
         self._lock = threading.RLock()  # held by the thread inside a call (_Claim)
         self._finalizer = weakref.finalize(self, _destroy, handle, self._lock)  # not _keep: see _destroy
 
@@ -949,7 +950,7 @@ class System:
             else:
                 done = self._step_observed(dt, nsteps, observer, every, sigint_every)
         if done > 0:
-            self._seconds_per_step = (time.perf_counter() - started) / done
+            self._seconds_per_step = (self._step_cost_key(), (time.perf_counter() - started) / done)
         return done
 
     def integrate(self, t_eval: ArrayIn, dt: float, *, energy: bool = False,
@@ -1059,17 +1060,28 @@ class System:
             return 0
         if not callable(signal.getsignal(signal.SIGINT)):
             return 0
-        seconds = self._seconds_per_step
-        if seconds is None:
-            # Not measured yet: 1e-7 s per flow and state entry, more than any
-            # system takes (an overestimate only makes the looks more frequent).
-            flows = c_size_t(1)
-            if self._query(lib.lpi_flows_per_step, byref(flows)) != 0:
-                flows.value = 1
-            seconds = 1e-7 * max(flows.value, 1) * max(self.dim, 1)
+        key = self._step_cost_key()
+        measured = self._seconds_per_step
+        if measured is not None and measured[0] == key:
+            seconds = measured[1]
+        else:
+            # Not measured with this method yet: 1e-7 s per flow and state
+            # entry, more than any system takes, or 2e-5 s per flow where the
+            # flows call Python (an overestimate only makes the looks more
+            # frequent, each far cheaper than the steps between them).
+            flows = max(key[-1], 1)
+            seconds = flows * (2e-5 if self._keep else 1e-7 * max(self.dim, 1))
         if seconds * nsteps < _OBSERVE_SECONDS:
             return 0
         return max(1, min(nsteps, int(_OBSERVE_SECONDS / max(seconds, 1e-12))))
+
+    def _step_cost_key(self):
+        """What a step's cost depends on besides the state: the method, the
+        split, the thread count and the flows per step (pieces added)."""
+        flows = c_size_t(0)
+        if self._query(lib.lpi_flows_per_step, byref(flows)) != 0:
+            flows.value = 0
+        return (self.method, self.split, self._threads, flows.value)
 
     def _step_observed(self, dt, nsteps, observer, every, sigint_every):
         """lpi_step under one library observer that serves both the caller's
@@ -1107,18 +1119,22 @@ class System:
         if sigint_every:
             signal.signal(signal.SIGINT, lambda signum, frame: received.append(signum))
         try:
-            self._call("lpi_set_observer", cadence, c_observer, None)
             try:
-                self._call("lpi_step", dt, nsteps)
+                self._call("lpi_set_observer", cadence, c_observer, None)
+                try:
+                    self._call("lpi_step", dt, nsteps)
+                finally:
+                    lib.lpi_set_observer(self._handle, 0, _lib.OBSERVER_FN(), None)  # NULL: removed
             finally:
-                lib.lpi_set_observer(self._handle, 0, _lib.OBSERVER_FN(), None)  # NULL: removed
+                if sigint_every:
+                    signal.signal(signal.SIGINT, previous)
+            if raised:
+                raise raised[0]
         finally:
-            if sigint_every:
-                signal.signal(signal.SIGINT, previous)
-        if raised:
-            raise raised[0]
-        if received:  # arrived after the last observation
-            run_previous_handler()
+            # A SIGINT after the last observation, or before the step failed
+            # (its exception then becomes the context of KeyboardInterrupt).
+            if received:
+                run_previous_handler()
         return stopped_at[0] if stopped_at else nsteps
 
     def energy(self) -> float:

@@ -76,6 +76,24 @@ class TestIntegerRanges(unittest.TestCase):
             with self.assertRaises(TypeError):
                 a.step(0.01, np.float64(7.0))
 
+    def test_numpy_bools_are_not_integers(self):
+        # np.bool_ has an __index__ (deprecated), so it would pass as 0 or 1.
+        if np is None:
+            self.skipTest("numpy not available")
+        with rigid_body() as b:
+            for call in (lambda: b.step(0.01, np.bool_(True)),
+                         lambda: b.step(0.01, 2, observer=lambda *a: None, every=np.bool_(True))):
+                with self.assertRaises(TypeError):
+                    call()
+            self.assertEqual(b.time, 0.0)
+            with self.assertRaises(TypeError):
+                b.threads = np.bool_(True)
+        g = lp.Generic(3, SO3)
+        with self.assertRaises(TypeError):
+            g.add_piece([np.bool_(False)], lambda x: [x[0]], lambda x: 0.5 * x[0] ** 2)
+        with self.assertRaises(lp.InvalidArgumentError):  # no piece was added
+            g.step(0.01, 1)
+
     def test_sizes_of_systems(self):
         for N in (2 ** 32 + 5, 2 ** 31, -2 ** 31 - 1):
             with self.assertRaises(OverflowError):
@@ -347,6 +365,48 @@ class TestInterrupt(unittest.TestCase):
             self.assertEqual(lp.lib.lpi_step(b._h(), 0.01, 1001), 0)  # one plain call
             self.assertEqual(as_list(a.state), as_list(b.state))
             self.assertEqual(a.time, b.time)
+
+    def test_sigint_before_a_failing_step_is_not_lost(self):
+        # Ctrl-C, then a callback fails before the next look for it: the
+        # failure is the context of the KeyboardInterrupt, not its end.
+        calls = [0]
+
+        def gradient(x):
+            calls[0] += 1
+            if calls[0] == 100:
+                os.kill(os.getpid(), signal.SIGINT)
+            if calls[0] == 200:
+                raise RuntimeError("model failure")
+            return [x[0]]
+
+        g = lp.Generic(3, SO3)
+        g.add_piece([0], gradient, lambda x: 0.5 * x[0] ** 2)
+        g.add_piece([1], lambda x: [x[0] / 2], lambda x: x[0] ** 2 / 4)
+        g.state = [1.0, 0.5, -0.3]
+        with self.assertRaises(KeyboardInterrupt) as caught:
+            g.step(1e-4, 10 ** 7)
+        self.assertIsInstance(caught.exception.__context__, lp.CallbackError)
+        self.assertEqual(g.time, 0.0)  # the failed step rolled back
+
+    def test_sigint_stops_steps_that_call_python_soon(self):
+        # The first call has no measured speed: its guess must not take
+        # flows that call Python for as fast as the library's own.
+        def gradient(x):
+            time.sleep(2e-5)
+            return [x[0]]
+
+        g = lp.Generic(3, SO3)
+        g.add_piece([0], gradient, lambda x: 0.5 * x[0] ** 2)
+        g.add_piece([1], lambda x: [x[0] / 2], lambda x: x[0] ** 2 / 4)
+        g.state = [1.0, 0.5, -0.3]
+        self.interrupt_soon()
+        with self.assertRaises(KeyboardInterrupt):
+            g.step(1e-4, 10 ** 8)
+        # Each step sleeps 2e-5 s at least, so at most 5000 steps come before
+        # the SIGINT at 0.1 s, and it is looked for every 1250 steps (0.05 s
+        # at the guessed 2e-5 s a flow). A guess of 1e-7 s a flow and entry
+        # looked first after 83333.
+        self.assertLess(round(g.time / 1e-4), 10000)
 
     def test_a_handler_that_does_not_raise_lets_the_step_finish(self):
         calls = []
