@@ -425,4 +425,23 @@ rm -rf "$out/ref"
 "$lpi" run $long --dt 0.01 --steps $((stop + 3)) --every 1000000000 --format npy --out "$out/ref" >/dev/null
 cmp -s "$out/ref/$csv" "$out/int/$csv" || { echo "one long call, interrupted and resumed: the CSV differs"; exit 1; }
 same_data npy "one long call, interrupted and resumed"
+# SIGTERM once the steps are done, while gnuplot draws the snapshots (the
+# script is written just before it starts): it was ignored (exit status 0),
+# and a Ctrl-C, which reaches gnuplot too, failed the run as gnuplot's
+# failure (1). Now gnuplot is ended and the run exits 143, keeping the old
+# images and no temporary file.
+if [ "$have_sine_euler" = 1 ] && command -v gnuplot >/dev/null 2>&1; then
+    rm -rf "$out/draw"
+    "$lpi" run sine-euler --N 9 --steps 600 --every 1 --snapshots 1 --out "$out/draw" >"$out/draw.out" 2>&1 &
+    pid=$!
+    waited=0
+    while [ ! -f "$out/draw/vorticity.gp" ] && [ $waited -lt 600 ]; do sleep 0.05; waited=$((waited + 1)); done
+    kill -TERM $pid
+    rc=0; wait $pid || rc=$?
+    [ "$rc" -eq 143 ] && grep -q "^interrupted .*images were drawn" "$out/draw.out" ||
+        { echo "SIGTERM while the images were drawn: exit status $rc, expected 143"; cat "$out/draw.out"; exit 1; }
+    ! ls -a "$out/draw" | grep -q "^\.lpi-" || { echo "SIGTERM while the images were drawn: temporaries left"; exit 1; }
+else
+    echo "not checked: a signal while the images are drawn (no sine-Euler or no gnuplot)"
+fi
 echo "lpi run: bad options refused, failures reported, SIGINT and --resume continue to the bit"

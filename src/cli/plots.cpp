@@ -1,6 +1,8 @@
 #include "plots.hpp"
 
 #include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -12,6 +14,7 @@
 #include <memory>
 
 #include "output.hpp"
+#include "run_watch.hpp"
 
 extern char **environ;
 
@@ -45,7 +48,10 @@ namespace {
 
 // Runs `gnuplot SCRIPT` in `dir`: no shell, so no name is ever parsed as a
 // command; its output discarded, what it says on standard error kept for the
-// message of a failure. "" when it succeeded, else why not.
+// message of a failure. "" when it succeeded, else why not. A SIGINT or
+// SIGTERM that lpi run catches (interrupted_by) ends gnuplot: it is looked
+// for at least every 0.1 s, so a signal that came just before a blocking
+// read is not missed.
 std::string run_gnuplot(const std::string &dir, const std::string &script) {
     int pipe_fds[2];
     if (pipe2(pipe_fds, O_CLOEXEC) != 0) return std::string("cannot run gnuplot: ") + std::strerror(errno);
@@ -64,9 +70,14 @@ std::string run_gnuplot(const std::string &dir, const std::string &script) {
     std::string said;
     if (spawned == 0) {
         char chunk[4096];
+        bool ended = false;
         for (;;) {
-            const ssize_t n = read(pipe_fds[0], chunk, sizeof chunk);
-            if (n < 0 && errno == EINTR) continue;  // a signal lpi run notes
+            if (interrupted_by && !ended) kill(pid, SIGTERM), ended = true;
+            pollfd ready{pipe_fds[0], POLLIN, 0};
+            const int polled = poll(&ready, 1, 100);
+            if (polled == 0 || (polled < 0 && errno == EINTR)) continue;
+            const ssize_t n = polled < 0 ? -1 : read(pipe_fds[0], chunk, sizeof chunk);
+            if (n < 0 && errno == EINTR) continue;
             if (n <= 0) break;
             said.append(chunk, static_cast<std::size_t>(n));
         }

@@ -185,6 +185,7 @@ int run_rollup(const OwnRun &run) {
     commands += "\nunset multiplot\n";
     script.add_figure("rollup", 1100, 450, commands);
     const std::string not_drawn = script.draw();
+    if (interrupted_by) return interrupted_drawing(not_drawn.empty(), run.out_dir + "/rollup.gp");
     if (!not_drawn.empty()) return cannot_write(not_drawn), 1;
     std::printf("   wrote %s.png and .svg\n", base.c_str());
     return 0;

@@ -774,6 +774,7 @@ int run_command(int argc, char **argv) {
             return 0;
         }
         const std::string not_drawn = plot_vorticity(o, data, written.bytes, dt, method);
+        if (interrupted_by) return interrupted_drawing(not_drawn.empty(), o.out_dir + "/vorticity.gp");
         if (!not_drawn.empty()) {
             std::fprintf(stderr, "lpi run: %s\n", not_drawn.c_str());
             return 1;

@@ -21,6 +21,15 @@ void catch_interrupts() {
     sigaction(SIGTERM, &action, nullptr);
 }
 
+int interrupted_drawing(bool drawn, const std::string &script) {
+    if (drawn)
+        std::printf("interrupted after the images were drawn\n");
+    else
+        std::printf("interrupted while the images were drawn: none was replaced (%s draws them)\n",
+                    script.c_str());
+    return 128 + interrupted_by;
+}
+
 extern "C" int watch_steps(const lpi_system *, int64_t step, double, void *user) {
     Watch *watch = static_cast<Watch *>(user);
     // Every process observes the same steps: they stop at the same one.

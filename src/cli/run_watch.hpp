@@ -8,6 +8,7 @@
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
+#include <string>
 
 #include <liepoisson.h>
 
@@ -18,6 +19,11 @@ extern volatile std::sig_atomic_t interrupted_by;
 
 // One shot: a second Ctrl-C ends the command at once (SA_RESETHAND).
 void catch_interrupts();
+
+// After a signal that came while the images of a finished run were drawn
+// (gnuplot is ended then, PlotScript::draw): says whether they were, and
+// returns the exit status, 128 + the signal's number.
+int interrupted_drawing(bool drawn, const std::string &script);
 
 // A progress bar with the time left, on stderr, only when it is a terminal;
 // redrawn at most ten times a second (wall clock).
