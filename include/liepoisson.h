@@ -285,8 +285,9 @@ LPI_API int lpi_moments_add_product_piece(lpi_system *sys, lpi_scalar_fn h, lpi_
  * round-off. See lpi_sine_euler_create(3). */
 
 /* Built without FFTW3: LPI_ERR_UNSUPPORTED. N even or < 3: LPI_ERR_INVALID.
- * A system needing more bytes (about 42 N^2) than the machine's physical
- * memory: LPI_ERR_NO_MEMORY, before anything is allocated. */
+ * A system needing more bytes (about 42 N^2, 58 N^2 for composite N) than
+ * the machine's physical memory: LPI_ERR_NO_MEMORY, before anything is
+ * allocated. */
 LPI_API int lpi_sine_euler_create(lpi_system **out, int32_t N);
 /* N of a sine-Euler system (LPI_ERR_UNSUPPORTED for another kind of system). */
 LPI_API int lpi_sine_euler_size(const lpi_system *sys, int32_t *N);

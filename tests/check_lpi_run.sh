@@ -50,6 +50,7 @@ refused --N report --N 1e12 --out "$out/bad"
 refused --N report --N 8 --out "$out/bad"
 refused --out report --out
 refused no-such-scene report no-such-scene
+refused "named twice" report pendulum rigid-body pendulum --out "$out/bad"
 refused --bogus report --bogus
 refused FILTER stress a b
 # An option may be given once, a flag too; an operand is never empty; an

@@ -10,7 +10,10 @@
 // layout and the two-at-a-time evaluation change no operation), and that is
 // (exp(t Lambda_l) - 1) / N computed from the angles with std::polar. Both
 // for the kernels this CPU runs (AVX2 where it has it) and for the baseline
-// ones, which every other CPU runs.
+// ones, which every other CPU runs. The transposed modes the flows of
+// composite N keep (transpose_kept_half) hold every line where its
+// transposed_view says, and a gather, scatter and transpose back there gives
+// the bits of the same gather and scatter in the modes themselves.
 #include <algorithm>
 #include <complex>
 #include <cstdint>
@@ -129,6 +132,47 @@ void test_gather_scatter_follow_the_lines(void **) {
         }
 }
 
+// N = 105 has General directions whose j1 and j2 differ (k = (3, 10): j =
+// (1, 2) / 4), where those of 15, 35 and 75 have j1 = j2.
+const int kTransposedSizes[] = {15, 105};
+
+void test_transposed_modes_hold_the_lines(void **) {
+    Random random{3};
+    for (const Kernels &kernels : kKernels)
+        for (int N : kTransposedSizes) {
+            const std::size_t doubles = 2 * static_cast<std::size_t>(N) * N;
+            const LineBlocks blocks(N);
+            for (const Direction &D : projective_line(N)) {
+                const Direction view = transposed_view(D);
+                for (int b = 0; b < blocks.count(); ++b) {
+                    const int d0 = blocks.first_line(b), count = blocks.lines(b), lane = blocks.first_lane(b);
+                    const std::vector<double> w = hermitian_field(N, random), stale = out_of_date(w, N, random);
+                    // Its kept half from the modes' kept half alone, the rest
+                    // of it left as it was (numbers no flow may read).
+                    std::vector<double> t = out_of_date(w, N, random), t_stale = t;
+                    transpose_kept_half(N, stale.data(), t.data());
+                    for (std::size_t m = 0; m < doubles / 2; ++m) {
+                        const std::size_t r = m / N, c = m % N, at = c * N + r;  // t's (r, c) is mode (c, r)
+                        if (kept(m, N))
+                            assert_memory_equal(&t[2 * m], &w[2 * at], 2 * sizeof(double));
+                        else
+                            assert_memory_equal(&t[2 * m], &t_stale[2 * m], 2 * sizeof(double));
+                    }
+                    std::vector<double> x(2 * static_cast<std::size_t>(N) * count), y(x.size());
+                    kernels.gather(D, N, d0, count, lane, stale.data(), x.data());
+                    kernels.gather(view, N, d0, count, lane, t.data(), y.data());
+                    assert_memory_equal(x.data(), y.data(), sizeof(double) * x.size());
+                    for (double &z : x) z = random.next();
+                    std::vector<double> direct = stale, back = stale;
+                    kernels.scatter(D, N, d0, count, lane, x.data(), direct.data());
+                    kernels.scatter(view, N, d0, count, lane, x.data(), t.data());
+                    transpose_kept_half(N, t.data(), back.data());
+                    assert_memory_equal(direct.data(), back.data(), sizeof(double) * doubles);
+                }
+            }
+        }
+}
+
 const int kPhaseSizes[] = {7, 35, 49, 125};
 
 void test_phase_is_the_complex_arithmetic(void **) {
@@ -190,6 +234,7 @@ int main() {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gather_scatter_follow_the_lines),
         cmocka_unit_test(test_phase_is_the_complex_arithmetic),
+        cmocka_unit_test(test_transposed_modes_hold_the_lines),
     };
     return lpi_run_tests(tests);
 }

@@ -102,6 +102,8 @@ int report_command(int argc, char **argv) {
         auto it = std::find_if(all.begin(), all.end(), [&](const Scene &s) { return s.name == name; });
         if (it == all.end()) args.fail("unknown scene '" + name + "' (lpi --help lists them)");
         if (it->run_own) args.fail("'" + name + "' is run by lpi run " + name + ", not reported");
+        // Twice, it ran twice, the second run writing over the first's files.
+        if (std::find(chosen.begin(), chosen.end(), &*it) != chosen.end()) args.fail("scene '" + name + "' named twice");
         chosen.push_back(&*it);
     }
     if (chosen.empty())

@@ -81,7 +81,10 @@ public:
                 next_observed = observer.every <= INT64_MAX - step ? step + observer.every : INT64_MAX;
             const bool final = step == n;
             if (merge_seam_) {
-                if (observed && !final) pending_.assign(state, state + size);
+                if (observed && !final) {
+                    model.settle(state);  // the copy must hold what the flows may keep elsewhere
+                    pending_.assign(state, state + size);
+                }
                 if (observed || final) {
                     model.flow(program_[last].piece, program_[last].weight * dt, state);
                 } else {

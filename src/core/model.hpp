@@ -37,10 +37,12 @@ public:
     // Exact flow of piece k for time t, in place on the working layout.
     // Flows may leave out of date the part of the state that follows from
     // the rest (sine-Euler: the conjugate half of the modes), which they
-    // never read; settle writes it. The integrator settles the state before
-    // anything but a flow reads it.
+    // never read, and may work on a copy of their own (sine-Euler: the modes
+    // transposed); settle writes both back. The integrator settles the state
+    // before anything but a flow reads or copies it; prepare_step drops a
+    // copy that a failed step left behind.
     virtual void flow(std::size_t piece, double t, double *state) = 0;
-    virtual void settle(double * /*state*/) const {}
+    virtual void settle(double * /*state*/) {}
 
     virtual double energy(const double *state) const = 0;
     virtual std::size_t casimir_count() const = 0;

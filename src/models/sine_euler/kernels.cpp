@@ -447,6 +447,19 @@ void write_conjugate_half(int N, double *w) {
                 store(w + 2 * mode_index(a, b, N), conjugate(load<Complex1>(w + 2 * mirror_index(a, b, N))));
 }
 
+void transpose_kept_half(int N, const double *__restrict src, double *__restrict dst) {
+    const int M = (N - 1) / 2;
+    constexpr int kTile = 16;  // 16 rows of src read a cache line each, used by 4 rows of dst
+    for (int r0 = 0; r0 <= M; r0 += kTile)
+        for (int c0 = 0; c0 < N; c0 += kTile)
+            for (int r = r0; r < std::min(r0 + kTile, M + 1); ++r)
+                for (int c = c0, end = std::min(c0 + kTile, r == 0 ? M + 1 : N); c < end; ++c) {
+                    const bool kept = kept_mode(c, r, N);
+                    const double *z = src + 2 * (kept ? mode_index(c, r, N) : mirror_index(c, r, N));
+                    store(dst + 2 * mode_index(r, c, N), load<Complex1>(z) * conjugating(!kept));
+                }
+}
+
 const char *kernel_instruction_set() {
 #if LPI_AVX2_KERNELS
     if (cpu_has_avx2()) return "avx2";

@@ -29,6 +29,11 @@ void scatter_block(const Direction &D, int N, int d0, int count, int first_lane,
                    double *w);
 // Writes every mode outside the kept half as the conjugate of its mirror.
 void write_conjugate_half(int N, double *w);
+// Writes the kept half of dst as the transpose of the modes src keeps: entry
+// (r, c) of dst is mode (c, r) of src, copied or conjugated exactly. The
+// transpose has the same mirrors, so dst is a kept half in its own right, and
+// the same call takes it back.
+void transpose_kept_half(int N, const double *src, double *dst);
 // The phase tables of one flow: kPhaseArrays arrays of 2N doubles, array a
 // at tables + 2 N a, written by write_phase and read by apply_phase.
 constexpr int kPhaseArrays = 6;

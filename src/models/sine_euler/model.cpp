@@ -75,7 +75,12 @@ class SineEuler final : public SineEulerModel {
 public:
     explicit SineEuler(int N)
         : N_(N), blocks_(N), eps_(2.0 * std::acos(-1.0) / N), dirs_(projective_line(N)),
-          hamiltonian_(N) {}
+          hamiltonian_(N) {
+        for (const Direction &D : dirs_) views_.push_back(transposed_view(D));
+        if (std::any_of(dirs_.begin(), dirs_.end(),
+                        [](const Direction &D) { return orientation(D) == Orientation::Transposed; }))
+            transposed_modes_.resize(2 * static_cast<std::size_t>(N) * N);
+    }
 
     const char *kind() const override { return "sine-euler"; }
     int truncation() const override { return N_; }
@@ -125,12 +130,18 @@ public:
     void grid(const double *state, double *out) const override { grid_from_modes(N_, state, out); }
 
     // Room for what FFTW's executions allocate (the plans are made by the
-    // first flow, which a baseline method never calls).
+    // first flow, which a baseline method never calls). And the transposed
+    // modes of a step that failed half-way are dropped: the state it started
+    // from was restored.
     void prepare_step() override {
         require_fftw_execution_headroom(N_, threads_);
+        transposed_ = false;
     }
     void flow(std::size_t piece, double t, double *state) override;
-    void settle(double *state) const override { write_conjugate_half(N_, state); }
+    void settle(double *state) override {
+        oriented_modes(Orientation::Modes, state);
+        write_conjugate_half(N_, state);
+    }
 
     double energy(const double *state) const override { return hamiltonian_.energy(state); }
     double enstrophy(const double *state) const override {
@@ -161,6 +172,18 @@ public:
     FftPlanning planning() const override { return planning_; }
 
 private:
+    // Column directions move their blocks fastest in the transposed modes
+    // (orientation, projective_line.hpp). Composite N have many, and the
+    // splitting meets all but (0,1) one after another (projective_line's
+    // order: a leapfrog step runs them, and the General ones among them, as
+    // one stretch). So the first of them transposes the kept half into
+    // transposed_modes_, the flows stay there, Column and General alike,
+    // and the next Row direction (or settle) transposes it back: two passes
+    // over half the modes for a stretch of flows. Every value is copied or
+    // conjugated exactly and every line keeps its elements' order: the same
+    // bits. The modes the flows work on, state or transposed_modes_, moved
+    // to where `wanted` says first.
+    double *oriented_modes(Orientation wanted, double *state);
     LineTransforms &transforms();
     bool line_spectrum(const Direction &D, const double *w);
 
@@ -168,6 +191,9 @@ private:
     LineBlocks blocks_;
     double eps_;
     std::vector<Direction> dirs_;
+    std::vector<Direction> views_;           // dirs_ as the transposed modes hold their lines
+    std::vector<double> transposed_modes_;  // the kept half, transposed (composite N only)
+    bool transposed_ = false;               // whether the flows' modes are there now
     Hamiltonian hamiltonian_;
     SplitChoice split_{{"directions"}};
     int threads_ = 1;
@@ -184,17 +210,30 @@ LineTransforms &SineEuler::transforms() {
 // B = FFT(b) of D's line stream b (line_stream; real). Returns false when
 // every b_s is zero.
 bool SineEuler::line_spectrum(const Direction &D, const double *w) {
-    if (!line_stream(D, hamiltonian_, w, transforms_->spectrum())) return false;
+    if (!line_stream(D, hamiltonian_, w, transposed_, transforms_->spectrum())) return false;
     transforms_->transform_spectrum();
     return true;
+}
+
+double *SineEuler::oriented_modes(Orientation wanted, double *state) {
+    if (wanted == Orientation::Transposed && !transposed_) {
+        transpose_kept_half(N_, state, transposed_modes_.data());
+        transposed_ = true;
+    } else if (wanted == Orientation::Modes && transposed_) {
+        transpose_kept_half(N_, transposed_modes_.data(), state);
+        transposed_ = false;
+    }
+    return transposed_ ? transposed_modes_.data() : state;
 }
 
 void SineEuler::flow(std::size_t piece, double t, double *state) {
     transforms();
     const Direction &D = dirs_[piece];
+    double *w = oriented_modes(orientation(D), state);
+    const Direction &lines = transposed_ ? views_[piece] : D;
     // A piece whose stream function is zero on its line moves nothing: its flow is the identity
     // (taken exactly, not through a round trip of FFTs).
-    if (!line_spectrum(D, state)) return;
+    if (!line_spectrum(D, w)) return;
     // Block b, lines d = d0 .. d0+count-1 of D: gather z_s = w_{d j + s k}
     // into x[s * count + (d - d0)], transform along s, multiply by the line's
     // (exp(t Lambda_l) - 1) / N, transform back, add the increments to the
@@ -203,13 +242,13 @@ void SineEuler::flow(std::size_t piece, double t, double *state) {
     run_line_flows(
         *transforms_, N_, blocks_.M, threads_, t / (2.0 * eps_),
         [&](int b, double *x) {
-            gather_block(D, N_, blocks_.first_line(b), blocks_.lines(b), blocks_.first_lane(b), state, x);
+            gather_block(lines, N_, blocks_.first_line(b), blocks_.lines(b), blocks_.first_lane(b), w, x);
         },
         [&](int b, double *x) {
             flow_block(*transforms_, N_, blocks_.first_line(b), blocks_.lines(b), -D.sigma, x);
         },
         [&](int b, double *x) {
-            scatter_block(D, N_, blocks_.first_line(b), blocks_.lines(b), blocks_.first_lane(b), x, state);
+            scatter_block(lines, N_, blocks_.first_line(b), blocks_.lines(b), blocks_.first_lane(b), x, w);
         });
 }
 
@@ -246,7 +285,8 @@ std::string gib(double bytes) {
 }
 
 // A sine-Euler system holds two working states of 2 N^2 doubles (the state
-// and the copy a failed step rolls back to), the N^2 doubles of lambda (the
+// and the copy a failed step rolls back to), for composite N a third (the
+// flows' transposed modes), the N^2 doubles of lambda (the
 // Hamiltonian's f, 2 N^2 more, is allocated when set), one byte per mode and direction
 // to say which modes each piece owns, and for composite N one byte per mode
 // while the directions are built. Refused before anything is allocated when
@@ -257,15 +297,17 @@ void require_memory(int N) {
     for (int p : prime_factors(N)) classes = classes / p * (static_cast<std::size_t>(p) + 1);
     const bool prime = classes == static_cast<std::size_t>(N) + 1;
     const std::size_t n = N;
+    const std::size_t arrays = prime ? 2 : 3;  // of 2 N^2 doubles
     std::size_t modes = 0, states = 0, tables = 0, bytes = 0;
     const bool fits = checked_multiply(n, n, modes) &&
-                      checked_multiply(modes, (2 * 2 + 1) * sizeof(double), states) &&
+                      checked_multiply(modes, (arrays * 2 + 1) * sizeof(double), states) &&
                       checked_multiply(classes + (prime ? 0 : n), n, tables) &&
                       states <= SIZE_MAX - tables;
     const std::string what = "sine-Euler N = " + std::to_string(N) + " needs ";
-    const std::string parts = " (two working states of 2 N^2 doubles, lambda and the direction tables)";
+    const std::string parts = std::string(" (") + (prime ? "two" : "three") +
+                              " working states of 2 N^2 doubles, lambda and the direction tables)";
     if (!fits) {  // the same count in floating point, to say how far beyond
-        const double estimate = (2 * 2 + 1) * sizeof(double) * static_cast<double>(n) * static_cast<double>(n) +
+        const double estimate = (arrays * 2 + 1) * sizeof(double) * static_cast<double>(n) * static_cast<double>(n) +
                                 static_cast<double>(classes + (prime ? 0 : n)) * static_cast<double>(n);
         char text[32];
         std::snprintf(text, sizeof text, "%.3g", estimate);

@@ -129,6 +129,22 @@ void for_each_direction(int N, const std::function<void(Direction &&)> &visit,
     }
 }
 
+Direction transposed_view(const Direction &D) {
+    Direction view;
+    view.k1 = D.k2, view.k2 = D.k1, view.j1 = D.j2, view.j2 = D.j1;
+    view.layout = D.layout == Direction::Row      ? Direction::Column
+                  : D.layout == Direction::Column ? Direction::Row
+                                                  : Direction::General;
+    view.sigma = D.sigma;
+    return view;
+}
+
+Orientation orientation(const Direction &D) {
+    if (D.layout == Direction::Row) return Orientation::Modes;
+    if (D.layout == Direction::Column && D.k1 != 0) return Orientation::Transposed;
+    return Orientation::Either;
+}
+
 std::vector<Direction> projective_line(int N) {
     std::vector<Direction> dirs;
     for_each_direction(N, [&](Direction &&D) { dirs.push_back(std::move(D)); });
@@ -147,7 +163,7 @@ double piece_energy(const Direction &D, const Hamiltonian &H, const double *mode
     return sum;
 }
 
-bool line_stream(const Direction &D, const Hamiltonian &H, const double *modes, double *b) {
+bool line_stream(const Direction &D, const Hamiltonian &H, const double *modes, bool transposed, double *b) {
     const int N = H.truncation();
     const double *lambda = H.weights(), *f = H.forcing();
     int a = 0, c = 0;
@@ -155,10 +171,12 @@ bool line_stream(const Direction &D, const Hamiltonian &H, const double *modes, 
     for (int s = 0; s < N; ++s) {
         if (D.owned[s]) {
             // A mode outside the half the flows keep is its mirror's
-            // conjugate (kernels.cpp): the same bits.
+            // conjugate (kernels.cpp): the same bits. Mode (a, c) is at
+            // (c, a) in the transposed modes.
             const std::size_t m = mode_index(a, c, N);
-            const bool kept = kept_mode(a, c, N);
-            const std::size_t k = kept ? m : mirror_index(a, c, N);
+            const int row = transposed ? c : a, column = transposed ? a : c;
+            const bool kept = kept_mode(row, column, N);
+            const std::size_t k = kept ? mode_index(row, column, N) : mirror_index(row, column, N);
             b[2 * s] = modes[2 * k] * lambda[m];
             b[2 * s + 1] = (kept ? modes[2 * k + 1] : -modes[2 * k + 1]) * lambda[m];
             if (f) {
