@@ -90,10 +90,10 @@ _C_INTEGER_RANGES = {
 
 def _integer(value, what, ctype):
     """value as an int that fits the C type ctype ("int32", "int64", "size"):
-    TypeError for a non-integer (a float, a string, a bool, numpy's bool_,
-    which has an __index__ of its own), OverflowError outside the type's
-    range."""
-    if isinstance(value, bool) or type(value).__name__ == "bool_":
+    TypeError for a non-integer (a float, a string, a bool, numpy's bool_ -
+    named bool from numpy 2 on - which has an __index__ of its own),
+    OverflowError outside the type's range."""
+    if isinstance(value, bool) or type(value).__name__ in ("bool_", "bool"):
         raise TypeError("%s must be an integer, not %s" % (what, type(value).__name__))
     try:
         v = operator.index(value)
