@@ -8,9 +8,14 @@
 !                 argument. When status is absent, a failure stops the program
 !                 with the library's message (as Fortran I/O does without
 !                 iostat=); when present, it receives LPI_OK, the negative
-!                 LPI_ERR_* code (then lpi_last_error(sys) gives the message)
-!                 or, from lpi_step, the positive LPI_STOPPED (not a failure:
-!                 never stops).
+!                 LPI_ERR_* code (then lpi_last_error(sys) gives the message;
+!                 for LPI_ERR_BUSY because another thread is inside a call on
+!                 the handle, lpi_last_error(c_null_ptr), as in C: the
+!                 handle's own is that thread's to write) or, from lpi_step,
+!                 the positive LPI_STOPPED (not a failure: never stops).
+! An empty array is passed as a length of 0 whatever made it (gfortran
+! passes an empty array constructor as a NULL address, which C would refuse
+! as a NULL pointer).
 ! What C cannot see is refused here, before any C call and changing nothing:
 ! a string holding a NUL (LPI_ERR_INVALID: C would stop reading there), a
 ! negative dim (LPI_ERR_INVALID), sine-Euler arrays not N x N and the four
@@ -550,10 +555,18 @@ contains
         integer(c_int), intent(in) :: st
         type(c_ptr), intent(in) :: sys
         integer, intent(out), optional :: status
+        character(len=:), allocatable :: message
         if (present(status)) then
             status = st
         else if (st < 0) then
-            error stop "liepoisson: "//f_string(c_lpi_status_name(st))//": "//f_string(c_lpi_last_error(sys))
+            ! Refused because another thread is inside a call on the handle:
+            ! the message is this thread's, and the handle's is the other
+            ! thread's to write (reading it would race with that thread).
+            message = ""
+            if (st == LPI_ERR_BUSY) message = f_string(c_lpi_last_error(c_null_ptr))
+            if (index(message, "another thread is inside a call on this handle") == 0) &
+                message = f_string(c_lpi_last_error(sys))
+            error stop "liepoisson: "//f_string(c_lpi_status_name(st))//": "//message
         end if
     end subroutine
 
@@ -622,12 +635,16 @@ contains
         call finish(c_lpi_rigid_body_create(sys, i1, i2, i3), c_null_ptr, status)
     end subroutine
 
+    ! m is left as it was on a failure (also a strided section: C writes a
+    ! local copy).
     recursive subroutine lpi_rigid_body_exact(sys, t, m, status)
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: t
-        real(c_double), intent(out) :: m(:)
+        real(c_double), intent(inout) :: m(:)
         integer, intent(out), optional :: status
         character(len=24) :: text
+        real(c_double) :: out(3)
+        integer(c_int) :: st
         ! C writes three values and is told no length: any other size is
         ! refused here (a size 2 array was written past its end).
         if (size(m) /= 3) then
@@ -635,7 +652,9 @@ contains
             call refuse(LPI_ERR_SIZE, "m has "//trim(text)//" elements, the exact solution 3", status)
             return
         end if
-        call finish(c_lpi_rigid_body_exact(sys, t, m), sys, status)
+        st = c_lpi_rigid_body_exact(sys, t, out)
+        if (st == LPI_OK) m = out
+        call finish(st, sys, status)
     end subroutine
 
     recursive subroutine lpi_pendulum_create(sys, status)
@@ -681,7 +700,12 @@ contains
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: x(:)
         integer, intent(out), optional :: status
-        call finish(c_lpi_set_state(sys, x, size(x, kind=c_size_t)), sys, status)
+        real(c_double) :: none(1) = 0  ! saved: read by nobody (a length of 0)
+        if (size(x) == 0) then
+            call finish(c_lpi_set_state(sys, none, 0_c_size_t), sys, status)
+        else
+            call finish(c_lpi_set_state(sys, x, size(x, kind=c_size_t)), sys, status)
+        end if
     end subroutine
 
     recursive subroutine lpi_get_state(sys, x, status)
@@ -782,7 +806,12 @@ contains
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(in) :: gammas(:)
         integer, intent(out), optional :: status
-        call finish(c_lpi_set_composition(sys, size(gammas, kind=c_size_t), gammas), sys, status)
+        real(c_double) :: none(1) = 0  ! saved: read by nobody (a length of 0)
+        if (size(gammas) == 0) then
+            call finish(c_lpi_set_composition(sys, 0_c_size_t, none), sys, status)
+        else
+            call finish(c_lpi_set_composition(sys, size(gammas, kind=c_size_t), gammas), sys, status)
+        end if
     end subroutine
 
     recursive subroutine lpi_flows_per_step(sys, flows, status)
@@ -835,10 +864,15 @@ contains
         type(c_ptr), intent(in), optional :: user
         integer, intent(out), optional :: status
         type(c_ptr) :: u
+        integer(c_int32_t) :: none(1) = 0  ! saved: read by nobody (a length of 0)
         u = c_null_ptr
         if (present(user)) u = user
-        call finish(c_lpi_add_piece(sys, size(indices, kind=c_size_t), indices, c_funloc(grad), &
-                                    c_funloc(energy), u), sys, status)
+        if (size(indices) == 0) then
+            call finish(c_lpi_add_piece(sys, 0_c_size_t, none, c_funloc(grad), c_funloc(energy), u), sys, status)
+        else
+            call finish(c_lpi_add_piece(sys, size(indices, kind=c_size_t), indices, c_funloc(grad), &
+                                        c_funloc(energy), u), sys, status)
+        end if
     end subroutine
 
     recursive subroutine lpi_add_casimir(sys, fn, user, status)
@@ -859,8 +893,13 @@ contains
         integer, intent(out), optional :: status
         integer(c_size_t) :: r
         integer(c_int) :: st
+        real(c_double) :: none(1) = 0  ! saved: read by nobody (a length of 0)
         r = 0
-        st = c_lpi_poisson_rank(sys, x, size(x, kind=c_size_t), r)
+        if (size(x) == 0) then
+            st = c_lpi_poisson_rank(sys, none, 0_c_size_t, r)
+        else
+            st = c_lpi_poisson_rank(sys, x, size(x, kind=c_size_t), r)
+        end if
         rank = int(r)
         call finish(st, sys, status)
     end subroutine
@@ -1187,7 +1226,12 @@ contains
         ! address C reads from holds the bytes in order.
         integer(c_int8_t), contiguous, target, intent(in) :: bytes(:)
         integer, intent(out), optional :: status
-        call finish(c_lpi_load_buffer(sys, c_loc(bytes), size(bytes, kind=c_size_t)), c_null_ptr, status)
+        integer(c_int8_t), target :: none(1) = 0  ! saved: read by nobody (a length of 0)
+        if (size(bytes) == 0) then
+            call finish(c_lpi_load_buffer(sys, c_loc(none), 0_c_size_t), c_null_ptr, status)
+        else
+            call finish(c_lpi_load_buffer(sys, c_loc(bytes), size(bytes, kind=c_size_t)), c_null_ptr, status)
+        end if
     end subroutine
 
 end module liepoisson

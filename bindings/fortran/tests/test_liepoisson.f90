@@ -183,7 +183,7 @@ contains
 
     subroutine test_rigid_body()
         type(c_ptr) :: sys, copy, copy2
-        real(c_double) :: m(3), m_copy(3), c0(1), c1(1), exact(3), h, short_m(2)
+        real(c_double) :: m(3), m_copy(3), c0(1), c1(1), exact(3), h, short_m(2), spread_m(5)
         integer(c_int8_t), allocatable :: bytes(:), spread_bytes(:)
         integer :: flows, status
         call lpi_rigid_body_create(sys, 1.0_c_double, 2.0_c_double, 3.0_c_double)
@@ -229,6 +229,12 @@ contains
         ! written past its end.
         call lpi_rigid_body_exact(sys, 1.0_c_double, short_m, status)
         call check(status == LPI_ERR_SIZE, "exact solution into 2 values refused")
+        ! A failure leaves m as it was, a strided section too (gfortran passed
+        ! C a temporary, copied back unwritten).
+        spread_m = 99.0_c_double
+        call lpi_rigid_body_exact(sys, ieee_nan(), spread_m(1::2), status)
+        call check(status == LPI_ERR_NONFINITE, "exact solution at t = NaN refused")
+        call check(all(spread_m == 99.0_c_double), "a failed exact solution leaves m as it was")
         call lpi_destroy(copy)
         call lpi_destroy(sys)
         call check(.not. c_associated(sys), "destroy nulls the handle")
@@ -260,6 +266,12 @@ contains
         call check(index(lpi_last_error(sys), "no-such-method'") > 0, "trailing blanks trimmed")
         call lpi_set_threads(sys, 2, status)
         call check(status == LPI_ERR_UNSUPPORTED, "threads on the pendulum")
+        ! An empty array constructor (passed by gfortran as a NULL address) is
+        ! a length of 0, as an empty variable is: not a NULL pointer.
+        call lpi_set_state(sys, [real(c_double) ::], status)
+        call check(status == LPI_ERR_SIZE, "empty constructor: LPI_ERR_SIZE, not NULL")
+        call lpi_set_composition(sys, [real(c_double) ::], status)
+        call check(status == LPI_ERR_INVALID, "no weights: LPI_ERR_INVALID, not NULL")
         call lpi_get_state(sys, after)
         call check(all(before == after), "state unchanged after failed calls")
         call lpi_set_method(sys, "leapfrog   ")

@@ -153,7 +153,11 @@ version_number() = Int(C.lpi_version_number())
 
 function _check(status, handle::Ptr{Cvoid} = C_NULL, cause = nothing)
     status >= 0 && return nothing
-    message = unsafe_string(C.lpi_last_error(handle))
+    # Refused because another thread is inside a call on the handle: the
+    # message is this thread's (the handle's is that thread's to write).
+    message = status == -13 ? unsafe_string(C.lpi_last_error(C_NULL)) : ""  # -13: LPI_ERR_BUSY (ABI)
+    occursin("another thread is inside a call on this handle", message) ||
+        (message = unsafe_string(C.lpi_last_error(handle)))
     # Julia has no exception chaining: a callback's exception joins the message.
     cause === nothing || (message *= " (callback threw: " * sprint(showerror, cause) * ")")
     throw(LiePoissonError(status, status_name(status), message))
