@@ -34,7 +34,8 @@ extern "C" {
  * aborting). Sine-Euler of order N (odd, >= 3) as lpi_sine_euler_create
  * makes it, its lines spread over the processes of comm (any count; more
  * than (N-1)/2 leaves some idle). LPI_ERR_INVALID when MPI is not running,
- * comm is MPI_COMM_NULL or the processes pass different N. The handle must be
+ * comm is MPI_COMM_NULL or an intercommunicator, or the processes pass
+ * different N. The handle must be
  * destroyed (lpi_destroy, collective) before MPI_Finalize. */
 LPI_API int lpi_sine_euler_create_mpi(lpi_system **out, int32_t N, MPI_Comm comm);
 

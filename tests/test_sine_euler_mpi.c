@@ -478,6 +478,17 @@ static void test_bad_input(void **state) {
         assert_null(none);
     }
     assert_int_equal(lpi_sine_euler_create_mpi(NULL, 13, MPI_COMM_WORLD), LPI_ERR_NULL);
+    /* An intercommunicator (even ranks against odd ones) is refused on every
+     * process: on 3, the odd group's one process waited for ever. */
+    if (size_ > 1) {
+        MPI_Comm group, inter;
+        MPI_Comm_split(MPI_COMM_WORLD, rank_ % 2, rank_, &group);
+        MPI_Intercomm_create(group, 0, MPI_COMM_WORLD, rank_ % 2 ? 0 : 1, 99, &inter);
+        LPI_ASSERT_FAILS(NULL, lpi_sine_euler_create_mpi(&none, 13, inter), LPI_ERR_INVALID,
+                         "intercommunicator");
+        assert_null(none);
+        MPI_Comm_free(&inter), MPI_Comm_free(&group);
+    }
     lpi_destroy(spread), lpi_destroy(single);
 }
 

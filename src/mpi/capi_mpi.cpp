@@ -48,7 +48,13 @@ LPI_API int lpi_sine_euler_create_mpi(lpi_system **out, int32_t N, MPI_Comm comm
         auto communicator = std::make_shared<const lpi::mpi::Communicator>(comm);
         require_same_arguments(*communicator, Arguments(out));  // N: compared by the model, named
         require(out, "out");
-        *out = new lpi_system(lpi::make_sine_euler_mpi(N, communicator));
+        std::unique_ptr<lpi::Model> model = lpi::make_sine_euler_mpi(N, communicator);
+        // The handle's states are allocated here: one process short of memory
+        // fails the call on all of them (it failed alone, the others' handles
+        // left waiting in their next collective).
+        std::unique_ptr<lpi_system> handle;
+        communicator->agree([&] { handle = std::make_unique<lpi_system>(std::move(model)); });
+        *out = handle.release();
     });
 }
 

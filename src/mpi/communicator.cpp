@@ -46,6 +46,13 @@ Communicator::Communicator(MPI_Comm comm) {
     if (!mpi_running())
         fail(LPI_ERR_INVALID, "MPI is not initialised (call MPI_Init first) or already finalised");
     if (comm == MPI_COMM_NULL) fail(LPI_ERR_INVALID, "the communicator is MPI_COMM_NULL");
+    // Collectives on an intercommunicator pair the two groups instead of
+    // joining them (one process of a group of one waited for ever). Every
+    // process of one holds one: refused alike on each, without a collective.
+    int inter = 0;
+    if (MPI_Comm_test_inter(comm, &inter) == MPI_SUCCESS && inter)
+        fail(LPI_ERR_INVALID, "the communicator is an intercommunicator (a system is spread over the "
+                              "processes of one group: MPI_Intercomm_merge makes one)");
     // The duplicate returns its errors. The user's communicator keeps its own
     // handler, except while it is duplicated (a failure there is returned).
     MPI_Errhandler users = MPI_ERRHANDLER_NULL;
