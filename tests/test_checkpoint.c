@@ -330,6 +330,69 @@ static void test_resume_every_method(void **state) {
     lpi_destroy(sys);
 }
 
+/* A composition lpi_set_composition accepts makes a checkpoint that loads.
+ * Mirrored pairs run as their mean, which moves the weights' sum by half an
+ * ulp of a pair's: the sum test must be the one on the means, which is what
+ * the checkpoint stores and its load tests again. */
+static void test_composition_near_sum_tolerance(void **state) {
+    (void)state;
+    lpi_system *sys = rigid_body();
+    /* Exactly 1 as given; the means of the outer pair round to 2^19, so the
+     * weights that would run sum to 1 - 2^-33, beyond 1e-10. */
+    const double wide[3] = {524288.0, 1.0 - 1048576.0 - 0x1p-33, 524288.0 + 0x1p-33};
+    LPI_ASSERT_FAILS(sys, lpi_set_composition(sys, 3, wide), LPI_ERR_INVALID,
+                     "lpi_set_composition");
+    if (!strstr(lpi_last_error(sys), "mean"))
+        fail_msg("message '%s' does not say the means are tested", lpi_last_error(sys));
+    /* Weights near the relative tolerance (from a random search that found
+     * ones whose checkpoint did not load), and more of them at random: every
+     * accepted composition saves and loads with its weights. */
+    const double found[5] = {0.85997794259338556, -0.75558083539622878, 0.79120578560572918,
+                             -0.75558083539622367, 0.8599779425933779};
+    uint64_t bits = 0x9E3779B97F4A7C15u;
+    int accepted = 0, refused = 0;
+    for (int trial = 0; trial < 4000; ++trial) {
+        double g[5];
+        if (trial == 0) {
+            memcpy(g, found, sizeof g);
+        } else {
+            double u[4];
+            for (int k = 0; k < 4; ++k) {
+                bits ^= bits << 13, bits ^= bits >> 7, bits ^= bits << 17;
+                u[k] = (double)(bits >> 11) * 0x1p-53;
+            }
+            /* Pairs a few ulps apart, the sum off by up to 1.1 times the
+             * tolerance. */
+            g[0] = 2.0 * u[0] - 0.5, g[1] = -2.0 * u[1];
+            g[3] = g[1] * (1.0 + (u[2] - 0.5) * 1e-15);
+            g[4] = g[0] * (1.0 + (u[3] - 0.5) * 1e-15);
+            g[2] = 1.0 - g[0] - g[1] - g[3] - g[4];
+            const double magnitude = 2.0 * fabs(g[0]) + 2.0 * fabs(g[1]) + fabs(g[2]);
+            bits ^= bits << 13, bits ^= bits >> 7, bits ^= bits << 17;
+            g[2] += ((double)(bits >> 11) * 0x1p-53 - 0.5) * 2.2e-14 * magnitude;
+        }
+        if (lpi_set_composition(sys, 5, g) != LPI_OK) {
+            ++refused;
+            continue;
+        }
+        ++accepted;
+        size_t size;
+        unsigned char *buf = save(sys, &size);
+        lpi_system *copy = load(buf, size);
+        assert_string_equal(lpi_get_method(copy), "custom");
+        size_t again_size;
+        unsigned char *again = save(copy, &again_size);
+        assert_int_equal(again_size, size);
+        assert_memory_equal(again, buf, size);
+        free(again), free(buf);
+        lpi_destroy(copy);
+    }
+    print_message("%d compositions accepted, %d refused\n", accepted, refused);
+    /* Both outcomes occur, or the weights did not probe the edge. */
+    assert_true(accepted > 100 && refused > 100);
+    lpi_destroy(sys);
+}
+
 /* The methods a rigid body refuses: the matrix-form baselines, which apply to
  * sine-Euler only; those that need BLAS say so in a build without it. */
 static void test_resume_matrix_baselines(void **state) {
@@ -1161,6 +1224,7 @@ int main(void) {
         cmocka_unit_test(test_resume_sine_euler),
         cmocka_unit_test(test_resume_every_method),
         cmocka_unit_test(test_resume_matrix_baselines),
+        cmocka_unit_test(test_composition_near_sum_tolerance),
         cmocka_unit_test(test_truncated_and_flipped),
         cmocka_unit_test(test_foreign_newer_other_order),
         cmocka_unit_test(test_layout_and_round_trip),
