@@ -10,7 +10,8 @@
 //    round-off: relative drift at most a floor plus kDriftPerFlow per exact
 //    piece flow (a linear bound, the worst case of accumulated round-off; for
 //    generic systems times ||t A|| / 5.4, the error growth of scaling and
-//    squaring), judged on runs that stayed bounded;
+//    squaring), and kUnboundedSlack times that on a run that did not stay
+//    bounded;
 //  - every failure (rk4 beyond its stability limit, implicit-midpoint not
 //    converging) is a documented status with the state rolled back bit for bit.
 //
@@ -40,6 +41,13 @@ namespace lpi_cli {
 namespace {
 
 constexpr double kDriftPerFlow = 1e-15;  // about 4.5 unit round-offs per flow
+// A run that grows (an unstable composition of the moment algebra's shears)
+// makes its round-off at terms its samples do not see: inside a step whose
+// substeps grow and shrink them again. Sampling every step changes nothing
+// measured; sofroniou-spaletta-10 at dt = one period drifts 8 times the
+// bound. So such a run is judged against a looser bound, which a Casimir
+// actually lost (a drift of order 1 at these steps) still fails.
+constexpr double kUnboundedSlack = 1e4;
 
 struct Outcome {
     int status = LPI_OK;
@@ -172,16 +180,20 @@ int stress_command(int argc, char **argv) {
     std::printf("liepoisson %s: stress cases (%s)\n", lpi_version_string(), quick ? "quick" : "full");
     std::printf("energy error and Casimir drift are relative maxima over the samples (the energy\n"
                 "error |H - H(0)| itself where H(0) = 0, marked 'abs');\n"
-                "bounded: finite and max|x| <= 1e3 max|x(0)|; must-hold failures are marked '!!'\n");
+                "bounded: finite and max|x| <= 1e3 max|x(0)| at every sample ('-': the run failed\n"
+                "before its first sample); must-hold failures are marked '!!'\n");
     int violations = 0, runs = 0;
     for (const Case &k : cases) {
         if (!filter.empty() && k.name.find(filter) == std::string::npos) continue;
-        std::printf("\n== %s (fastest period %.3g)\n", k.name.c_str(), k.period);
-        std::printf("   %-9s %-9s %-22s %-22s %-7s %-10s %-10s %s\n", "dt/period", "steps",
+        if (k.period > 0.0)
+            std::printf("\n== %s (fastest period %.3g)\n", k.name.c_str(), k.period);
+        else
+            std::printf("\n== %s\n", k.name.c_str());
+        std::printf("   %-9s %-9s %-22s %-22s %-7s %-10s %-10s %s\n", k.period > 0.0 ? "dt/period" : "dt", "steps",
                     "method", "status", "bounded", "max dH/H", "C drift", "");
         const std::vector<bool> accepted = accepted_methods(k.create);
         for (double factor : k.factors) {
-            const double dt = factor * k.period;
+            const double dt = k.period > 0.0 ? factor * k.period : factor;
             for (int m = 0; m < lpi_method_count(); ++m) {
                 const std::string method = lpi_method_name(m);
                 if (!k.methods.empty() &&
@@ -197,23 +209,25 @@ int stress_command(int argc, char **argv) {
                 if (poisson && o.status != LPI_OK && o.status != k.allowed_failure) verdict += " !! Poisson method failed";
                 const double growth = k.pade_growth ? std::max(1.0, 2.0 * kPi * factor / 5.4) : 1.0;
                 const double tolerance =
-                    k.drift_floor + kDriftPerFlow * growth *
-                                        static_cast<double>(o.flows_per_step) *
-                                        static_cast<double>(o.steps_done);
-                // An unbounded run (an unstable composition of the moment
-                // algebra's shears) meets larger terms inside its steps than
-                // the samples show: its drift is printed, not judged.
-                if (poisson && o.bounded && !(o.casimir_drift <= tolerance))
-                    verdict += " !! Casimir drift";
+                    (k.drift_floor + kDriftPerFlow * growth *
+                                         static_cast<double>(o.flows_per_step) *
+                                         static_cast<double>(o.steps_done)) *
+                    (o.bounded ? 1.0 : kUnboundedSlack);
+                if (poisson && !(o.casimir_drift <= tolerance)) verdict += " !! Casimir drift";
                 if (!verdict.empty()) ++violations;
                 std::string status = lpi_status_name(o.status);
                 if (o.status != LPI_OK) status += o.rolled_back ? " (rolled back)" : "";
+                // A run that failed before its first sample measured nothing;
+                // one that failed later is bounded or not over what it ran.
+                const bool measured = o.steps_done > 0;
                 const std::string energy_error =
-                    format("%.2e%s", o.energy_error, o.absolute_energy_error ? " abs" : "");
-                std::printf("   %-9.0e %-9lld %-22s %-22s %-7s %-10s %-10.2e%s\n", factor,
+                    measured ? format("%.2e%s", o.energy_error, o.absolute_energy_error ? " abs" : "")
+                             : "-";
+                const std::string drift = measured ? format("%.2e", o.casimir_drift) : "-";
+                std::printf("   %-9.0e %-9lld %-22s %-22s %-7s %-10s %-10s%s\n", factor,
                             static_cast<long long>(o.steps_done), method.c_str(), status.c_str(),
-                            o.bounded ? "yes" : "no", energy_error.c_str(), o.casimir_drift,
-                            verdict.c_str());
+                            !measured ? "-" : o.bounded ? "yes" : "no", energy_error.c_str(),
+                            drift.c_str(), verdict.c_str());
                 if (o.status != LPI_OK) std::printf("      %s\n", o.message.c_str());
                 std::fflush(stdout);
             }

@@ -195,7 +195,6 @@ std::vector<Case> build_cases(bool quick) {
         Case k;
         k.name = "generic so(3), constants 1e100, dt = 1 (|tA| ~ 1e100)";
         k.create = [] { return generic_so3(1e100); };
-        k.period = 1.0;
         k.factors = {1.0};
         k.steps = 10;
         k.allowed_failure = LPI_ERR_INVALID;

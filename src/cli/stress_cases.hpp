@@ -12,15 +12,14 @@
 namespace lpi_cli {
 
 // Extra measured quantities a case may compute itself (moments).
-// Extra measured quantities a case may compute itself (moments).
 using CasimirMeasure = std::function<void(const std::vector<double> &x, std::vector<long double> &c,
                                           std::vector<long double> &scale)>;
 
 struct Case {
     std::string name;
     std::function<Handle()> create;  // configured system with its initial state
-    double period = 1.0;             // fastest period; steps are multiples of it
-    std::vector<double> factors;     // dt = factor * period
+    double period = 0.0;             // fastest period; steps are multiples of it
+    std::vector<double> factors;     // dt = factor * period (period 0: dt = factor)
     std::int64_t steps = 1000;
     std::vector<std::string> methods;  // empty: every method
     CasimirMeasure measure;            // empty: lpi_casimirs, scale from kind below
