@@ -16,6 +16,8 @@
 #include "core/error.hpp"
 #include "lpi_test.h"
 
+#include "core/cpu_features.hpp"
+#include "models/compiled_flows.hpp"
 #include "models/moments_algebra.hpp"
 
 // `call` returns LPI_OK, or the test fails with the handle's message.
@@ -147,6 +149,35 @@ void test_compiled_flows_match_the_general_plan(void **) {
     assert_int_equal(abelian_sets, 37);
 }
 
+// The flows compiled for the baseline and for FMA (chosen at run time) give
+// the same bits: fma rounds once, as an instruction or in libm. Near the
+// identity and far from it (each takes its own instantiation), with the
+// gradient's terms of either sign.
+void test_baseline_and_fma_flows_agree(void **) {
+    static constexpr lpi::compiled::Table<lpi::MomentAlgebra> table;
+    if (!lpi::cpu_has_fma()) LPI_SKIP("this processor has no FMA: only the baseline flows run here");
+    std::mt19937_64 rng(19);
+    std::uniform_real_distribution<double> u(-1.5, 1.5);
+    int flows = 0;
+    for (unsigned mask = 1; mask < 256; ++mask) {
+        if (!table.flows[mask]) continue;
+        assert_non_null(table.fma_flows[mask]);
+        for (int draw = 0; draw < 200; ++draw) {
+            double g[8], x[8], a[8], b[8];
+            for (double &v : g) v = u(rng);
+            for (double &v : x) v = u(rng);
+            const double t = draw % 2 ? 0.01 * u(rng) : 4.0 * u(rng);
+            std::memcpy(a, x, sizeof x);
+            std::memcpy(b, x, sizeof x);
+            assert_int_equal(table.flows[mask](g, t, a), table.fma_flows[mask](g, t, b));
+            if (std::memcmp(a, b, sizeof a) != 0)
+                fail_msg("index set 0x%02x, t = %g: the baseline and FMA flows differ", mask, t);
+            ++flows;
+        }
+    }
+    std::printf("%d flows of the baseline and FMA instantiations, bit for bit equal\n", flows);
+}
+
 // A compiled flow that overflows is refused as the general one is: x
 // unchanged to the bit, LPI_ERR_NONFINITE naming the piece and a component.
 void test_compiled_flow_refuses_overflow(void **) {
@@ -228,8 +259,9 @@ void test_compiled_flow_takes_values_near_the_largest(void **) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_compiled_flows_match_the_general_plan),
+        cmocka_unit_test(test_baseline_and_fma_flows_agree),
         cmocka_unit_test(test_compiled_flow_refuses_overflow),
         cmocka_unit_test(test_compiled_flow_takes_values_near_the_largest),
     };
-    return cmocka_run_group_tests(tests, nullptr, nullptr);
+    return lpi_run_tests(tests);
 }

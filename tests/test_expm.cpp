@@ -324,10 +324,10 @@ void test_plane_closed_form(void **) {
         assert_true(error < 16 * 2.2e-16 * std::max(1.0, norm));
         assert_true(y[1] == x[1]);
     }
-    // A self-loop alone: x' = a x, exp = e^a.
+    // A self-loop alone (x' = a x, exp = e^a): a diagonal, the series' path.
     const std::vector<lpi::SparseTerm> loop = {{1, 1, 0, -0.75}};
     lpi::SparseExponential exponential(2, loop);
-    assert_int_equal(static_cast<int>(exponential.path()), static_cast<int>(lpi::ExpmPath::Plane));
+    assert_int_equal(static_cast<int>(exponential.path()), static_cast<int>(lpi::ExpmPath::DiagonalSeries));
     double z[2] = {4.0, 3.0};
     const double g = 2.0;
     exponential.apply(&g, 0.5, z);
@@ -601,14 +601,15 @@ void expect_components(const std::vector<double> &y, const std::vector<long doub
 void test_contracted_components_keep_relative_accuracy(void **) {
     for (const double s : {0.5, 1.0, 4.0, 10.0, 30.0}) {
         const long double grow = std::exp(static_cast<long double>(s)), shrink = 1.0L / grow;
-        // diag(-s, s) and [[0, s], [s, 0]] on its two eigenvectors (1, -1), (1, 1).
+        // diag(-s, s) (the series' path) and [[0, s], [s, 0]] (the plane's) on its
+        // two eigenvectors (1, -1), (1, 1).
         const std::vector<lpi::SparseTerm> diagonal = {{0, 0, 0, -1.0}, {1, 1, 0, 1.0}};
         const std::vector<lpi::SparseTerm> boost = {{0, 1, 0, 1.0}, {1, 0, 0, 1.0}};
         lpi::SparseExponential scaling(2, diagonal), hyperbolic(2, boost);
-        assert_int_equal(static_cast<int>(scaling.path()), static_cast<int>(lpi::ExpmPath::Plane));
+        assert_int_equal(static_cast<int>(scaling.path()), static_cast<int>(lpi::ExpmPath::DiagonalSeries));
         std::vector<double> y = {0.7, -1.3};
         scaling.apply(&s, 1.0, y.data());
-        expect_components(y, {0.7L * shrink, -1.3L * grow}, "plane diag(-s, s)", s);
+        expect_components(y, {0.7L * shrink, -1.3L * grow}, "diag(-s, s)", s);
         y = {1.5, -1.5};
         hyperbolic.apply(&s, 1.0, y.data());
         expect_components(y, {1.5L * shrink, -1.5L * shrink}, "plane [[0, s], [s, 0]], contracted", s);
@@ -676,13 +677,13 @@ void test_contracted_components_keep_relative_accuracy(void **) {
 void test_scalings_past_the_range_of_exp(void **) {
     const std::vector<lpi::SparseTerm> loop = {{0, 0, 0, 1.0}};
     lpi::SparseExponential grow(1, loop);
-    assert_int_equal(static_cast<int>(grow.path()), static_cast<int>(lpi::ExpmPath::Plane));
+    assert_int_equal(static_cast<int>(grow.path()), static_cast<int>(lpi::ExpmPath::DiagonalSeries));
     const double a = 800.0;
     std::vector<double> y = {1e-300};
     grow.apply(&a, 1.0, y.data());
     const long double exact = 1e-300L * std::exp(800.0L);
     const double error = static_cast<double>(std::fabs(y[0] - exact) / exact);
-    std::printf("1x1 plane, 1e-300 e^800: %.17g, rel. error %.2e\n", y[0], error);
+    std::printf("1x1 diagonal, 1e-300 e^800: %.17g, rel. error %.2e\n", y[0], error);
     assert_true(error < 4 * 2.2e-16);
     y = {0.0};
     grow.apply(&a, 1.0, y.data());

@@ -24,6 +24,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "../core/cpu_features.hpp"
 #include "expm.hpp"
 
 namespace lpi {
@@ -248,12 +249,18 @@ struct Piece {
         return -1;
     }
 
-    // Near the identity (every scaling exponent below 1/2 in size, where no
-    // growth can fall below -1/2) the flow takes z + growth z throughout;
-    // otherwise a second instantiation, out of the first one's way, asks
-    // scaled_by_exponential for each scaling. Both give the general plan's
-    // bits.
-    static long flow(const double *g, double t, double *x) {
+    // Near the identity (every scaling exponent at most 1/2 in size, every
+    // factor a normal double within [e^-1/2, e^1/2]) the flow scales without
+    // asking; otherwise a second instantiation, out of the first one's way,
+    // asks scaled_by_exponential for each scaling. Both give the general
+    // plan's bits.
+    static long flow(const double *g, double t, double *x) { return flow_body(g, t, x); }
+#if LPI_FMA_DISPATCH
+    // The same flow with the exponentials' fma as instructions (the same bits).
+    LPI_TARGET_FMA static long flow_fma(const double *g, double t, double *x) { return flow_body(g, t, x); }
+#endif
+
+    [[gnu::always_inline]] static inline long flow_body(const double *g, double t, double *x) {
         double s[P.parameters];
         unroll<0, P.parameters>([&](auto p) { s[p] = shortened(t * g[p], P.shortening[p]); });
         bool far = false;
@@ -276,16 +283,16 @@ struct Piece {
     template <bool Far>
     [[gnu::always_inline]] static inline long flow_in(const double *s, double *x) {
         constexpr int depth = P.depth;
-        // For exp(tD): E_k = exp(k s) - 1 of each group by powers of
-        // expm1(+-s) (expm1_powers, shared with SparseExponential); first,
+        // For exp(tD): M_k = exp(k s) of each group by powers of one
+        // expm1 (exponential_powers, shared with SparseExponential); first,
         // so that nothing of x is held across the calls.
-        double growths[P.groups > 0 ? P.groups : 1][2 * kMaxMultiple + 1];
+        Exponential factors[P.groups > 0 ? P.groups : 1][2 * kMaxMultiple + 1];
         unroll<0, P.groups>([&](auto q) {
             constexpr Group G = P.group[q];
             if constexpr (Far)
-                expm1_powers(G.base * s[G.parameter], G.largest, growths[q] + kMaxMultiple);
+                exponential_powers(G.base * s[G.parameter], G.largest, factors[q] + kMaxMultiple);
             else
-                expm1_powers_near(G.base * s[G.parameter], G.largest, growths[q] + kMaxMultiple);
+                exponential_powers_near(G.base * s[G.parameter], G.largest, factors[q] + kMaxMultiple);
         });
         // c[v][k] = ((tN)^k x / k!)_v, written for k <= level(v) and read
         // only there (the general sweep's lanes above are exact zeros).
@@ -336,21 +343,22 @@ struct Piece {
         double scaled[P.scalings > 0 ? P.scalings : 1];
         unroll<0, P.scalings>([&](auto d) {
             constexpr Scaling S = P.scaling[d];
-            double growth, exponent;
+            Exponential factor;
+            double exponent;
             if constexpr (S.group < 0) {
                 exponent = S.coefficient * s[S.parameter];
-                growth = std::expm1(exponent);
+                factor = exponential_of(exponent);
             } else {
                 constexpr Group G = P.group[S.group];
                 exponent = S.multiple * (G.base * s[G.parameter]);
-                growth = growths[S.group][kMaxMultiple + S.multiple];
+                factor = factors[S.group][kMaxMultiple + S.multiple];
             }
             if constexpr (Far)
-                scaled[d] = scaled_by_exponential(y[S.index], growth, exponent);
+                scaled[d] = scaled_by_exponential(y[S.index], factor, exponent);
             else
-                scaled[d] = y[S.index] + growth * y[S.index];
+                scaled[d] = lpi::scaled(y[S.index], factor);
         });
-        // Near the identity every growth lies in [e^-1/2 - 1, e^1/2 - 1], so
+        // Near the identity every factor lies in [e^-1/2, e^1/2], so
         // no scaled value can overflow where every |y| is at most half the
         // largest double: a test on y, known before the exponentials, instead
         // of one at the end of the flow's chain of operations (with that one
@@ -375,27 +383,37 @@ struct Piece {
     }
 };
 
-template <class Algebra, unsigned Mask>
+template <class Algebra, unsigned Mask, bool Fma>
 constexpr CompiledFlow flow_of() {
-    if constexpr (Piece<Algebra, Mask>::P.usable)
-        return &Piece<Algebra, Mask>::flow;
-    else
+    if constexpr (!Piece<Algebra, Mask>::P.usable)
         return nullptr;
+#if LPI_FMA_DISPATCH
+    else if constexpr (Fma)
+        return &Piece<Algebra, Mask>::flow_fma;
+#endif
+    else
+        return &Piece<Algebra, Mask>::flow;
 }
 
-template <class Algebra, unsigned... Masks>
+template <class Algebra, bool Fma, unsigned... Masks>
 constexpr void fill_table(CompiledFlow *table, std::integer_sequence<unsigned, Masks...>) {
-    ((table[Masks] = flow_of<Algebra, Masks>()), ...);
+    ((table[Masks] = flow_of<Algebra, Masks, Fma>()), ...);
 }
 
 // The compiled flows of every index set of the algebra, by mask (nullptr
-// where there is none).
+// where there is none), for the baseline and for processors with FMA.
 template <class Algebra>
 struct Table {
     static_assert(Algebra::dim <= kMaxDim, "a compiled algebra has at most kMaxDim indices");
     CompiledFlow flows[1u << Algebra::dim] = {};
+    CompiledFlow fma_flows[1u << Algebra::dim] = {};
     constexpr Table() {
-        fill_table<Algebra>(flows, std::make_integer_sequence<unsigned, 1u << Algebra::dim>{});
+        fill_table<Algebra, false>(flows, std::make_integer_sequence<unsigned, 1u << Algebra::dim>{});
+        fill_table<Algebra, true>(fma_flows, std::make_integer_sequence<unsigned, 1u << Algebra::dim>{});
+    }
+    CompiledFlow flow(unsigned mask) const {
+        if (mask >= sizeof flows / sizeof flows[0]) return nullptr;
+        return cpu_has_fma() ? fma_flows[mask] : flows[mask];
     }
 };
 

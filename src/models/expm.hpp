@@ -18,6 +18,9 @@
 #include <limits>
 #include <vector>
 
+#include "../core/cpu_features.hpp"
+#include "../core/exact_sums.hpp"
+
 namespace lpi {
 
 // The n * n entries of a dense n x n matrix of doubles; LPI_ERR_NO_MEMORY
@@ -54,51 +57,73 @@ enum class ExpmPath { Nilpotent, DiagonalSeries, Plane, Pade };
 // path takes exp(t k c g_p) - 1 by powers of expm1(+-t c g_p).
 constexpr int kMaxScalingMultiple = 8;
 
-// One side of expm1_powers (below), E[side * k], from its base E[side] by the
-// recurrence.
-inline void expm1_side_powers(int side, double base, int largest, double *E) {
-    E[side] = base;
-    for (int k = 2; k <= largest; ++k) E[side * k] = E[side * (k - 1)] + base + E[side * (k - 1)] * base;
+// e^a as hi + lo, to about 2^-104 of itself, for a scaling z e^a =
+// fma(hi, z, lo z): one rounding, of a product that depends on the state. A
+// growth is a constant wherever the gradient is (a linear piece), rounded
+// alike in every flow, and a pair e^a, e^-a rounded apart moved their product
+// with one sign (sl(2), H = a h: e f, and the Casimir h^2 + 4 e f, 690
+// standard errors over 2e5 flows at t = a = 1, through the plane's closed
+// form; 149 through expm1 and -v / (1 + v) in doubles). Here one expm1 makes
+// every power of a group: (1 + v)^k and its reciprocals agree to 2^-100.
+struct Exponential {
+    double hi, lo;
+};
+// a + b, a b and 1 / a as double-doubles (exact_sums.hpp: the exact parts
+// through fma).
+inline Exponential exponential_sum(double a, double b) {
+    Exponential sum;
+    two_sum(a, b, sum.hi, sum.lo);
+    return sum;
+}
+inline Exponential exponential_product(Exponential a, Exponential b) {
+    Exponential product;
+    two_product(a.hi, b.hi, product.hi, product.lo);
+    product.lo += a.hi * b.lo + a.lo * b.hi;
+    return product;
+}
+inline Exponential exponential_reciprocal(Exponential a) {
+    const double r = 1.0 / a.hi;
+    // 1 - r a, its first part exact through fma.
+    return {r, (-std::fma(r, a.hi, -1.0) - r * a.lo) * r};
 }
 
-// E[k] = exp(k s) - 1 for k = +-1 .. +-largest (E points at k = 0), by
-// E_{k+1} = E_k + v + E_k v from v = E_1 = expm1(s) on one side and
-// E_{-k-1} = E_{-k} + w + E_{-k} w from w = E_-1 on the other. The growing
-// side must come from expm1 itself: for s < -ln 2, w = -v / (1 + v) would
-// take 1 + v = e^s by cancellation and leave every growing entry a relative
-// error e^|s| times the round-off, so there w = expm1(-s) and v follows from
-// it. For s >= -ln 2, w = -v / (1 + v) with 1 + v >= 1/2. Where one side
-// overflows, the other is -1 (its exponentials are below the smallest
-// double): those entries only contract, and scaled_by_exponential takes them
-// from exp itself. The DiagonalSeries path and the compiled flows share it,
-// so that they give the same bits.
-inline void expm1_powers(double s, int largest, double *E) {
-    auto side_powers = [largest, E](int side, double base) { expm1_side_powers(side, base, largest, E); };
-    auto other_side = [](double v) { return std::isfinite(v) ? -v / (1.0 + v) : -1.0; };
-    if (s >= -0.6931471805599453) {
-        const double v = std::expm1(s);
-        side_powers(1, v);
-        side_powers(-1, other_side(v));
-    } else {
-        const double w = std::expm1(-s);
-        side_powers(-1, w);
-        side_powers(1, other_side(w));
-    }
+// M[k] = e^(k s) for k = +-1 .. +-largest (M points at k = 0), from one
+// side's base 1 + expm1 as an exact sum, the other side its reciprocal, the
+// powers by products: each keeps its relative accuracy. The base is the
+// side that does not contract by more than half (1 + expm1(s) near e^s << 1
+// would keep only an absolute 2^-106); that test, and not the sign of s,
+// picks it, so that flows near the identity take one branch. Where the base
+// overflows, the other side is 0, and those scalings go to
+// scaled_beyond_range. The DiagonalSeries path and the compiled flows share
+// it, so that they give the same bits.
+inline void exponential_side_powers(int side, int largest, Exponential *M) {
+    for (int k = 2; k <= largest; ++k) M[side * k] = exponential_product(M[side * (k - 1)], M[side]);
+}
+inline void exponential_powers(double s, int largest, Exponential *M) {
+    const int base = s >= -0.6931471805599453 ? 1 : -1;
+    const double v = std::expm1(base * s);
+    M[base] = std::isfinite(v) ? exponential_sum(1.0, v) : Exponential{v, 0.0};
+    M[-base] = std::isfinite(v) ? exponential_reciprocal(M[base]) : Exponential{0.0, 0.0};
+    exponential_side_powers(1, largest, M);
+    exponential_side_powers(-1, largest, M);
+}
+// exponential_powers where |s| <= 1/2 (every multiple within [-1/2, 1/2], as
+// the compiled flows' near case asks): the same bits without its tests.
+inline void exponential_powers_near(double s, int largest, Exponential *M) {
+    M[1] = exponential_sum(1.0, std::expm1(s));
+    M[-1] = exponential_reciprocal(M[1]);
+    exponential_side_powers(1, largest, M);
+    exponential_side_powers(-1, largest, M);
+}
+// e^a alone, as one side of exponential_powers.
+inline Exponential exponential_of(double a) {
+    Exponential M[3];
+    exponential_powers(a, 1, M + 1);
+    return M[2];
 }
 
-// expm1_powers where |s| <= 1/2 (every multiple within [-1/2, 1/2], as the
-// compiled flows' near case asks): the same bits without its tests.
-inline void expm1_powers_near(double s, int largest, double *E) {
-    const double v = std::expm1(s);
-    expm1_side_powers(1, v, largest, E);
-    expm1_side_powers(-1, -v / (1.0 + v), largest, E);
-}
-
-// z exp(a), given growth = exp(a) - 1: z + growth z, rounding z once (no
-// bias near the identity), except where exp(a) contracts z by more than half.
-// There growth is close to -1 and z + growth z would keep only the accuracy of
-// z itself, a relative error e^-a times the round-off, so z is scaled by
-// exp(a) instead; and where exp(a) overflows, z e^a may still be a double
+// z e^a from M = e^a (exponential_powers): fma(M.hi, z, M.lo z), where M is
+// a normal double; past that range z e^a may still be a double
 // (scaled_beyond_range). The DiagonalSeries path, the 1x1 plane and the
 // compiled flows share it.
 double scaled_beyond_range(double z, double a);
@@ -106,9 +131,11 @@ double scaled_beyond_range(double z, double a);
 // contracted past e^-708 took the error of that rounding (2.6e-3 of z
 // e^-740 for z = 1e300).
 constexpr double kSmallestNormalExponent = -708.39641853226408;  // ln DBL_MIN
-inline double scaled_by_exponential(double z, double growth, double a) {
-    if (growth < -0.5) return a >= kSmallestNormalExponent ? z * std::exp(a) : scaled_beyond_range(z, a);
-    if (growth <= std::numeric_limits<double>::max()) return z + growth * z;
+inline double scaled(double z, Exponential M) { return std::fma(M.hi, z, M.lo * z); }
+inline double scaled_by_exponential(double z, Exponential M, double a) {
+    if (M.hi >= std::numeric_limits<double>::min() && M.hi <= std::numeric_limits<double>::max() &&
+        a >= kSmallestNormalExponent)
+        return scaled(z, M);
     return scaled_beyond_range(z, a);
 }
 // z exp(a), past the range of exp as well: the 2x2 plane's eigencomponents
@@ -304,6 +331,12 @@ private:
     bool sweep(double *x);
     bool sweep(double *x);                // in lanes_ lanes
     void apply_scalings(double *x);  // DiagonalSeries: exp(tD) after N, from times_
+    // Its body, compiled for the baseline and with FMA (cpu_features.hpp).
+    [[gnu::always_inline]] inline void scale(double *x);
+    void scale_baseline(double *x);
+#if LPI_FMA_DISPATCH
+    LPI_TARGET_FMA void scale_fma(double *x);
+#endif
     bool shear(double *x);  // depth 1, x untouched on failure
     void apply_plane(double t, double *x);  // a block of order 1 or 2
     // The plane's elliptic flows: M = exp(t A) as three shears (see
@@ -349,7 +382,7 @@ private:
     std::vector<double> coefficients_, accumulator_;
     std::vector<Scaling> scalings_;
     std::vector<PowerGroup> power_groups_;
-    std::vector<double> powers_;  // per group: exp(k s) - 1, k = -kMaxMultiple .. kMaxMultiple
+    std::vector<Exponential> powers_;  // per group: exp(k s), k = -kMaxMultiple .. kMaxMultiple
     std::vector<double> scaled_values_;
     std::vector<BlockEntry> block_;  // per position, block paths
     std::vector<bool> alone_;        // Pade: per local index, a component of its own

@@ -263,7 +263,10 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
         if (!diagonal(e)) commuting = commuting && same_terms(diagonal_at(e.row), diagonal_at(e.col));
     }
 
-    if (!acyclic || (any_diagonal && (m <= 2 || !commuting))) {
+    // A diagonal that commutes takes the series' path at any size, where its
+    // scalings are paired (exponential_powers); the plane's closed form
+    // rounded e^-r and e^r apart, alike in every flow with the same constants.
+    if (!acyclic || (any_diagonal && !commuting)) {
         path_ = m <= 2 ? ExpmPath::Plane : ExpmPath::Pade;
         depth_ = 0;
         // The plane's closed form takes any order; the Pade block is put in
@@ -342,7 +345,7 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
             scaling.multiple = static_cast<int>(k);
             group.largest = std::max(group.largest, std::abs(scaling.multiple));
         }
-        powers_.assign(power_groups_.size() * (2 * kMaxMultiple + 1), 0.0);
+        powers_.assign(power_groups_.size() * (2 * kMaxMultiple + 1), Exponential{0.0, 0.0});
         scaled_values_.resize(scalings_.size());
         lanes_ = depth_ <= 1 ? 1 : depth_ <= 2 ? 2 : depth_ <= 4 ? 4 : depth_ <= 8 ? 8 : depth_;
         for (std::size_t k = 0; k < lanes_; ++k) inverse_.push_back(reciprocal(static_cast<int>(k + 1)));
@@ -545,35 +548,47 @@ bool SparseExponential::sweep(double *x) {
     }
 }
 
-// x_i <- exp(d_i) x_i = x_i + expm1(d_i) x_i after the series of N, one
-// expm1 for each run of equal diagonal terms (scaled_by_exponential: the
-// exponential itself where it contracts by more than half). When a result is
-// not finite, x goes back to what it was before the series too.
+// x_i <- exp(d_i) x_i after the series of N, one expm1 for each run of
+// equal diagonal terms (exponential_powers, scaled_by_exponential). When a
+// result is not finite, x goes back to what it was before the series too.
 void SparseExponential::apply_scalings(double *x) {
-    // Group by group: E_k = exp(k s) - 1 for s = base s_p, exact (the cut of
+#if LPI_FMA_DISPATCH
+    if (cpu_has_fma()) return scale_fma(x);
+#endif
+    scale_baseline(x);
+}
+
+void SparseExponential::scale_baseline(double *x) { scale(x); }
+#if LPI_FMA_DISPATCH
+void SparseExponential::scale_fma(double *x) { scale(x); }
+#endif
+
+inline void SparseExponential::scale(double *x) {
+    // Group by group: M_k = exp(k s) for s = base s_p, exact (the cut of
     // s_p covers base). From t (base g_p) instead, the diagonal ran for
     // another time than the series of the same parameter, up to 2^-45 of it
     // apart: no flow of the algebra (a Casimir moved 1e-14 a flow, always
     // the same way, with M = [[a, 1, 0], [0, a, 0], [0, 0, 2a]], a = 255/128).
     for (std::size_t q = 0; q < power_groups_.size(); ++q) {
         const PowerGroup &group = power_groups_[q];
-        double *E = powers_.data() + q * (2 * kMaxMultiple + 1) + kMaxMultiple;
-        expm1_powers(group.base * times_[group.parameter], group.largest, E);
+        Exponential *M = powers_.data() + q * (2 * kMaxMultiple + 1) + kMaxMultiple;
+        exponential_powers(group.base * times_[group.parameter], group.largest, M);
     }
     std::size_t failed = scalings_.size();
     for (std::size_t d = 0; d < scalings_.size(); ++d) {
         const Scaling &scaling = scalings_[d];
-        double growth, exponent;
+        Exponential factor;
+        double exponent;
         if (scaling.group < 0) {
             exponent = scaled_[scaling.position];
-            growth = std::expm1(exponent);
+            factor = exponential_of(exponent);
         } else {
             const PowerGroup &group = power_groups_[static_cast<std::size_t>(scaling.group)];
             exponent = scaling.multiple * (group.base * times_[group.parameter]);
-            growth = powers_[static_cast<std::size_t>(scaling.group * (2 * kMaxMultiple + 1) +
+            factor = powers_[static_cast<std::size_t>(scaling.group * (2 * kMaxMultiple + 1) +
                                                       kMaxMultiple + scaling.multiple)];
         }
-        scaled_values_[d] = scaled_by_exponential(x[scaling.global], growth, exponent);
+        scaled_values_[d] = scaled_by_exponential(x[scaling.global], factor, exponent);
         if (failed == scalings_.size() && !std::isfinite(scaled_values_[d])) failed = d;
     }
     if (failed < scalings_.size()) {
@@ -650,7 +665,7 @@ void SparseExponential::apply_plane(double t, double *x) {
     check_norm(std::max(std::fabs(A[0]) + std::fabs(A[2]), std::fabs(A[1]) + std::fabs(A[3])), t);
     const double x0 = x[moved_[0]];
     if (moved_.size() == 1) {  // x0 e^a, as the diagonal scalings take it
-        const double y0 = scaled_by_exponential(x0, std::expm1(A[0]), A[0]);
+        const double y0 = scaled_by_exponential(x0, exponential_of(A[0]), A[0]);
         increment_[0] = y0 - x0;  // only to name a non-finite component
         if (!std::isfinite(y0)) fail_nonfinite();
         x[moved_[0]] = y0;

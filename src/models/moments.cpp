@@ -338,7 +338,7 @@ private:
 
 CompiledFlow moment_piece_flow(unsigned mask) {
     static constexpr compiled::Table<MomentAlgebra> table;
-    return mask < sizeof table.flows / sizeof table.flows[0] ? table.flows[mask] : nullptr;
+    return table.flow(mask);
 }
 
 std::unique_ptr<GenericModel> make_moments() {
