@@ -3,6 +3,7 @@
 
 #include <dlfcn.h>
 #include <sched.h>
+#include <sys/mman.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -49,15 +50,45 @@ int threads_started_on_loading() {
     return std::min(asked > 0 ? asked : processors, processors) - 1;
 }
 
+// OpenBLAS takes a buffer of BUFFER_SIZE (128 MiB on x86-64) and a page
+// from the system for each thread it starts as it loads, and one for the
+// first call, which later calls reuse; where the system refuses one (a
+// process under an address-space limit) it retries for ever: the call never
+// returns, nor does the process's exit, which waits for its threads. So
+// before loading it the library maps that much, with the 40 MiB the load
+// maps itself and a stack of 8 MiB a thread (mapped, not malloc'ed: a
+// compiler may drop a malloc whose block is never used, and a mapping is
+// given back whole), and refuses where it cannot. Calls on several threads
+// at once need a buffer each, which memory run short since the first call
+// may not have (not covered). Counted for any LAPACK, as the threads are.
+constexpr std::size_t kMiB = std::size_t{1} << 20;
+constexpr std::size_t kOpenBlasBuffer = 128 * kMiB + 4096;
+constexpr std::size_t kOpenBlasLoading = 48 * kMiB, kOpenBlasThread = kOpenBlasBuffer + 8 * kMiB;
+
+void require_openblas_memory(std::size_t bytes, const std::string &for_what, const std::string &advice) {
+    void *probe = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (probe == MAP_FAILED)
+        fail(LPI_ERR_NO_MEMORY, for_what + " may need " + std::to_string(bytes) +
+                                    " bytes for OpenBLAS's buffers, which this process cannot have (it "
+                                    "would wait for them for ever)" + advice);
+    munmap(probe, bytes);
+}
+
 const Routines &routines() {
     static std::mutex mutex;
     static Routines loaded;
     std::lock_guard<std::mutex> lock(mutex);
     if (loaded.zheevd) return loaded;
     const std::string name = LPI_LAPACK_LIBRARY;
-    require_threads_can_start(threads_started_on_loading(), "loading " + name,
+    const int threads = threads_started_on_loading();
+    require_threads_can_start(threads, "loading " + name,
                               "a threaded OpenBLAS starts them as it loads, and ends the process where it "
                               "cannot; OPENBLAS_NUM_THREADS=1 asks for none");
+    // Its threads' buffers, and the one of the call that follows.
+    require_openblas_memory(kOpenBlasLoading + static_cast<std::size_t>(threads) * kOpenBlasThread +
+                                kOpenBlasBuffer,
+                            "loading " + name,
+                            threads > 0 ? "; OPENBLAS_NUM_THREADS=1 asks for the first call's alone" : "");
     void *library = ::dlopen(name.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (!library) {
         const char *why = ::dlerror();

@@ -19,7 +19,8 @@ using cplx = std::complex<double>;
 // character arguments. Each throws LPI_ERR_UNSUPPORTED naming the library
 // when it cannot be loaded or lacks the routine, and LPI_ERR_NO_MEMORY when
 // the threads a threaded OpenBLAS starts on loading cannot be had (it is
-// then not loaded, and a later call tries again).
+// then not loaded, and a later call tries again), or the buffers OpenBLAS
+// takes on loading and on its first call cannot (lapack.cpp).
 void zheevd(const char *jobz, const char *uplo, const int *n, cplx *a, const int *lda, double *w,
             cplx *work, const int *lwork, double *rwork, const int *lrwork, int *iwork, const int *liwork,
             int *info, std::size_t jobz_len, std::size_t uplo_len);
