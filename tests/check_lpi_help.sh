@@ -91,6 +91,17 @@ rc=0; timeout 120 "$lpi" report rigid-body sine-euler-long --N 3 --T 1e300 --out
 [ "$rc" -eq 2 ] && grep -q -e "--T: 1e+300 / .* is too many steps" "$out/long.err" && ! grep -q "^==" "$out/long.out" ||
     { echo "lpi report sine-euler-long --T 1e300: exit status $rc, expected 2 before any scene runs"; cat "$out/long.err"; exit 1; }
 
+# A --T below the sweep's largest step (every run one step of T, the rows
+# repeating one another, the plot empty) is refused (2) before anything runs.
+rc=0; "$lpi" report sine-euler-long --N 3 --T 1e-20 --out "$out/short" >"$out/short.out" 2>"$out/short.err" || rc=$?
+[ "$rc" -eq 2 ] && grep -q -e "which --T must reach" "$out/short.err" && ! grep -q "^==" "$out/short.out" ||
+    { echo "lpi report sine-euler-long --T 1e-20: exit status $rc, expected 2"; cat "$out/short.err"; exit 1; }
+# An option where a value belongs is refused (2), not taken as the value
+# (--out --help wrote into ./--help).
+rc=0; (cd "$out" && "$lpi" report pendulum --out --help) >"$out/value.out" 2>"$out/value.err" || rc=$?
+[ "$rc" -eq 2 ] && grep -q -e "--out needs a value, not the option '--help'" "$out/value.err" && [ ! -e "$out/--help" ] ||
+    { echo "lpi report --out --help: exit status $rc, expected 2"; cat "$out/value.err"; exit 1; }
+
 # Standard output that cannot be written fails the command (exit status 1);
 # an argument after --version or --help is refused (2).
 if [ -w /dev/full ]; then

@@ -187,12 +187,16 @@ public:
         std::exit(2);
     }
 
-    // The value of `option` (just read by next()): the following argument, non-empty.
+    // The value of `option` (just read by next()): the following argument,
+    // non-empty, and no option ("--out --help" wrote into ./--help; a file
+    // of such a name is still ./--help).
     std::string value(const std::string &option) {
         if (!seen_.insert(option).second) fail(option + " is given twice");
         if (done()) fail(option + " needs a value");
         const std::string text = argv_[next_++];
         if (text.empty()) fail(option + ": the value is empty");
+        if (text.size() > 2 && text.compare(0, 2, "--") == 0)
+            fail(option + " needs a value, not the option '" + text + "' (a file of that name is ./" + text + ")");
         return text;
     }
 

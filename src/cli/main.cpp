@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "output.hpp"
+#include "plots.hpp"
 #include "processes.hpp"
 #include "report.hpp"
 #include "run.hpp"
@@ -116,6 +117,16 @@ int report_command(int argc, char **argv) {
                 return std::find(s->options.begin(), s->options.end(), option) != s->options.end();
             }))
             args.fail(option + ": no scene reported takes it (lpi --help lists each scene's options)");
+    // A --T below a sweep's largest step makes its steps T each, one step a
+    // run: the sweep's rows repeat one another and its plot has nothing to show.
+    for (const Scene *s : chosen)
+        if (!s->steps.empty() &&
+            std::find(s->options.begin(), s->options.end(), "--T") != s->options.end()) {
+            const double largest = *std::max_element(s->steps.begin(), s->steps.end());
+            if (s->final_time < largest)
+                args.fail(format("--T %g: %s sweeps steps up to %g, which --T must reach", s->final_time,
+                                 s->name.c_str(), largest));
+        }
     // Every run of every scene reported is a count of steps below 2^62 (a
     // --T of 1e300 is not): checked before any scene runs.
     for (const Scene *s : chosen)
@@ -141,7 +152,9 @@ int report_command(int argc, char **argv) {
     int status = 0;
     for (const Scene *s : chosen)
         if (!run_report(*s, options)) status = 1;
-    if (status == 0) std::printf("\nCSV, PNG and SVG files are in %s/\n", options.out_dir.c_str());
+    if (status == 0)
+        std::printf("\n%s files are in %s/%s\n", have_gnuplot() ? "CSV, PNG and SVG" : "CSV", options.out_dir.c_str(),
+                    have_gnuplot() ? "" : " (no images: gnuplot not found)");
     return status;
 }
 
@@ -151,8 +164,9 @@ int methods_command(int argc, char **argv) {
         const std::string arg = args.next();
         if (args.help(arg)) {
             std::printf("usage: lpi methods\n  the integration methods (lpi run --method NAME): name, order,\n"
-                        "  stages (leapfrog-equivalent cost), Poisson (keeps Casimirs to round-off),\n"
-                        "  reference\n");
+                        "  stages (for a splitting method the leapfrog steps it composes, its cost in\n"
+                        "  leapfrog steps; 1 for the others, whose cost lpi report measures), Poisson\n"
+                        "  (keeps Casimirs to round-off), reference\n");
             return 0;
         }
         args.fail("takes no argument ('" + arg + "')");

@@ -165,13 +165,15 @@ std::string plot_style(std::size_t i, const std::string &method) {
     return "lc " + plot_colour(i) + " " + plot_marker(i) + " dt " + (is_poisson(method) ? "1" : "2");
 }
 
-// A method's legend entry: its order and stages (a step's cost in leapfrog
-// steps), which is what tells the curves apart.
+// A method's legend entry: its order and, for a splitting method, its stages
+// (a step's cost in leapfrog steps), which is what tells the curves apart. A
+// baseline's one "stage" says nothing of its cost, which the plot shows.
 std::string method_label(const std::string &method) {
     const int i = method_index(method);
+    const std::string order = method + " (order " + std::to_string(lpi_method_order(i));
+    if (!is_poisson(method)) return order + ")";
     const int stages = lpi_method_stages(i);
-    return method + " (order " + std::to_string(lpi_method_order(i)) + ", " + std::to_string(stages) +
-           (stages == 1 ? " stage)" : " stages)");
+    return order + ", " + std::to_string(stages) + (stages == 1 ? " stage)" : " stages)");
 }
 
 std::string csv_plot_preamble() {

@@ -60,8 +60,8 @@ std::string plot_marker(std::size_t i);
 // Poisson maps) dashed, so the two families read apart at a glance.
 std::string plot_style(std::size_t i, const std::string &method);
 
-// A method's legend entry: its order and stages (a step's cost in leapfrog
-// steps), which is what tells the curves apart.
+// A method's legend entry: its order and, for a splitting method, its stages
+// (a step's cost in leapfrog steps).
 std::string method_label(const std::string &method);
 
 // A gnuplot script and the images it draws, in one output directory.
