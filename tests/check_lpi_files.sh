@@ -7,7 +7,8 @@
 #    rollup naming the file, and so does an image gnuplot leaves empty or
 #    cut short while exiting 0 (the old images kept); without gnuplot the
 #    plots are skipped, said so; lpi report whose CSV cannot be written
-#    fails before its work, not saying where its files are;
+#    fails before its work, not saying where its files are, and one whose
+#    plot or any file fails keeps all of the scene's old files;
 #  - a write that fails (RLIMIT_FSIZE, as a full disk) keeps the old CSV,
 #    the old .npy set and the old HDF5 file whole, names the file and the
 #    reason, exits 1 (no crash, also with SIGXFSZ at its default action, and
@@ -98,6 +99,22 @@ if [ "$have_se" = 1 ]; then
     PATH="$out/cut-gnuplot:$PATH" expect 1 "rollup.svg (the SVG is cut short" run rollup --N 5 --steps 3 --out "$out/p9"
     (cd "$out" && md5sum -c --quiet "$out/images.md5") || fail "an unfinished image replaced a good one"
     no_temporaries "$out/p8"; no_temporaries "$out/p9"
+    # A report whose plot fails, or one of whose files cannot be written,
+    # keeps every file of the last report: no new CSV beside old images.
+    for scene in figure2 pendulum "sine-euler-long --N 5 --T 5"; do
+        name=${scene%% *}
+        PATH="$ok_path" "$lpi" report $scene --out "$out/p11" >/dev/null
+        (cd "$out/p11" && md5sum $(ls | grep -e "^$name[._]") > "$out/report.md5")
+        PATH="$bad_path" expect 1 "$name.gp.*fake gnuplot" report $scene --out "$out/p11"
+        (cd "$out/p11" && md5sum -c --quiet "$out/report.md5") || fail "a failed plot of $name replaced its files"
+        no_temporaries "$out/p11"
+    done
+    rm "$out/p11/pendulum_energy.csv"; mkdir "$out/p11/pendulum_energy.csv"
+    (cd "$out/p11" && md5sum pendulum.csv pendulum.gp pendulum_*.png pendulum_*.svg > "$out/report.md5")
+    PATH="$ok_path" expect 1 "pendulum_energy.csv.*directory" report pendulum --out "$out/p11"
+    (cd "$out/p11" && md5sum -c --quiet "$out/report.md5") ||
+        fail "a report whose energy CSV could not be written replaced its other files"
+    no_temporaries "$out/p11"
     # lpi report whose CSV cannot be written fails before the work, and says
     # nothing of files written.
     mkdir -p "$out/p10/figure2.csv"

@@ -76,8 +76,10 @@ std::string format_steps(const std::vector<double> &steps) {
     return text;
 }
 
-// Writes BASE.csv and BASE_history.csv: "" or why not.
-std::string write_long_csv(const std::string &base, const LongRunScene &scene, const std::vector<LongRow> &rows) {
+// SCENE.csv and SCENE_history.csv, as data files of `script` (which puts them
+// in place): the script's names of the two.
+std::pair<std::string, std::string> long_csv(PlotScript &script, const LongRunScene &scene,
+                                             const std::vector<LongRow> &rows) {
     std::string csv = "scene,run,method,order,poisson,dt,steps,cpu_seconds,max_energy_error,"
                       "max_casimir_drift,final_casimir_drift,reached_time,status\n";
     std::string history = "run,method,dt,time,energy_error,casimir_drift\n";
@@ -91,18 +93,18 @@ std::string write_long_csv(const std::string &base, const LongRunScene &scene, c
             history += format("%d,%s,%.17g,%.10g,%.6e,%.6e\n", r.run, r.method.c_str(), r.dt, s.time,
                               s.energy_error, s.casimir_drift);
     }
-    const std::string why = write_output(base + ".csv", csv);
-    return why.empty() ? write_output(base + "_history.csv", history) : why;
+    return {script.data(scene.name + ".csv", csv), script.data(scene.name + "_history.csv", history)};
 }
 
 // Max energy error and max Casimir drift against CPU time (one curve per
 // method through its step sizes), and both against time for the run of each
 // method whose CPU time is nearest `history_cpu`.
 // "" or why not.
-std::string plot_long(const std::string &dir, const LongRunScene &scene, const std::vector<LongRow> &rows,
+// `files`: the script's names of SCENE.csv and SCENE_history.csv.
+std::string plot_long(PlotScript &script, const std::pair<std::string, std::string> &files,
+                      const LongRunScene &scene, const std::vector<LongRow> &rows,
                       const std::vector<std::string> &methods, double history_cpu) {
     const std::string &base = scene.name;  // in dir
-    PlotScript script(dir, base + ".gp");
     script += csv_plot_preamble();
     const char *energy_label = "|H(t) - H(0)| / |H(0)|";
     const char *casimir_label = "max_i |{/Symbol l}_i(t) - {/Symbol l}_i(0)| / max_i |{/Symbol l}_i(0)|";
@@ -133,10 +135,10 @@ std::string plot_long(const std::string &dir, const LongRunScene &scene, const s
             std::vector<double> steps;
             for (const LongRow &r : rows)
                 if (r.method == methods[i] && r.status == LPI_OK) steps.push_back(r.dt);
-            commands += format("%s'%s.csv' using (strcol(3) eq '%s' && strcol(13) eq 'LPI_OK' ? $8 : 1/0):"
+            commands += format("%s%s using (strcol(3) eq '%s' && strcol(13) eq 'LPI_OK' ? $8 : 1/0):"
                                "($%d > 0 ? $%d : 1/0) with linespoints %s lw 1.5 ps 1.5 title '%s, dt = %s' "
                                "noenhanced",
-                               i ? ", " : "", base.c_str(), methods[i].c_str(), p.column, p.column,
+                               i ? ", " : "", files.first.c_str(), methods[i].c_str(), p.column, p.column,
                                plot_style(i, methods[i]).c_str(), method_label(methods[i]).c_str(),
                                format_steps(steps).c_str());
         }
@@ -170,11 +172,11 @@ std::string plot_long(const std::string &dir, const LongRunScene &scene, const s
             if (!nearest[i]) continue;
             const int c = p.history_column;
             const std::size_t interval = std::max<std::size_t>(1, nearest[i]->history.size() / 8);
-            commands += format("%s'%s_history.csv' using ($1 == %d && (int($0) + %zu) %% %zu == 0 ? $4 : 1/0):"
+            commands += format("%s%s using ($1 == %d && (int($0) + %zu) %% %zu == 0 ? $4 : 1/0):"
                                "($%d > 0 ? $%d : 1/0) with points %s ps 1.1 notitle, "
                                "'' using ($1 == %d ? $4 : 1/0):($%d > 0 ? $%d : 1/0) with lines lc %s dt %d "
                                "lw 1.5 notitle, 1/0 with linespoints %s ps 1.1 lw 1.5 title '%s, dt = %g' noenhanced",
-                               first ? "" : ", ", base.c_str(), nearest[i]->run, i * interval / methods.size(),
+                               first ? "" : ", ", files.second.c_str(), nearest[i]->run, i * interval / methods.size(),
                                interval, c, c, plot_style(i, methods[i]).c_str(), nearest[i]->run, c, c,
                                plot_colour(i).c_str(), is_poisson(methods[i]) ? 1 : 2,
                                plot_style(i, methods[i]).c_str(), method_label(methods[i]).c_str(),
@@ -263,28 +265,29 @@ bool run_long_scene(const LongRunScene &scene, const std::string &out_dir) {
         std::printf("\n");
     }
 
+    // The CSV files go in place with the images, or, where a file fails,
+    // none does: the directory keeps the last report whole.
     const std::string base = out_dir + "/" + scene.name;
-    std::string why = write_long_csv(base, scene, rows);
-    if (!why.empty()) return cannot_write(why);
-    std::printf("   wrote %s.csv and %s_history.csv (every sample of every run)\n", base.c_str(), base.c_str());
+    PlotScript script(out_dir, scene.name + ".gp");
+    const std::pair<std::string, std::string> files = long_csv(script, scene, rows);
     // The history plot compares the methods at about equal cost: the
     // geometric mean of all successful runs' CPU times.
     double log_sum = 0.0;
     int count = 0;
     for (const LongRow &r : rows)
         if (r.status == LPI_OK && r.cpu > 0.0) log_sum += std::log(r.cpu), ++count;
-    if (!have_gnuplot()) {
-        std::printf("   gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n");
-        return true;
-    }
-    if (count == 0) {
-        std::printf("   no run succeeded: no plots\n");
-        return true;
-    }
-    why = plot_long(out_dir, scene, rows, methods, std::exp(log_sum / count));
+    const bool drawn = have_gnuplot() && count > 0;
+    const std::string why = drawn ? plot_long(script, files, scene, rows, methods, std::exp(log_sum / count))
+                                  : script.save_data();
     if (!why.empty()) return cannot_write(why);
-    std::printf("   wrote %s_energy.png, %s_casimirs.png and %s_history.png\n", base.c_str(), base.c_str(),
-                base.c_str());
+    std::printf("   wrote %s.csv and %s_history.csv (every sample of every run)\n", base.c_str(), base.c_str());
+    if (!have_gnuplot())
+        std::printf("   gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n");
+    else if (count == 0)
+        std::printf("   no run succeeded: no plots\n");
+    else
+        std::printf("   wrote %s_energy.png, %s_casimirs.png and %s_history.png\n", base.c_str(), base.c_str(),
+                    base.c_str());
     return true;
 }
 

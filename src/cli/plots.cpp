@@ -136,8 +136,21 @@ std::string unfinished(const std::string &path, const std::string &image) {
     return "";
 }
 
-// An image's mark in a script's text until draw() names it.
+// An image's and a data file's mark in a script's text until draw() names it.
 std::string mark(std::size_t i) { return "\x01" + std::to_string(i) + "\x01"; }
+std::string data_mark(std::size_t i) { return "\x02" + std::to_string(i) + "\x02"; }
+
+// The files' contents into temporaries beside them, each closed, none in place.
+std::vector<std::unique_ptr<FileReplacement>> prepared(const std::string &dir,
+                                                       const std::vector<std::pair<std::string, std::string>> &files) {
+    std::vector<std::unique_ptr<FileReplacement>> out;
+    for (const auto &[file, text] : files) {
+        out.push_back(std::make_unique<FileReplacement>(dir + "/" + file));
+        out.back()->write(reinterpret_cast<const unsigned char *>(text.data()), text.size());
+        out.back()->close_descriptor();
+    }
+    return out;
+}
 
 }  // namespace
 
@@ -195,25 +208,46 @@ void PlotScript::add_figure(const std::string &base, int width, int height, cons
              output(base + ".svg") + commands + "set output\n";
 }
 
-std::string PlotScript::with_names(const std::vector<std::string> &names) const {
+std::string PlotScript::data(const std::string &file, std::string text) {
+    data_.push_back({file, std::move(text)});
+    return data_mark(data_.size() - 1);
+}
+
+std::string PlotScript::save_data() const {
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const DataFile &d : data_) files.push_back({d.file, d.text});
+    return failure_of([&] {
+        for (auto &file : prepared(dir_, files)) file->commit();
+    });
+}
+
+std::string PlotScript::with_names(const std::vector<std::string> &images,
+                                   const std::vector<std::string> &data) const {
     std::string text = text_;
-    for (std::size_t i = names.size(); i-- > 0;) replace_all(text, mark(i), names[i]);
+    for (std::size_t i = images.size(); i-- > 0;) replace_all(text, mark(i), images[i]);
+    for (std::size_t i = data.size(); i-- > 0;) replace_all(text, data_mark(i), data[i]);
     return text;
 }
 
 std::string PlotScript::draw() const {
     const std::string script = dir_ + "/" + name_;
-    std::vector<std::string> quoted(images_.size());
+    std::vector<std::string> quoted(images_.size()), quoted_data(data_.size());
     for (std::size_t i = 0; i < images_.size(); ++i)
         if (!gnuplot_string(images_[i], quoted[i])) return "cannot draw " + dir_ + "/" + images_[i];
-    std::string why = write_output(script, with_names(quoted));
-    if (!why.empty()) return why;
-    // gnuplot runs a copy of the script that draws each image into its
-    // temporary file: a temporary beside the script, removed afterwards.
-    std::vector<std::unique_ptr<FileReplacement>> drawn;
+    for (std::size_t i = 0; i < data_.size(); ++i)
+        if (!gnuplot_string(data_[i].file, quoted_data[i])) return "cannot draw from " + dir_ + "/" + data_[i].file;
+    // The data files and the script that names them, ready beside their
+    // places; gnuplot runs a copy of the script that reads the data's and
+    // draws each image into its temporary file: a temporary beside the
+    // script, removed afterwards.
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const DataFile &d : data_) files.push_back({d.file, d.text});
+    files.push_back({name_, with_names(quoted, quoted_data)});
+    std::vector<std::unique_ptr<FileReplacement>> written, drawn;
     std::unique_ptr<FileReplacement> run;
-    std::vector<std::string> temporaries;
-    why = failure_of([&] {
+    std::vector<std::string> temporaries, data_temporaries;
+    std::string why = failure_of([&] {
+        written = prepared(dir_, files);
         for (const std::string &image : images_) {
             drawn.push_back(std::make_unique<FileReplacement>(dir_ + "/" + image));
             drawn.back()->close_descriptor();
@@ -231,7 +265,12 @@ std::string PlotScript::draw() const {
         temporaries[i] = seen_from_dir(temporaries[i]);
         if (!gnuplot_string(temporaries[i], quoted[i])) return "cannot draw " + dir_ + "/" + images_[i];
     }
-    const std::string text = with_names(quoted);
+    for (std::size_t i = 0; i < data_.size(); ++i) {
+        data_temporaries.push_back(seen_from_dir(written[i]->temporary()));
+        if (!gnuplot_string(data_temporaries[i], quoted_data[i]))
+            return "cannot draw from " + dir_ + "/" + data_[i].file;
+    }
+    const std::string text = with_names(quoted, quoted_data);
     why = failure_of([&] {
         run->write(reinterpret_cast<const unsigned char *>(text.data()), text.size());
         run->close_descriptor();
@@ -242,16 +281,21 @@ std::string PlotScript::draw() const {
         // Its messages name the files lpi names.
         replace_all(said, seen_from_dir(run->temporary()), name_);
         for (std::size_t i = 0; i < temporaries.size(); ++i) replace_all(said, temporaries[i], images_[i]);
+        for (std::size_t i = 0; i < data_temporaries.size(); ++i)
+            replace_all(said, data_temporaries[i], data_[i].file);
         return "gnuplot failed on " + script + ": " + said;
     }
-    // Every image whole before any is put in place: a failure keeps them all.
+    // Every image whole before any file is put in place: a failure keeps them all.
     for (std::size_t i = 0; i < drawn.size(); ++i) {
         const std::string wrong = unfinished(drawn[i]->temporary(), images_[i]);
         if (!wrong.empty())
             return "gnuplot did not draw " + dir_ + "/" + images_[i] + " (" + wrong +
-                   "; a full disk?): the old image is kept";
+                   "; a full disk?): the old files are kept";
     }
     return failure_of([&] {
+        for (auto &file : written) file->sync();
+        for (auto &image : drawn) image->sync();
+        for (auto &file : written) file->commit();
         for (auto &image : drawn) image->commit();
     });
 }

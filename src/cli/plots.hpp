@@ -64,14 +64,16 @@ std::string plot_style(std::size_t i, const std::string &method);
 // (a step's cost in leapfrog steps).
 std::string method_label(const std::string &method);
 
-// A gnuplot script and the images it draws, in one output directory.
-// gnuplot runs there, without a shell, so every file a script names is a
-// name inside that directory, lpi's own (the directory the user gave never
-// enters a script). The images are drawn into temporary files beside them
-// and put in place (output.hpp) only when gnuplot succeeded and every image
-// is whole (gnuplot's exit status does not tell a write that failed): a
-// failure keeps the old images and the command fails, naming the file. The script itself
-// is saved as DIR/NAME, naming the images, to be rerun there by hand.
+// A gnuplot script, the data files it reads that the command writes with it,
+// and the images it draws, in one output directory. gnuplot runs there,
+// without a shell, so every file a script names is a name inside that
+// directory, lpi's own (the directory the user gave never enters a script).
+// The data files are written and the images drawn into temporary files
+// beside them, and all are put in place (output.hpp) with the script, saved
+// as DIR/NAME to be rerun there by hand, only when gnuplot succeeded and
+// every image is whole (gnuplot's exit status does not tell a write that
+// failed): a failure keeps every old file, and the command fails, naming the
+// file. So a directory never holds one run's data beside another's images.
 class PlotScript {
 public:
     PlotScript(std::string dir, std::string name) : dir_(std::move(dir)), name_(std::move(name)) {}
@@ -82,6 +84,11 @@ public:
     }
     // "set output '...'" for `image`, a name in the directory.
     std::string output(const std::string &image);
+    // A data file (a name in the directory, its text) for the script to
+    // read: what to write in the script where it names the file (quoted).
+    std::string data(const std::string &file, std::string text);
+    // Without gnuplot: puts the data files alone in place. "" or why not.
+    std::string save_data() const;
     // Commands drawn twice, as BASE.png, then BASE.svg beside it.
     void add_figure(const std::string &base, int width, int height, const std::string &commands);
     // Saves the script, runs gnuplot and puts the images in place: "" or why
@@ -89,10 +96,15 @@ public:
     std::string draw() const;
 
 private:
-    // The text with each image's mark replaced by names[i].
-    std::string with_names(const std::vector<std::string> &names) const;
+    // The text with each image's and each data file's mark replaced by the
+    // quoted names given.
+    std::string with_names(const std::vector<std::string> &images, const std::vector<std::string> &data) const;
     std::string dir_, name_, text_;
     std::vector<std::string> images_;
+    struct DataFile {
+        std::string file, text;
+    };
+    std::vector<DataFile> data_;
 };
 
 // The start of a script that plots lpi's CSV files: a grid, the key outside.

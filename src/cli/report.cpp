@@ -206,11 +206,12 @@ std::string history_text(const std::map<std::string, History> &histories) {
     return text;
 }
 
-// Draws the work-precision and energy plots with gnuplot from the CSV files.
-// "" or why not.
-std::string plot(const std::string &dir, const Scene &scene, const std::vector<std::string> &methods,
-                 const std::vector<Row> &rows, const std::map<std::string, History> &histories) {
-    PlotScript script(dir, scene.name + ".gp");
+// Draws the work-precision and energy plots with gnuplot from the CSV files
+// (`sweep` and `history`: the script's names of its data files), which it
+// puts in place with the images. "" or why not.
+std::string plot(PlotScript &script, const std::string &sweep, const std::string &history, const Scene &scene,
+                 const std::vector<std::string> &methods, const std::vector<Row> &rows,
+                 const std::map<std::string, History> &histories) {
     script += csv_plot_preamble();
     const std::string &base = scene.name;  // in dir
     Range cpu, error, energy;
@@ -223,9 +224,9 @@ std::string plot(const std::string &dir, const Scene &scene, const std::vector<s
                                   scene.name.c_str(), scene.final_time) +
                            decade_axis("x", cpu.lo, cpu.hi) + decade_axis("y", error.lo, error.hi) + "plot ";
     for (std::size_t i = 0; i < methods.size(); ++i)
-        commands += format("%s'%s.csv' using (strcol(2) eq '%s' && strcol(10) eq 'LPI_OK' ? $6 : 1/0):7 "
+        commands += format("%s%s using (strcol(2) eq '%s' && strcol(10) eq 'LPI_OK' ? $6 : 1/0):7 "
                            "with linespoints %s lw 1.5 ps 1.2 title '%s' noenhanced",
-                           i ? ", " : "", base.c_str(), methods[i].c_str(), plot_style(i, methods[i]).c_str(),
+                           i ? ", " : "", sweep.c_str(), methods[i].c_str(), plot_style(i, methods[i]).c_str(),
                            method_label(methods[i]).c_str());
     script.add_figure(base + "_work_precision", 1000, 820, commands + "\n");
 
@@ -240,11 +241,11 @@ std::string plot(const std::string &dir, const Scene &scene, const std::vector<s
         const auto h = histories.find(methods[i]);
         const std::size_t n = h == histories.end() ? 0 : h->second.samples.size();
         const std::size_t interval = std::max<std::size_t>(1, n / 8);
-        commands += format("%s'%s_energy.csv' using (strcol(1) eq '%s' && (int($0) + %zu) %% %zu == 0 ? $3 : 1/0):"
+        commands += format("%s%s using (strcol(1) eq '%s' && (int($0) + %zu) %% %zu == 0 ? $3 : 1/0):"
                            "($4 > 0 ? $4 : 1/0) with points %s ps 1.1 notitle, "
                            "'' using (strcol(1) eq '%s' ? $3 : 1/0):($4 > 0 ? $4 : 1/0) with lines lc %s dt %d "
                            "lw 1.2 notitle, 1/0 with linespoints %s ps 1.1 lw 1.2 title '%s' noenhanced",
-                           i ? ", " : "", base.c_str(), methods[i].c_str(), i * interval / methods.size(), interval,
+                           i ? ", " : "", history.c_str(), methods[i].c_str(), i * interval / methods.size(), interval,
                            plot_style(i, methods[i]).c_str(), methods[i].c_str(), plot_colour(i).c_str(),
                            is_poisson(methods[i]) ? 1 : 2, plot_style(i, methods[i]).c_str(),
                            method_label(methods[i]).c_str());
@@ -373,19 +374,22 @@ bool run_report(const Scene &scene, const ReportOptions &options) {
         std::printf("\n");
     }
 
+    // The CSV files go in place with the images, or, where a file fails,
+    // none does: the directory keeps the last report whole.
     const std::string base = options.out_dir + "/" + scene.name;
-    std::string why = write_output(base + ".csv", csv_text(rows, scene));
-    if (why.empty()) why = write_output(base + "_energy.csv", history_text(histories));
+    PlotScript script(options.out_dir, scene.name + ".gp");
+    const std::string sweep = script.data(scene.name + ".csv", csv_text(rows, scene));
+    const std::string energy = script.data(scene.name + "_energy.csv", history_text(histories));
+    const std::string why = have_gnuplot() ? plot(script, sweep, energy, scene, methods, rows, histories)
+                                           : script.save_data();
     if (!why.empty()) return cannot_write(why);
     std::printf("   wrote %s.csv and %s_energy.csv (energy history of every method at dt = %g)\n", base.c_str(),
                 base.c_str(), scene.final_time / static_cast<double>(history_steps));
-    if (!have_gnuplot()) {
+    if (!have_gnuplot())
         std::printf("   gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n");
-        return true;
-    }
-    why = plot(options.out_dir, scene, methods, rows, histories);
-    if (!why.empty()) return cannot_write(why);
-    std::printf("   wrote %s_work_precision.png and %s_energy.png, each with .svg\n", base.c_str(), base.c_str());
+    else
+        std::printf("   wrote %s_work_precision.png and %s_energy.png, each with .svg\n", base.c_str(),
+                    base.c_str());
     return true;
 }
 
