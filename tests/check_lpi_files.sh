@@ -23,7 +23,8 @@
 #    is refused (2) and one that fails leaves the old CSV; --resume with
 #    another --dt is refused (2); --init refuses a FIFO (1) at once;
 #  - H(0) = 0 gives an absolute energy error, labelled, not -nan;
-#  - rollup stops on SIGINT (130) and SIGTERM (143) with its CSV written.
+#  - rollup stops on SIGINT (130) and SIGTERM (143) with its CSV written;
+#    lpi report too, keeping the last report's files of the scene.
 # The sine-Euler parts are left out (and named) in a build without FFTW.
 set -eu
 lpi="$1"; out="$2"
@@ -129,6 +130,30 @@ if [ "$have_se" = 1 ]; then
     [ "$rc" -eq 0 ] && grep -q "gnuplot not found" "$out/stdout" ||
         { cat "$out/stdout"; fail "without gnuplot: exit status $rc"; }
 fi
+
+# lpi report stops at SIGINT (130) and SIGTERM (143): a signal while gnuplot
+# draws (a slow fake one, started once the work is done) ends gnuplot, and
+# the scene's files stay the last report's, with no temporary file left. It
+# used to die by the signal, its temporaries left and gnuplot drawing on.
+mkdir -p "$out/slow-gnuplot"
+printf '#!/bin/sh\n: > "%s/slow.started"\nexec sleep 60\n' "$out" > "$out/slow-gnuplot/gnuplot"
+chmod +x "$out/slow-gnuplot/gnuplot"
+PATH="$out/ok-gnuplot:$PATH" "$lpi" report pendulum --out "$out/sig" >/dev/null
+(cd "$out/sig" && md5sum * > "$out/sig.md5")
+for signal in INT TERM; do
+    rm -f "$out/slow.started"
+    PATH="$out/slow-gnuplot:$PATH" "$lpi" report pendulum --out "$out/sig" >"$out/sig.out" 2>&1 &
+    pid=$!
+    waited=0
+    while [ ! -f "$out/slow.started" ] && [ $waited -lt 1200 ]; do sleep 0.05; waited=$((waited + 1)); done
+    kill -$signal $pid
+    rc=0; wait $pid || rc=$?
+    want=130; [ $signal = TERM ] && want=143
+    [ "$rc" -eq $want ] && grep -q "^interrupted: pendulum was not finished" "$out/sig.out" ||
+        { cat "$out/sig.out"; fail "lpi report, SIG$signal while gnuplot draws: exit status $rc, expected $want"; }
+    (cd "$out/sig" && md5sum -c --quiet "$out/sig.md5") || fail "lpi report, SIG$signal: the last report's files changed"
+    no_temporaries "$out/sig"
+done
 
 # A write that fails keeps the old file whole and says why. RLIMIT_FSIZE
 # (SIGXFSZ ignored: the write fails with EFBIG) stands for a full disk; the

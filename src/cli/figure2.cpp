@@ -8,6 +8,7 @@
 
 #include "output.hpp"
 #include "plots.hpp"
+#include "run_watch.hpp"
 #include "scenes.hpp"
 #include "systems.hpp"
 
@@ -33,6 +34,7 @@ bool run_figure2(const std::string &out_dir) {
     double worst_first = 0.0, worst_second = 0.0, c2_drift = 0.0, spectrum_change = 0.0;
     const double t0 = cpu_seconds();
     for (int64_t done = 0; done < steps; done += every) {
+        stop_if_interrupted();
         check(lpi_step(h.get(), dt, every), h.get(), "step");
         const double rel = (energy_of(h.get()) - H0) / H0;
         check(lpi_sine_euler_casimir_traces(h.get(), 2, traces), h.get(), "Casimir traces");
@@ -63,6 +65,7 @@ bool run_figure2(const std::string &out_dir) {
     std::printf("   %.2f CPU seconds (diagnostics included)\n", cpu);
     if (!have_gnuplot()) {
         const std::string why = script.save_data();
+        stop_if_interrupted();
         if (!why.empty()) return cannot_write(why);
         std::printf("   wrote %s; gnuplot not found: no PNG\n", csv.c_str());
         return true;
@@ -84,6 +87,7 @@ bool run_figure2(const std::string &out_dir) {
         "lc rgb '#009e73' pt 7 ps 0.8 title 'spectrum of W (every 10^4 steps)'\nunset multiplot\n";
     script.add_figure("figure2", 1000, 700, commands);
     const std::string why = script.draw();
+    stop_if_interrupted();  // gnuplot ended by the signal, or the files written
     if (!why.empty()) return cannot_write(why);
     std::printf("   wrote %s, %s/figure2.png and .svg\n", csv.c_str(), out_dir.c_str());
     return true;

@@ -11,6 +11,7 @@
 
 #include "output.hpp"
 #include "plots.hpp"
+#include "run_watch.hpp"
 #include "report.hpp"
 
 namespace lpi_cli {
@@ -51,6 +52,7 @@ LongRow long_run(const LongRunScene &scene, const std::string &method, double dt
     const double h0 = energy_of(h.get());
     const std::vector<double> spectrum0 = casimirs_of(h.get());
     for (int k = 1; k <= samples; ++k) {
+        stop_if_interrupted();
         const double t0 = cpu_seconds();
         row.status = lpi_step(h.get(), row.dt, per_sample);
         row.cpu += cpu_seconds() - t0;
@@ -279,6 +281,7 @@ bool run_long_scene(const LongRunScene &scene, const std::string &out_dir) {
     const bool drawn = have_gnuplot() && count > 0;
     const std::string why = drawn ? plot_long(script, files, scene, rows, methods, std::exp(log_sum / count))
                                   : script.save_data();
+    stop_if_interrupted();  // gnuplot ended by the signal, or the files written
     if (!why.empty()) return cannot_write(why);
     std::printf("   wrote %s.csv and %s_history.csv (every sample of every run)\n", base.c_str(), base.c_str());
     if (!have_gnuplot())

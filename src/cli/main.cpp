@@ -12,6 +12,7 @@
 
 #include "output.hpp"
 #include "plots.hpp"
+#include "run_watch.hpp"
 #include "processes.hpp"
 #include "report.hpp"
 #include "run.hpp"
@@ -58,7 +59,7 @@ void print_usage(FILE *to) {
                  "       lpi methods   the integration methods: name, order, stages, reference\n"
                  "       lpi --version | --help (-h, help)\n"
                  "exit status: 0 success, 1 a failure, 2 a bad option, 130 (143) interrupted by\n"
-                 "SIGINT (SIGTERM) (lpi run)\n");
+                 "SIGINT (SIGTERM) (lpi run, lpi report)\n");
     print_scenes(to, false);
 }
 
@@ -150,8 +151,16 @@ int report_command(int argc, char **argv) {
                 lpi_version_string());
     // A scene whose files were not written fails the command; the others still run.
     int status = 0;
-    for (const Scene *s : chosen)
-        if (!run_report(*s, options)) status = 1;
+    catch_interrupts();
+    for (const Scene *s : chosen) {
+        try {
+            if (!run_report(*s, options)) status = 1;
+        } catch (const Interrupted &) {
+            std::printf("\ninterrupted: %s was not finished, and its files in %s/ are the last report's\n",
+                        s->name.c_str(), options.out_dir.c_str());
+            return 128 + interrupted_by;
+        }
+    }
     if (status == 0)
         std::printf("\n%s files are in %s/%s\n", have_gnuplot() ? "CSV, PNG and SVG" : "CSV", options.out_dir.c_str(),
                     have_gnuplot() ? "" : " (no images: gnuplot not found)");

@@ -15,6 +15,7 @@
 
 #include "output.hpp"
 #include "plots.hpp"
+#include "run_watch.hpp"
 
 // OpenBLAS's own call, when an OpenBLAS is loaded where the program sees it
 // (weak: null otherwise, and no link dependency).
@@ -81,7 +82,11 @@ constexpr const char *kOtherReference = "mclachlan-8";
 std::vector<double> reference_run(const Scene &scene, const std::string &method, int64_t steps) {
     Handle h = scene.create();
     check(lpi_set_method(h.get(), method.c_str()), h.get(), "reference method");
-    check(lpi_step(h.get(), scene.final_time / static_cast<double>(steps), steps), h.get(), "reference run");
+    // Not timed: observed, to stop at a signal (observing changes no bit).
+    check(lpi_set_observer(h.get(), observation_interval(h.get()), stop_at_signal, nullptr), h.get(), "observer");
+    const int status = lpi_step(h.get(), scene.final_time / static_cast<double>(steps), steps);
+    stop_if_interrupted();
+    check(status, h.get(), "reference run");
     return state_of(h.get());
 }
 
@@ -119,6 +124,7 @@ std::vector<Sample> diagnose(const Scene &scene, const char *method, double dt, 
     std::vector<Sample> out;
     int64_t done = 0;
     for (int64_t k = 1; k <= count; ++k) {
+        stop_if_interrupted();
         const int64_t target = steps * k / count;
         if (lpi_step(h.get(), dt, target - done) != LPI_OK) break;
         done = target;
@@ -141,6 +147,7 @@ Row measure(const Scene &scene, const char *method, int order, double dt,
     int repeats = 0;
     std::vector<double> end;
     do {
+        stop_if_interrupted();
         Handle h = scene.create();
         check(lpi_set_method(h.get(), method), h.get(), "set method");
         // Warm up (FFTW plans are made on a system's first step), then start
@@ -382,6 +389,7 @@ bool run_report(const Scene &scene, const ReportOptions &options) {
     const std::string energy = script.data(scene.name + "_energy.csv", history_text(histories));
     const std::string why = have_gnuplot() ? plot(script, sweep, energy, scene, methods, rows, histories)
                                            : script.save_data();
+    stop_if_interrupted();  // gnuplot ended by the signal, or the files written
     if (!why.empty()) return cannot_write(why);
     std::printf("   wrote %s.csv and %s_energy.csv (energy history of every method at dt = %g)\n", base.c_str(),
                 base.c_str(), scene.final_time / static_cast<double>(history_steps));

@@ -42,6 +42,8 @@ extern "C" int watch_steps(const lpi_system *, int64_t step, double, void *user)
     return 0;
 }
 
+extern "C" int stop_at_signal(const lpi_system *, int64_t, double, void *) { return interrupted_by ? 1 : 0; }
+
 int64_t observation_interval(const lpi_system *sys) {
     std::size_t flows = 0;
     if (lpi_flows_per_step(sys, &flows) != LPI_OK || flows == 0) return 1;

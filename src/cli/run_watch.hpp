@@ -20,6 +20,19 @@ extern volatile std::sig_atomic_t interrupted_by;
 // One shot: a second Ctrl-C ends the command at once (SA_RESETHAND).
 void catch_interrupts();
 
+// lpi report's way out at SIGINT or SIGTERM: thrown where its work can stop
+// (between runs, and after a run that stop_at_signal stopped) and caught by
+// the command, which exits 128 + the signal. A scene writes its files at its
+// end, all or none (PlotScript), so the interrupted one keeps the last
+// report's.
+struct Interrupted {};
+inline void stop_if_interrupted() {
+    if (interrupted_by) throw Interrupted{};
+}
+// An observer that stops lpi_step at a signal (LPI_STOPPED), for the runs
+// that are not timed.
+extern "C" int stop_at_signal(const lpi_system *, int64_t step, double, void *);
+
 // After a signal that came while the images of a finished run were drawn
 // (gnuplot is ended then, PlotScript::draw): says whether they were, and
 // returns the exit status, 128 + the signal's number.
