@@ -1,11 +1,13 @@
 #include "generic.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <set>
 #include <tuple>
 
 #include "../core/error.hpp"
@@ -136,13 +138,14 @@ const std::vector<StructureConstants::Output> &StructureConstants::bracket(std::
 void StructureConstants::check_jacobi() const {
     // Jac(p,q,r) = {{x_p,x_q},x_r} + {{x_q,x_r},x_p} + {{x_r,x_p},x_q}, linear
     // in x: component m is sum_l c_pq^l c_lr^m + c_qr^l c_lp^m + c_rp^l c_lq^m.
-    // It vanishes unless one of the three brackets does not, so each triple
-    // is visited from its first nonzero pair only, with r among the indices
-    // that some involved bracket can reach.
+    // It vanishes unless one of its terms does not, and {{x_a,x_b},x_c} is
+    // nonzero only along a path: a term c_ab^l x_l of a bracket with x_l and
+    // x_c not commuting. So the triples are found from those paths (each
+    // bracket's outputs' partners) and each is checked once: work that
+    // follows the paths, where taking every partner of x_a and x_b took
+    // R x| R^n (n brackets) through n^2 triples (37 s at n = 20000).
     std::vector<ScaledProductSum> sums(dim_);
     std::vector<std::uint32_t> touched;
-    std::vector<std::size_t> stamp(dim_, 0);
-    std::size_t pass = 0;
     auto accumulate = [&](std::uint32_t a, std::uint32_t b, std::uint32_t d) {
         for (const Output &first : bracket(a, b))
             for (const Output &second : bracket(first.l, d)) {
@@ -150,47 +153,32 @@ void StructureConstants::check_jacobi() const {
                 sums[second.l].add(first.c, second.c);
             }
     };
-    auto nonzero = [&](std::uint32_t a, std::uint32_t b) { return !bracket(a, b).empty(); };
-
+    std::set<std::array<std::uint32_t, 3>> checked;
     for (const auto &[key, outputs] : brackets_) {
         const auto i = static_cast<std::uint32_t>(key / dim_), j = static_cast<std::uint32_t>(key % dim_);
         if (i > j) continue;
-        ++pass;
-        std::vector<std::uint32_t> candidates;
-        auto consider = [&](std::uint32_t from) {
-            for (const Term &t : columns_[from])
-                if (stamp[t.i] != pass) {
-                    stamp[t.i] = pass;
-                    candidates.push_back(t.i);
+        for (const Output &o : outputs)
+            for (const Term &partner : columns_[o.l]) {
+                const std::uint32_t r = partner.i;
+                if (r == i || r == j) continue;
+                std::array<std::uint32_t, 3> t = {i, j, r};
+                std::sort(t.begin(), t.end());
+                if (!checked.insert(t).second) continue;
+                accumulate(t[0], t[1], t[2]);
+                accumulate(t[1], t[2], t[0]);
+                accumulate(t[2], t[0], t[1]);
+                for (std::uint32_t m : touched) {
+                    if (sums[m].exceeds(kJacobiTolerance))
+                        fail(LPI_ERR_INVALID,
+                             "the structure constants violate the Jacobi identity at (i, j, k) = (" +
+                                 std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " +
+                                 std::to_string(t[2]) + "): {{x_i, x_j}, x_k} + {{x_j, x_k}, x_i} + "
+                                 "{{x_k, x_i}, x_j} has coefficient " + sums[m].text() +
+                                 " on " + x_name(m) + " (must be 0)");
                 }
-        };
-        consider(i);
-        consider(j);
-        for (const Output &o : outputs) consider(o.l);
-        for (std::uint32_t r : candidates) {
-            if (r == i || r == j) continue;
-            std::uint32_t t[3] = {i, j, r};
-            std::sort(t, t + 3);
-            std::pair<std::uint32_t, std::uint32_t> first =
-                nonzero(t[0], t[1]) ? std::make_pair(t[0], t[1])
-                : nonzero(t[0], t[2]) ? std::make_pair(t[0], t[2])
-                                      : std::make_pair(t[1], t[2]);
-            if (first != std::make_pair(i, j)) continue;
-            accumulate(t[0], t[1], t[2]);
-            accumulate(t[1], t[2], t[0]);
-            accumulate(t[2], t[0], t[1]);
-            for (std::uint32_t m : touched) {
-                if (sums[m].exceeds(kJacobiTolerance))
-                    fail(LPI_ERR_INVALID,
-                         "the structure constants violate the Jacobi identity at (i, j, k) = (" +
-                             std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " +
-                             std::to_string(t[2]) + "): {{x_i, x_j}, x_k} + {{x_j, x_k}, x_i} + "
-                             "{{x_k, x_i}, x_j} has coefficient " + sums[m].text() +
-                             " on " + x_name(m) + " (must be 0)");
+                for (std::uint32_t m : touched) sums[m] = ScaledProductSum{};
+                touched.clear();
             }
-            for (std::uint32_t m : touched) sums[m] = ScaledProductSum{};
-            touched.clear();
-        }
     }
 }
 
@@ -492,15 +480,21 @@ void GenericModel::add_piece(std::size_t n, const std::int32_t *indices, lpi_gra
                                       std::to_string(p) + "] are both " +
                                       std::to_string(sigma[p]) + " (indices must be distinct)");
     }
-    for (std::size_t p = 0; p < n; ++p)
-        for (std::size_t q = p + 1; q < n; ++q) {
-            const auto &terms = constants_->bracket(sigma[p], sigma[q]);
-            if (!terms.empty())
-                fail(LPI_ERR_NOT_ABELIAN, "the index set is not abelian: indices " +
-                                              std::to_string(sigma[p]) + " and " +
-                                              std::to_string(sigma[q]) + " do not commute, " +
-                                              bracket_text(sigma[p], sigma[q], terms));
+    // The first pair (p, q), p < q, that does not commute, found through
+    // each index's partners (the brackets it has) rather than all n^2 pairs
+    // (25 s for 160000 indices of an abelian algebra).
+    for (std::size_t p = 0; p < n; ++p) {
+        std::size_t first = n;
+        for (const StructureConstants::Term &t : constants_->column(sigma[p])) {
+            const auto it = seen.find(t.i);
+            if (it != seen.end() && it->second > p) first = std::min(first, it->second);
         }
+        if (first == n) continue;
+        const std::uint32_t a = sigma[p], b = sigma[first];
+        fail(LPI_ERR_NOT_ABELIAN, "the index set is not abelian: indices " + std::to_string(a) + " and " +
+                                      std::to_string(b) + " do not commute, " +
+                                      bracket_text(a, b, constants_->bracket(a, b)));
+    }
     std::string label = next_piece_name() + " (indices {";
     for (std::size_t p = 0; p < n; ++p) label += (p ? ", " : "") + std::to_string(sigma[p]);
     label += "})";
