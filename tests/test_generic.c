@@ -557,6 +557,43 @@ static void test_constant_scaling_without_bias(void **state) {
     }
 }
 
+/* The same for scalings that share no expm1 with a group: R x| R^4 with
+ * {h, x1} = 2 x1, {h, x2} = -2 x2, {h, x3} = 3 x3, {h, x4} = -3 x4 under
+ * H = h keeps x1 x2 and x3 x4; 3 is no multiple of 2, so x3 and x4 scale
+ * alone, and from expm1(0.3) and expm1(-0.3) the product x3 x4 moved by 252
+ * standard errors over 2e5 flows. Each now takes e^-a as the reciprocal of
+ * e^a from expm1(|a|). */
+static void test_lone_scalings_without_bias(void **state) {
+    (void)state;
+    static const int32_t i[] = {0, 0, 0, 0}, j[] = {1, 2, 3, 4}, k[] = {1, 2, 3, 4};
+    static const double c[] = {2.0, -2.0, 3.0, -3.0};
+    double a = 1.0;
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_generic_create(&sys, 5, 4, i, j, k, c), LPI_OK);
+    const int32_t h = 0;
+    assert_int_equal(lpi_add_piece(sys, 1, &h, scaled_gradient, scaled_energy, &a), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
+    uint64_t seed = 11;
+    lpi_test_mean changes[2] = {{0.0, 0.0, 0}, {0.0, 0.0, 0}};
+    for (int m = 0; m < 60000; ++m) {
+        double x[5], y[5];
+        for (int e = 0; e < 5; ++e) x[e] = 1.0 + 0.5 * lpi_test_uniform(&seed);
+        assert_int_equal(lpi_set_state(sys, x, 5), LPI_OK);
+        assert_int_equal(lpi_step(sys, 0.1, 1), LPI_OK);
+        assert_int_equal(lpi_get_state(sys, y, 5), LPI_OK);
+        lpi_test_mean_add(&changes[0], product_change(x[1], x[2], y[1], y[2]));
+        lpi_test_mean_add(&changes[1], product_change(x[3], x[4], y[3], y[4]));
+    }
+    for (int q = 0; q < 2; ++q) {
+        double mean, spread;
+        const double z = lpi_test_mean_z(&changes[q], &mean, &spread);
+        printf("R x| R^4, weights %s, one flow of 0.1: mean change of %s %.2e, %.1f standard errors\n",
+               q ? "+-3 (alone)" : "+-2 (a group)", q ? "x3 x4" : "x1 x2", mean, z);
+        assert_true(fabs(z) < 5.0);
+    }
+    lpi_destroy(sys);
+}
+
 /* H = J1 + 0.7 P1 on the abelian set {J1, P1} of e(3). */
 static int pair_gradient(size_t n, const double *x, double *g, void *user) {
     (void)n; (void)x; (void)user;
@@ -809,6 +846,7 @@ int main(void) {
         cmocka_unit_test(test_hyperbolic_piece_keeps_contracted_components),
         cmocka_unit_test(test_constant_rotation_without_bias),
         cmocka_unit_test(test_constant_scaling_without_bias),
+        cmocka_unit_test(test_lone_scalings_without_bias),
         cmocka_unit_test(test_large_semidirect_product),
         cmocka_unit_test(test_disjoint_blocks_without_bias),
         cmocka_unit_test(test_cancelling_factors),

@@ -115,11 +115,16 @@ inline void exponential_powers_near(double s, int largest, Exponential *M) {
     exponential_side_powers(1, largest, M);
     exponential_side_powers(-1, largest, M);
 }
-// e^a alone, as one side of exponential_powers.
+// e^a for an entry in no group: from expm1(|a|), so that the entry -a of
+// another index (a Casimir x y under e^a, e^-a) takes the reciprocal of the
+// very same value. From expm1(a) and expm1(-a) they were rounded apart, alike
+// in every flow (sl(2)-like pairs of weights 2 and 3, or of two parameters:
+// 107 to 252 standard errors over 2e5 flows).
 inline Exponential exponential_of(double a) {
-    Exponential M[3];
-    exponential_powers(a, 1, M + 1);
-    return M[2];
+    const double v = std::expm1(std::fabs(a));
+    if (!std::isfinite(v)) return a >= 0.0 ? Exponential{v, 0.0} : Exponential{0.0, 0.0};
+    const Exponential grown = exponential_sum(1.0, v);
+    return a >= 0.0 ? grown : exponential_reciprocal(grown);
 }
 
 // z e^a from M = e^a (exponential_powers): fma(M.hi, z, M.lo z), where M is
