@@ -23,6 +23,8 @@ extern "C" {
 }
 #endif
 
+#include "mapped_bytes.h"
+
 /* ---- skips and the exit status ------------------------------------------
  * A test that cannot run here (this build lacks an optional part, or a tool
  * it runs under cannot host it) calls LPI_SKIP with the reason: the reason is
@@ -138,15 +140,6 @@ static inline void lpi_assert_unchanged(const lpi_system *sys, const lpi_snapsho
 #else
 #define LPI_SKIP_UNDER_A_SANITIZER() ((void)0)
 #endif
-static inline size_t lpi_test_mapped_bytes(void) { /* VmSize; 0 where /proc does not say */
-    FILE *f = fopen("/proc/self/status", "r");
-    char line[256];
-    size_t kib = 0;
-    while (f && fgets(line, sizeof line, f))
-        if (strncmp(line, "VmSize:", 7) == 0) kib = (size_t)strtoull(line + 7, NULL, 10);
-    if (f) fclose(f);
-    return kib * 1024;
-}
 
 typedef int (*lpi_test_limited_call)(lpi_system *sys, const void *context);
 static inline int lpi_test_with_address_space_limited(int limited, lpi_test_limited_call call, lpi_system *sys,

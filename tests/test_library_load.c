@@ -25,6 +25,8 @@
 
 #include <liepoisson.h>
 
+#include "mapped_bytes.h"
+
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define UNDER_A_SANITIZER 1
 #elif defined(__has_feature)
@@ -84,22 +86,12 @@ static int spectrum_under_a_thread_limit(void) {
 #endif
 
 #ifndef UNDER_A_SANITIZER
-static size_t mapped_bytes(void) { /* VmSize; 0 where /proc does not say */
-    FILE *f = fopen("/proc/self/status", "r");
-    char line[256];
-    size_t kib = 0;
-    while (f && fgets(line, sizeof line, f))
-        if (strncmp(line, "VmSize:", 7) == 0) kib = (size_t)strtoull(line + 7, NULL, 10);
-    if (f) fclose(f);
-    return kib * 1024;
-}
-
 /* In a child: 0 when the spectrum is refused with LPI_ERR_NO_MEMORY while the
  * address space has 64 MiB to spare and computed once it has more, 77 where
  * nothing can be checked, else 1 .. 3. A hang ends by SIGALRM. */
 static int spectrum_under_an_address_limit(void) {
     struct rlimit saved, tight;
-    const size_t mapped = mapped_bytes();
+    const size_t mapped = lpi_test_mapped_bytes();
     if (mapped == 0 || getrlimit(RLIMIT_AS, &saved) != 0) return 77;
     tight = saved;
     tight.rlim_cur = mapped + ((size_t)64 << 20);
