@@ -3,7 +3,6 @@
 
 #include <dlfcn.h>
 #include <sched.h>
-#include <sys/mman.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -11,6 +10,7 @@
 #include <string>
 
 #include "error.hpp"
+#include "headroom.hpp"
 #include "lpi_config.h"
 #include "threads.hpp"
 
@@ -55,10 +55,9 @@ int threads_started_on_loading() {
 // first call, which later calls reuse; where the system refuses one (a
 // process under an address-space limit) it retries for ever: the call never
 // returns, nor does the process's exit, which waits for its threads. So
-// before loading it the library maps that much, with the 40 MiB the load
-// maps itself and a stack of 8 MiB a thread (mapped, not malloc'ed: a
-// compiler may drop a malloc whose block is never used, and a mapping is
-// given back whole), and refuses where it cannot. Calls on several threads
+// before loading it the library asks for that much, with the 40 MiB the
+// load maps itself and a stack of 8 MiB a thread (headroom.hpp), and
+// refuses where it cannot have it. Calls on several threads
 // at once need a buffer each, which memory run short since the first call
 // may not have (not covered). Counted for any LAPACK, as the threads are.
 constexpr std::size_t kMiB = std::size_t{1} << 20;
@@ -66,12 +65,10 @@ constexpr std::size_t kOpenBlasBuffer = 128 * kMiB + 4096;
 constexpr std::size_t kOpenBlasLoading = 48 * kMiB, kOpenBlasThread = kOpenBlasBuffer + 8 * kMiB;
 
 void require_openblas_memory(std::size_t bytes, const std::string &for_what, const std::string &advice) {
-    void *probe = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (probe == MAP_FAILED)
+    if (!address_space_available(bytes))
         fail(LPI_ERR_NO_MEMORY, for_what + " may need " + std::to_string(bytes) +
                                     " bytes for OpenBLAS's buffers, which this process cannot have (it "
                                     "would wait for them for ever)" + advice);
-    munmap(probe, bytes);
 }
 
 const Routines &routines() {

@@ -10,10 +10,10 @@
 #include <mutex>
 #include <new>
 
-#include <sys/mman.h>
 
 #include "../../core/error.hpp"
 #include "../../core/files.hpp"
+#include "../../core/headroom.hpp"
 #include "../../core/text.hpp"
 #include "../sine_euler.hpp"
 #include "lpi_config.h"
@@ -50,15 +50,11 @@ void require_fftw_execution_headroom(int N, int threads) {
     require_fftw_headroom(bytes, "the flows' transforms of length " + std::to_string(N));
 }
 
-// Mapped, not malloc'ed: a compiler may drop a malloc whose block is never
-// used, and a mapping is given back whole.
 void require_fftw_headroom(std::size_t bytes, const std::string &what) {
-    void *probe = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (probe == MAP_FAILED)
+    if (!address_space_available(bytes))
         fail(LPI_ERR_NO_MEMORY, "FFTW may take " + std::to_string(bytes) + " bytes for " + what +
                                     ", which this process cannot have (FFTW ends the process when its "
                                     "own allocation fails, so it is not called)");
-    munmap(probe, bytes);
 }
 
 const char *planning_name(FftPlanning planning) { return kPlanningNames[static_cast<int>(planning)]; }
