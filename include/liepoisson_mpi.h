@@ -36,7 +36,9 @@ extern "C" {
  * than (N-1)/2 leaves some idle). LPI_ERR_INVALID when MPI is not running,
  * comm is MPI_COMM_NULL or an intercommunicator, or the processes pass
  * different N. The handle must be
- * destroyed (lpi_destroy, collective) before MPI_Finalize. */
+ * destroyed (lpi_destroy, collective) before MPI_Finalize; a call on it
+ * after MPI_Finalize returns LPI_ERR_INVALID. Observers may read the system,
+ * making the same calls on every process (see lpi_sine_euler_create_mpi(3)). */
 LPI_API int lpi_sine_euler_create_mpi(lpi_system **out, int32_t N, MPI_Comm comm);
 
 /* Collective: the checkpoint file at path (read by rank 0) as a sine-Euler

@@ -247,12 +247,15 @@ LPI_API int lpi_sine_euler_get_stream(const lpi_system *sys, double *psi, size_t
         require(psi, "stream function buffer");
         const int N = model.truncation();
         lpi::require_length("stream function buffer", n, squared(N));
+        // Collectives on a spread system, before the agreement (whose action
+        // makes none).
         const std::vector<double> whole = model.whole_state(sys->system.working_state().data());
+        const lpi::sine_euler::Hamiltonian H = model.hamiltonian();
         std::vector<double> grid;
         model.agree_on_every_process([&] {  // one outcome on every process
             std::vector<double> modes(2 * squared(N));
             grid.resize(n);
-            model.hamiltonian().stream_function(whole.data(), modes.data());
+            H.stream_function(whole.data(), modes.data());
             lpi::sine_euler::grid_from_modes(N, modes.data(), grid.data());
         });
         lpi::require_no_overflow(grid.data(), n, [&](std::size_t i) {
@@ -286,10 +289,11 @@ LPI_API int lpi_sine_euler_spectrum(const lpi_system *sys, double *energy, doubl
                                     std::to_string(count) + " shells");
         }
         const std::vector<double> whole = model.whole_state(sys->system.working_state().data());
+        const lpi::sine_euler::Hamiltonian H = model.hamiltonian();
         std::vector<double> e, z;
         model.agree_on_every_process([&] {  // one outcome on every process
             e.resize(count), z.resize(count);
-            lpi::sine_euler::shell_spectra(model.hamiltonian(), whole.data(), e.data(), z.data());
+            lpi::sine_euler::shell_spectra(H, whole.data(), e.data(), z.data());
         });
         lpi::require_no_overflow(e.data(), count, [](std::size_t k) {
             return "the energy of shell " + std::to_string(k + 1) + " of this state";

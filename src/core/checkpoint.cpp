@@ -235,31 +235,35 @@ std::vector<unsigned char> encode_checkpoint(const System &system) {
     if (!find_checkpoint_kind(model.kind()))
         fail(LPI_ERR_UNSUPPORTED, std::string("a ") + model.kind() + " system cannot be "
                                   "checkpointed: this library cannot rebuild its kind");
-    Writer w;
-    w.bytes().assign(kMagic, kMagic + sizeof kMagic);
-    w.put(kByteOrder);
-    w.put(kCheckpointVersion);
-    w.put(std::uint64_t{0});  // total size, filled in below
-    w.put_string(model.kind());
-    w.put_doubles32(parameters, "parameters");
-    w.put_string(model.split());
-    w.put_string(system.method().name);
-    w.put_doubles32(system.method().gammas, "composition weights");
-    w.put(system.implicit_settings().tolerance);
-    w.put(static_cast<std::int32_t>(system.implicit_settings().max_iterations));
-    w.put(system.time());
-    w.put(system.time_carry());
     // A model spread over processes stores its whole state, as one process
     // holding it would: the file loads either way.
     const std::vector<double> state = model.whole_state(system.working_state().data());
-    w.put(static_cast<std::uint64_t>(state.size()));
-    for (double x : state) w.put(x);
-
-    std::vector<unsigned char> &bytes = w.bytes();
-    const std::uint64_t total = bytes.size() + kChecksumSize;
-    std::memcpy(bytes.data() + 16, &total, sizeof total);
-    w.put(crc32(bytes.data(), bytes.size()));
-    return std::move(bytes);
+    // Written (it allocates) with one outcome on every process of a spread
+    // model: one short of memory leaves none waiting in the next collective.
+    std::vector<unsigned char> bytes;
+    model.agree_on_every_process([&] {
+        Writer w;
+        w.bytes().assign(kMagic, kMagic + sizeof kMagic);
+        w.put(kByteOrder);
+        w.put(kCheckpointVersion);
+        w.put(std::uint64_t{0});  // total size, filled in below
+        w.put_string(model.kind());
+        w.put_doubles32(parameters, "parameters");
+        w.put_string(model.split());
+        w.put_string(system.method().name);
+        w.put_doubles32(system.method().gammas, "composition weights");
+        w.put(system.implicit_settings().tolerance);
+        w.put(static_cast<std::int32_t>(system.implicit_settings().max_iterations));
+        w.put(system.time());
+        w.put(system.time_carry());
+        w.put(static_cast<std::uint64_t>(state.size()));
+        for (double x : state) w.put(x);
+        const std::uint64_t total = w.bytes().size() + kChecksumSize;
+        std::memcpy(w.bytes().data() + 16, &total, sizeof total);
+        w.put(crc32(w.bytes().data(), w.bytes().size()));
+        bytes.swap(w.bytes());
+    });
+    return bytes;
 }
 
 Checkpoint decode_checkpoint(const unsigned char *data, std::size_t size) {

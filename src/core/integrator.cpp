@@ -105,6 +105,11 @@ public:
         return {RunOutcome::Done, n};
     }
 
+    // The copy an observed step keeps of the state before its last flow.
+    void prepare_run(const Model &model, const StepObserver &observer) override {
+        if (merge_seam_ && observer.every > 0) pending_.reserve(model.state_size());
+    }
+
     std::size_t evaluations_per_step() const override {
         return merge_seam_ ? program_.size() - 1 : program_.size();
     }

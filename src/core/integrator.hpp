@@ -52,6 +52,12 @@ public:
     // matrix methods to keep their matrix form.
     virtual RunOutcome run(Model &model, double *state, double dt, std::int64_t n,
                            const StepObserver &observer, StepsInProgress &progress);
+    // Allocates what run() will, before it runs: on a model spread over
+    // processes, nothing may fail on one process alone between two flows
+    // (the others would wait in the next one's exchange).
+    virtual void prepare_run(const Model &model, const StepObserver &observer) {
+        (void)model, (void)observer;
+    }
     // Piece flows (or vector-field evaluations) per step in a long run.
     virtual std::size_t evaluations_per_step() const = 0;
     // The largest |multiple of dt| that one flow or stage of a step takes.

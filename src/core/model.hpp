@@ -4,9 +4,10 @@
 #pragma once
 
 #include <cstddef>
-#include <functional>
 #include <string>
 #include <vector>
+
+#include "action_ref.hpp"
 
 namespace lpi {
 
@@ -80,7 +81,7 @@ public:
     virtual std::vector<double> whole_state(const double *state) const;
     // Runs action on one process (a file written once) and gives its outcome,
     // a return or an lpi::Error, to every process.
-    virtual void on_one_process(const std::function<void()> &action) const { action(); }
+    virtual void on_one_process(ActionRef action) const { action(); }
     // Whether `value` holds on any process (an observer that stops the run
     // on one process stops it on all).
     virtual bool on_any_process(bool value) const { return value; }
@@ -88,13 +89,14 @@ public:
     // process throws the status and message of the lowest such rank (a
     // check whose answer may differ between processes, such as a thread
     // count bounded by each process's processors).
-    virtual void agree_on_every_process(const std::function<void()> &action) const { action(); }
+    virtual void agree_on_every_process(ActionRef action) const { action(); }
     // Throws LPI_ERR_INVALID on every process when the processes passed
     // different bytes (`what`, named in the message), before anything reads
     // them otherwise: a value refused on one process alone would leave the
     // others waiting in a collective. Nothing for a model of one process.
-    virtual void require_same_on_every_process(const void *bytes, std::size_t size,
-                                               const std::string &what) const {
+    // `what` is a C string: a std::string made for the call could fail to
+    // allocate on one process alone, before the collective.
+    virtual void require_same_on_every_process(const void *bytes, std::size_t size, const char *what) const {
         (void)bytes, (void)size, (void)what;
     }
 };

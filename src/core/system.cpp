@@ -78,17 +78,17 @@ void System::set_composition(const double *gammas, std::size_t n) {
 }
 
 void System::set_split(const std::string &name) {
-    const std::string previous = model_->split();
-    std::string current;
+    std::string previous, current;
     std::unique_ptr<Integrator> integrator;
     try {
         model_->agree_on_every_process([&] {
+            previous = model_->split();
             model_->set_split(name);  // throws, unchanged, if unknown
             current = model_->split();
             integrator = make_integrator(method_, *model_, implicit_);
         });
     } catch (...) {
-        model_->set_split(previous);
+        if (!previous.empty()) model_->set_split(previous);  // empty: never changed
         throw;
     }
     integrator_ = std::move(integrator);
@@ -122,17 +122,23 @@ void System::get_state(double *x, std::size_t n) const {
     model_->to_public(state_.data(), x);
 }
 
-void System::restore_working_state(std::vector<double> state, double time, double time_carry) {
-    require_length("working state", state.size(), model_->state_size());
-    for (std::size_t i = 0; i < state.size(); ++i)
-        if (!std::isfinite(state[i]))
-            fail(LPI_ERR_NONFINITE, "working state entry " + std::to_string(i) + " is not finite");
-    if (!std::isfinite(time)) fail(LPI_ERR_NONFINITE, "time is not finite");
-    if (!std::isfinite(time_carry) || time + time_carry != time)
-        fail(LPI_ERR_INVALID, "the time's carry " + number_text(time_carry) +
-                                  " is not below half a unit in the last place of the time " +
-                                  number_text(time));
-    state_.swap(state);
+void System::restore_working_state(const std::vector<double> &state, double time, double time_carry) {
+    // Checked and copied with one outcome on every process of a spread
+    // model: each holds its own part of the state.
+    std::vector<double> restored;
+    model_->agree_on_every_process([&] {
+        require_length("working state", state.size(), model_->state_size());
+        for (std::size_t i = 0; i < state.size(); ++i)
+            if (!std::isfinite(state[i]))
+                fail(LPI_ERR_NONFINITE, "working state entry " + std::to_string(i) + " is not finite");
+        if (!std::isfinite(time)) fail(LPI_ERR_NONFINITE, "time is not finite");
+        if (!std::isfinite(time_carry) || time + time_carry != time)
+            fail(LPI_ERR_INVALID, "the time's carry " + number_text(time_carry) +
+                                      " is not below half a unit in the last place of the time " +
+                                      number_text(time));
+        restored = state;
+    });
+    state_.swap(restored);
     time_ = Time{time, time_carry};
 }
 
@@ -186,26 +192,27 @@ bool System::step(double dt, std::int64_t nsteps) {
                                    "' overflows a double");
     // Everything the step sets up or allocates, before its first flow: on a
     // model spread over processes, a failure on one of them (its thread
-    // limit, memory for the plans) then fails the call on every process, and
-    // none is left waiting in a flow's exchange.
+    // limit, memory for the plans or the watch) then fails the call on every
+    // process, and none is left waiting in a flow's exchange.
+    StepObserver watch;
     model_->agree_on_every_process([&] {
         prepare_threads();
         model_->prepare_step();
         saved_ = state_;
+        if (observer_) {
+            watch.every = observe_every_;
+            watch.observe = [&](std::int64_t done) {
+                time_ = begun.advanced(dt, done);
+                // An observer that fails (throws) on one process fails the
+                // call on every one: none is left waiting in the next
+                // collective.
+                bool stop = false;
+                model_->agree_on_every_process([&] { stop = observer_(done, time_.value); });
+                return model_->on_any_process(stop);
+            };
+        }
+        integrator_->prepare_run(*model_, watch);
     });
-
-    StepObserver watch;
-    if (observer_) {
-        watch.every = observe_every_;
-        watch.observe = [&](std::int64_t done) {
-            time_ = begun.advanced(dt, done);
-            // An observer that fails (throws) on one process fails the call
-            // on every one: none is left waiting in the next collective.
-            bool stop = false;
-            model_->agree_on_every_process([&] { stop = observer_(done, time_.value); });
-            return model_->on_any_process(stop);
-        };
-    }
     const double average_iterations = integrator_->average_iterations();
     const auto roll_back = [&] {
         state_.swap(saved_);

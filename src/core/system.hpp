@@ -47,7 +47,7 @@ public:
     const std::vector<double> &working_state() const { return state_; }
     // Restores a working state and time exactly (checkpoints): the length
     // must be the model's state_size() and every value finite.
-    void restore_working_state(std::vector<double> state, double time, double time_carry = 0.0);
+    void restore_working_state(const std::vector<double> &state, double time, double time_carry = 0.0);
 
     // Called by step() after every `every`-th step with the steps completed
     // in the call and the time; true stops the call there.

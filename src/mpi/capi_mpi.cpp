@@ -45,7 +45,7 @@ extern "C" {
 LPI_API int lpi_sine_euler_create_mpi(lpi_system **out, int32_t N, MPI_Comm comm) {
     if (out) *out = nullptr;
     return guarded(nullptr, "lpi_sine_euler_create_mpi", [&] {
-        auto communicator = std::make_shared<const lpi::mpi::Communicator>(comm);
+        auto communicator = lpi::mpi::Communicator::duplicate(comm);
         require_same_arguments(*communicator, Arguments(out));  // N: compared by the model, named
         require(out, "out");
         std::unique_ptr<lpi::Model> model = lpi::make_sine_euler_mpi(N, communicator);
@@ -61,7 +61,7 @@ LPI_API int lpi_sine_euler_create_mpi(lpi_system **out, int32_t N, MPI_Comm comm
 LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
     if (out) *out = nullptr;
     return guarded(nullptr, "lpi_load_mpi", [&] {
-        const auto communicator = std::make_shared<const lpi::mpi::Communicator>(comm);
+        const auto communicator = lpi::mpi::Communicator::duplicate(comm);
         const lpi::mpi::Communicator &reader = *communicator;
         require_same_arguments(reader, Arguments(out, Text{path}));
         require(out, "out");
@@ -105,7 +105,8 @@ LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
             cp.state = lpi::local_state_of_modes(*model, cp.state.data());
             handle = std::make_unique<lpi_system>(std::move(model));
         });
-        reader.agree([&] { naming_path(path, [&] { lpi::restore_checkpoint(handle->system, cp); }); });
+        // Its calls agree on each outcome (an action makes no collective).
+        naming_path(path, [&] { lpi::restore_checkpoint(handle->system, cp); });
         *out = handle.release();
     });
 }

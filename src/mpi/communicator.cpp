@@ -1,6 +1,7 @@
 // MPI behind the library's Communicator (see the header).
 #include "communicator.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <new>
 #include <stdexcept>
@@ -20,29 +21,53 @@ bool mpi_running() {
     return initialised && !finalised;
 }
 
+// message = text, or empty when there is no memory for it: the outcome
+// must reach the agreement's collective.
+void set_message(std::string &message, const char *prefix, const char *text) noexcept {
+    try {
+        message = std::string(prefix) + text;
+    } catch (...) {
+        message.clear();
+    }
+}
+
 // The status and message of whatever action() throws; LPI_OK when nothing.
-int outcome_of(const std::function<void()> &action, std::string &message) {
+int outcome_of(ActionRef action, std::string &message) {
     try {
         action();
         return LPI_OK;
     } catch (const Error &e) {
-        message = e.what();
+        set_message(message, "", e.what());
         return e.status();
     } catch (const std::bad_alloc &) {
-        message = "out of memory";
+        set_message(message, "", "out of memory");
         return LPI_ERR_NO_MEMORY;
     } catch (const std::length_error &) {
-        message = "a buffer of the size this needs cannot be allocated";
+        set_message(message, "", "a buffer of the size this needs cannot be allocated");
         return LPI_ERR_NO_MEMORY;
     } catch (const std::exception &e) {
-        message = std::string("internal error: ") + e.what();
+        set_message(message, "internal error: ", e.what());
+        return LPI_ERR_INTERNAL;
+    } catch (...) {
+        rethrow_if_thread_ending();
+        set_message(message, "internal error: ", "an exception of unknown type");
         return LPI_ERR_INTERNAL;
     }
 }
 
+// The longest message an agreement shares (its buffer is allocated once).
+constexpr std::size_t kMessageCapacity = 2048;
+
 }  // namespace
 
-Communicator::Communicator(MPI_Comm comm) {
+Communicator::Communicator(int size)
+    : size_(size),
+      headers_(2 * static_cast<std::size_t>(size)),
+      gathered_integers_(static_cast<std::size_t>(size)),
+      gathered_(static_cast<std::size_t>(size)),
+      message_(kMessageCapacity) {}
+
+std::shared_ptr<const Communicator> Communicator::duplicate(MPI_Comm comm) {
     if (!mpi_running())
         fail(LPI_ERR_INVALID, "MPI is not initialised (call MPI_Init first) or already finalised");
     if (comm == MPI_COMM_NULL) fail(LPI_ERR_INVALID, "the communicator is MPI_COMM_NULL");
@@ -53,18 +78,41 @@ Communicator::Communicator(MPI_Comm comm) {
     if (MPI_Comm_test_inter(comm, &inter) == MPI_SUCCESS && inter)
         fail(LPI_ERR_INVALID, "the communicator is an intercommunicator (a system is spread over the "
                               "processes of one group: MPI_Intercomm_merge makes one)");
-    // The duplicate returns its errors. The user's communicator keeps its own
-    // handler, except while it is duplicated (a failure there is returned).
+    int size = 0;
+    if (MPI_Comm_size(comm, &size) != MPI_SUCCESS || size < 1)
+        fail(LPI_ERR_INVALID, "the communicator's size cannot be read");
+    // Made before the first collective, and agreed on in it: a process that
+    // cannot allocate it does not leave the others waiting in MPI_Comm_dup.
+    std::shared_ptr<Communicator> made;
+    int ready = 0;
+    try {
+        made.reset(new Communicator(size));
+        ready = 1;
+    } catch (const std::bad_alloc &) {
+    } catch (const std::length_error &) {
+    }
+    // The user's communicator returns its errors while it is used here, and
+    // keeps its own handler otherwise.
     MPI_Errhandler users = MPI_ERRHANDLER_NULL;
     MPI_Comm_get_errhandler(comm, &users);
     MPI_Comm_set_errhandler(comm, MPI_ERRORS_RETURN);
-    const int duplicated = MPI_Comm_dup(comm, &comm_);
+    int all_ready = 0;
+    int code = MPI_Allreduce(&ready, &all_ready, 1, MPI_INT, MPI_MIN, comm);
+    MPI_Comm new_comm = MPI_COMM_NULL;
+    if (code == MPI_SUCCESS && all_ready) code = MPI_Comm_dup(comm, &new_comm);
     MPI_Comm_set_errhandler(comm, users);
     MPI_Errhandler_free(&users);
-    check(duplicated, "MPI_Comm_dup");
-    check(MPI_Comm_set_errhandler(comm_, MPI_ERRORS_RETURN), "MPI_Comm_set_errhandler");
-    check(MPI_Comm_rank(comm_, &rank_), "MPI_Comm_rank");
-    check(MPI_Comm_size(comm_, &size_), "MPI_Comm_size");
+    if (code != MPI_SUCCESS) {
+        char text[MPI_MAX_ERROR_STRING];
+        int length = 0;
+        MPI_Error_string(code, text, &length);
+        fail(LPI_ERR_INTERNAL, "duplicating the communicator failed: " + std::string(text, length));
+    }
+    if (!all_ready) fail(LPI_ERR_NO_MEMORY, "out of memory for the communicator on some process");
+    made->comm_ = new_comm;
+    made->check(MPI_Comm_set_errhandler(new_comm, MPI_ERRORS_RETURN), "MPI_Comm_set_errhandler");
+    made->check(MPI_Comm_rank(new_comm, &made->rank_), "MPI_Comm_rank");
+    return made;
 }
 
 Communicator::~Communicator() {
@@ -84,10 +132,17 @@ void Communicator::check(int code, const char *call) const {
     fail(LPI_ERR_INTERNAL, std::string(call) + " failed: " + std::string(text, length));
 }
 
+void Communicator::require_running() const {
+    if (!mpi_running())
+        fail(LPI_ERR_INVALID, "MPI is finalised: a system spread over processes is destroyed before "
+                              "MPI_Finalize");
+}
+
 void Communicator::alltoallv(const double *send, const std::vector<int> &send_counts,
                              const std::vector<int> &send_offsets, double *receive,
                              const std::vector<int> &receive_counts,
                              const std::vector<int> &receive_offsets) const {
+    require_running();
     check(MPI_Alltoallv(send, send_counts.data(), send_offsets.data(), MPI_C_DOUBLE_COMPLEX, receive,
                         receive_counts.data(), receive_offsets.data(), MPI_C_DOUBLE_COMPLEX, comm_),
           "MPI_Alltoallv");
@@ -95,45 +150,70 @@ void Communicator::alltoallv(const double *send, const std::vector<int> &send_co
 
 void Communicator::allgatherv(const double *send, int count, double *receive,
                               const std::vector<int> &counts, const std::vector<int> &offsets) const {
+    require_running();
     check(MPI_Allgatherv(send, count, MPI_C_DOUBLE_COMPLEX, receive, counts.data(), offsets.data(),
                          MPI_C_DOUBLE_COMPLEX, comm_),
           "MPI_Allgatherv");
 }
 
-std::vector<double> Communicator::allgather(double value) const {
-    std::vector<double> values(static_cast<std::size_t>(size_));
-    check(MPI_Allgather(&value, 1, MPI_DOUBLE, values.data(), 1, MPI_DOUBLE, comm_), "MPI_Allgather");
-    return values;
+const std::vector<double> &Communicator::allgather(double value) const {
+    require_running();
+    check(MPI_Allgather(&value, 1, MPI_DOUBLE, gathered_.data(), 1, MPI_DOUBLE, comm_), "MPI_Allgather");
+    return gathered_;
 }
 
-std::vector<long long> Communicator::allgather(long long value) const {
-    std::vector<long long> values(static_cast<std::size_t>(size_));
-    check(MPI_Allgather(&value, 1, MPI_LONG_LONG, values.data(), 1, MPI_LONG_LONG, comm_),
+const std::vector<long long> &Communicator::allgather(long long value) const {
+    require_running();
+    check(MPI_Allgather(&value, 1, MPI_LONG_LONG, gathered_integers_.data(), 1, MPI_LONG_LONG, comm_),
           "MPI_Allgather");
-    return values;
+    return gathered_integers_;
 }
 
-void Communicator::require_same(long long value, const std::string &what) const {
-    const std::vector<long long> values = allgather(value);
-    for (long long v : values)
-        if (v != values[0])
-            fail(LPI_ERR_INVALID, "the processes passed different " + what +
+void Communicator::exchange_headers(Stage stage, long long value) const {
+    require_running();
+    const long long mine[2] = {stage, value};
+    check(MPI_Allgather(mine, 2, MPI_LONG_LONG, headers_.data(), 2, MPI_LONG_LONG, comm_), "MPI_Allgather");
+}
+
+void Communicator::require_same(long long value, const char *what) const {
+    exchange_headers(kCalling, value);
+    // A process ending an agreement has left the observer this process calls
+    // from: the call is refused alike on every process that makes it.
+    int ended = -1, failed = -1;
+    for (int r = 0; r < size_; ++r) {
+        if (headers_[2 * r] != kEndingAgreement) continue;
+        if (ended < 0) ended = r;
+        if (failed < 0 && headers_[2 * r + 1] != LPI_OK) failed = r;
+    }
+    if (failed >= 0)
+        fail(LPI_ERR_CALLBACK, "rank " + std::to_string(failed) + " failed in its observer and left it while "
+                               "this process called the system from its own");
+    if (ended >= 0)
+        fail(LPI_ERR_INVALID, "rank " + std::to_string(ended) + " had returned from its observer while this "
+                              "process called the system from its own (the observers of a system spread "
+                              "over processes make the same calls)");
+    for (int r = 1; r < size_; ++r)
+        if (headers_[2 * r + 1] != headers_[1])
+            fail(LPI_ERR_INVALID, std::string("the processes passed different ") + what +
                                       " (every process must make the same calls with the same arguments)");
 }
 
 double Communicator::max(double value) const {
+    require_running();
     double result = 0.0;
     check(MPI_Allreduce(&value, &result, 1, MPI_DOUBLE, MPI_MAX, comm_), "MPI_Allreduce");
     return result;
 }
 
 bool Communicator::all(bool value) const {
+    require_running();
     int local = value ? 1 : 0, result = 0;
     check(MPI_Allreduce(&local, &result, 1, MPI_INT, MPI_LAND, comm_), "MPI_Allreduce");
     return result != 0;
 }
 
 void Communicator::broadcast(double *values, std::size_t n) const {
+    require_running();
     while (n > 0) {  // in pieces that an int counts
         const int count = n > INT_MAX ? INT_MAX : static_cast<int>(n);
         check(MPI_Bcast(values, count, MPI_DOUBLE, 0, comm_), "MPI_Bcast");
@@ -143,6 +223,7 @@ void Communicator::broadcast(double *values, std::size_t n) const {
 }
 
 void Communicator::broadcast(unsigned char *bytes, std::size_t n) const {
+    require_running();
     while (n > 0) {
         const int count = n > INT_MAX ? INT_MAX : static_cast<int>(n);
         check(MPI_Bcast(bytes, count, MPI_UNSIGNED_CHAR, 0, comm_), "MPI_Bcast");
@@ -152,28 +233,34 @@ void Communicator::broadcast(unsigned char *bytes, std::size_t n) const {
 }
 
 void Communicator::share_outcome(int status, const std::string &message) const {
-    std::vector<int> statuses(static_cast<std::size_t>(size_));
-    check(MPI_Allgather(&status, 1, MPI_INT, statuses.data(), 1, MPI_INT, comm_), "MPI_Allgather");
+    // Until no process calls the system from an observer this one has left
+    // (each such call is refused, and its process comes here in the end).
+    bool calling = true;
+    while (calling) {
+        exchange_headers(kEndingAgreement, status);
+        calling = false;
+        for (int r = 0; r < size_; ++r) calling = calling || headers_[2 * r] == kCalling;
+    }
     int failed = -1;
     for (int r = 0; r < size_ && failed < 0; ++r)
-        if (statuses[static_cast<std::size_t>(r)] != LPI_OK) failed = r;
+        if (headers_[2 * r + 1] != LPI_OK) failed = r;
     if (failed < 0) return;
-    int length = rank_ == failed ? static_cast<int>(message.size()) : 0;
+    int length = rank_ == failed ? static_cast<int>(std::min(message.size(), message_.size())) : 0;
     check(MPI_Bcast(&length, 1, MPI_INT, failed, comm_), "MPI_Bcast");
-    std::string text(static_cast<std::size_t>(length), '\0');
-    if (rank_ == failed) text = message;
-    check(MPI_Bcast(&text[0], length, MPI_CHAR, failed, comm_), "MPI_Bcast");
+    if (rank_ == failed) std::copy(message.begin(), message.begin() + length, message_.begin());
+    check(MPI_Bcast(message_.data(), length, MPI_CHAR, failed, comm_), "MPI_Bcast");
+    std::string text(message_.data(), static_cast<std::size_t>(length));
     if (size_ > 1 && failed != 0) text = "on rank " + std::to_string(failed) + ": " + text;
-    fail(static_cast<lpi_status>(statuses[static_cast<std::size_t>(failed)]), text);
+    fail(static_cast<lpi_status>(headers_[2 * failed + 1]), text);
 }
 
-void Communicator::agree(const std::function<void()> &action) const {
+void Communicator::agree(ActionRef action) const {
     std::string message;
     const int status = outcome_of(action, message);
     share_outcome(status, message);
 }
 
-void Communicator::on_root(const std::function<void()> &action) const {
+void Communicator::on_root(ActionRef action) const {
     std::string message;
     const int status = rank_ == 0 ? outcome_of(action, message) : LPI_OK;
     share_outcome(status, message);

@@ -3,23 +3,41 @@
 // (LPI_ERR_INTERNAL naming the call) instead of aborting the program, and the
 // library's messages never meet the user's. Every function here is
 // collective unless it says otherwise.
+//
+// What keeps the processes in step: a call on a spread system opens with
+// require_same, and from there every process makes the same collectives
+// unless one fails, which only an agreement's action may do (agree,
+// on_root: the failure is shared at its end). So nothing that may throw on
+// one process alone (an allocation) stands between two collectives outside
+// an action, no action makes a collective of its own (an observer's calls on
+// the system, each opening with require_same, aside), and these functions
+// allocate nothing before their MPI calls. require_same and the end of an
+// agreement exchange one kind of header, so a process that left its
+// observer (it failed there) while another calls the system from its own is
+// seen by both, instead of pairing two different collectives: the call is
+// refused, and the ending agreement waits for it.
 #pragma once
 
 #include <mpi.h>
 
 #include <cstddef>
-#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "../core/action_ref.hpp"
 
 namespace lpi {
 namespace mpi {
 
 class Communicator {
 public:
-    // LPI_ERR_INVALID when MPI is not initialised (or already finalised) or
-    // comm is MPI_COMM_NULL.
-    explicit Communicator(MPI_Comm comm);
+    // A duplicate of comm (collective on it). LPI_ERR_INVALID when MPI is
+    // not initialised (or already finalised), or comm is MPI_COMM_NULL or an
+    // intercommunicator; LPI_ERR_NO_MEMORY on every process when one cannot
+    // allocate it. Every collective after MPI_Finalize is refused alike
+    // (LPI_ERR_INVALID): MPI would abort the program.
+    static std::shared_ptr<const Communicator> duplicate(MPI_Comm comm);
     ~Communicator();
     Communicator(const Communicator &) = delete;
     Communicator &operator=(const Communicator &) = delete;
@@ -37,13 +55,15 @@ public:
                    const std::vector<int> &receive_offsets) const;
     void allgatherv(const double *send, int count, double *receive, const std::vector<int> &counts,
                     const std::vector<int> &offsets) const;
-    // One value from each process, in rank order, on every process.
-    std::vector<double> allgather(double value) const;
-    std::vector<long long> allgather(long long value) const;
+    // One value from each process, in rank order, on every process (held
+    // until the next collective).
+    const std::vector<double> &allgather(double value) const;
+    const std::vector<long long> &allgather(long long value) const;
     double max(double value) const;
     // LPI_ERR_INVALID on every process, naming `what`, when the processes'
-    // values differ (fingerprints of what each process was given).
-    void require_same(long long value, const std::string &what) const;
+    // values differ (fingerprints of what each process was given). A call
+    // on the system opens with it.
+    void require_same(long long value, const char *what) const;
     bool all(bool value) const;
     void broadcast(double *values, std::size_t n) const;  // from rank 0
     void broadcast(unsigned char *bytes, std::size_t n) const;  // from rank 0
@@ -51,17 +71,27 @@ public:
     // Runs action on every process; when it throws on any of them, every
     // process throws the status and message of the lowest such rank, so
     // that no process goes on alone.
-    void agree(const std::function<void()> &action) const;
+    void agree(ActionRef action) const;
     // Runs action on rank 0 only and gives its outcome to every process.
-    void on_root(const std::function<void()> &action) const;
+    void on_root(ActionRef action) const;
 
 private:
+    explicit Communicator(int size);  // buffers for size processes; no MPI call
+    // What a process is doing when it sends a header.
+    enum Stage : long long { kCalling = 1, kEndingAgreement = 2 };
     void check(int code, const char *call) const;  // throws LPI_ERR_INTERNAL
+    void require_running() const;                 // LPI_ERR_INVALID after MPI_Finalize
+    // Every process's (stage, value), into headers_.
+    void exchange_headers(Stage stage, long long value) const;
     // Every process learns the outcome (status, message) of the lowest rank
     // that failed; throws it when there is one.
     void share_outcome(int status, const std::string &message) const;
     MPI_Comm comm_ = MPI_COMM_NULL;
     int rank_ = 0, size_ = 1;
+    // Allocated once: the collectives allocate nothing.
+    mutable std::vector<long long> headers_, gathered_integers_;
+    mutable std::vector<double> gathered_;
+    mutable std::vector<char> message_;
 };
 
 }  // namespace mpi

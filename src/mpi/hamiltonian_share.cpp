@@ -1,6 +1,8 @@
 // The Hamiltonian spread over processes (see the header).
 #include "hamiltonian_share.hpp"
 
+#include <optional>
+
 #include "../core/error.hpp"
 #include "../models/sine_euler/indexing.hpp"
 
@@ -82,47 +84,59 @@ void HamiltonianShare::keep(Share &share) noexcept {
 }
 
 Hamiltonian HamiltonianShare::whole(const Communicator &comm) const {
-    if (euler_) return Hamiltonian(N_);
-    // Every process's lines, as complex entries (lambda, 0) then f.
-    const int per_mode = f_.empty() ? 1 : 2;
-    std::vector<double> held;
-    held.reserve(2 * static_cast<std::size_t>(per_mode) * N_ * mine_);
-    for (std::size_t e = N_; e < lambda_.size(); ++e) {
-        held.push_back(lambda_[e]);
-        held.push_back(0.0);
-        if (!f_.empty()) held.push_back(f_[2 * e]), held.push_back(f_[2 * e + 1]);
+    std::optional<Hamiltonian> H;
+    if (euler_) {
+        comm.agree([&] { H.emplace(N_); });
+        return std::move(*H);
     }
+    // Every process's lines, as complex entries (lambda, 0) then f; the
+    // buffers allocated, and agreed on, before the collective.
+    const int per_mode = f_.empty() ? 1 : 2;
     const int P = lines_.P;
-    std::vector<int> counts(P), offsets(P);
+    std::vector<double> held, all;
+    std::vector<int> counts, offsets;
+    comm.agree([&] {
+        held.reserve(2 * static_cast<std::size_t>(per_mode) * N_ * mine_);
+        for (std::size_t e = N_; e < lambda_.size(); ++e) {
+            held.push_back(lambda_[e]);
+            held.push_back(0.0);
+            if (!f_.empty()) held.push_back(f_[2 * e]), held.push_back(f_[2 * e + 1]);
+        }
+        counts.resize(P), offsets.resize(P);
+        all.resize(2 * static_cast<std::size_t>(per_mode) * N_ * M_);
+    });
     for (int r = 0; r < P; ++r) {
         counts[r] = per_mode * lines_.count(r) * N_;
         offsets[r] = per_mode * (lines_.first[r] - 1) * N_;
     }
-    std::vector<double> all(2 * static_cast<std::size_t>(per_mode) * N_ * M_);
     comm.allgatherv(held.data(), per_mode * mine_ * N_, all.data(), counts, offsets);
 
-    const std::size_t modes = static_cast<std::size_t>(N_) * N_;
-    std::vector<double> lambda(modes), f(f_.empty() ? 0 : 2 * modes);
-    for (int s = 0; s < N_; ++s) {
-        lambda[mode_index(0, s, N_)] = lambda_[s];
-        if (!f.empty()) f[2 * s] = f_[2 * s], f[2 * s + 1] = f_[2 * s + 1];
-    }
-    for (int r = 0; r < P; ++r) {
-        const double *slab = all.data() + 2 * static_cast<std::size_t>(offsets[r]);
-        const int count = lines_.count(r);
-        for (int s = 0; s < N_; ++s)
-            for (int i = 0; i < count; ++i) {
-                const double *z = slab + 2 * per_mode * (static_cast<std::size_t>(s) * count + i);
-                const int d = lines_.first[r] + i;
-                const std::size_t m = mode_index(d, s, N_), minus = sine_euler::mirror_index(d, s, N_);
-                lambda[m] = lambda[minus] = z[0];
-                if (f.empty()) continue;
-                f[2 * m] = f[2 * minus] = z[2];
-                f[2 * m + 1] = z[3];
-                f[2 * minus + 1] = -z[3];
-            }
-    }
-    return Hamiltonian(N_, lambda.data(), modes, f.empty() ? nullptr : f.data(), f.size());
+    // Assembled, and agreed on, after it.
+    comm.agree([&] {
+        const std::size_t modes = static_cast<std::size_t>(N_) * N_;
+        std::vector<double> lambda(modes), f(f_.empty() ? 0 : 2 * modes);
+        for (int s = 0; s < N_; ++s) {
+            lambda[mode_index(0, s, N_)] = lambda_[s];
+            if (!f.empty()) f[2 * s] = f_[2 * s], f[2 * s + 1] = f_[2 * s + 1];
+        }
+        for (int r = 0; r < P; ++r) {
+            const double *slab = all.data() + 2 * static_cast<std::size_t>(offsets[r]);
+            const int count = lines_.count(r);
+            for (int s = 0; s < N_; ++s)
+                for (int i = 0; i < count; ++i) {
+                    const double *z = slab + 2 * per_mode * (static_cast<std::size_t>(s) * count + i);
+                    const int d = lines_.first[r] + i;
+                    const std::size_t m = mode_index(d, s, N_), minus = sine_euler::mirror_index(d, s, N_);
+                    lambda[m] = lambda[minus] = z[0];
+                    if (f.empty()) continue;
+                    f[2 * m] = f[2 * minus] = z[2];
+                    f[2 * m + 1] = z[3];
+                    f[2 * minus + 1] = -z[3];
+                }
+        }
+        H.emplace(N_, lambda.data(), modes, f.empty() ? nullptr : f.data(), f.size());
+    });
+    return std::move(*H);
 }
 
 template <class F>

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -69,11 +70,15 @@ public:
     // As the model of one process stores them: N, and lambda and f when they
     // are not Euler's.
     std::vector<double> checkpoint_parameters() const override {
-        std::vector<double> p = {double(N_)};
-        if (!share_.is_default()) {
-            const std::vector<double> lambda_f = hamiltonian().parameters();
+        std::optional<Hamiltonian> H;
+        if (!share_.is_default()) H.emplace(hamiltonian());
+        std::vector<double> p;
+        comm_->agree([&] {  // it allocates: one outcome on every process
+            p = {double(N_)};
+            if (!H) return;
+            const std::vector<double> lambda_f = H->parameters();
             p.insert(p.end(), lambda_f.begin(), lambda_f.end());
-        }
+        });
         return p;
     }
     Hamiltonian hamiltonian() const override { return share_.whole(*comm_); }
@@ -110,10 +115,10 @@ public:
         return comm_->all(all_finite(state, state_size()));
     }
     std::vector<double> whole_state(const double *state) const override;
-    void on_one_process(const std::function<void()> &action) const override { comm_->on_root(action); }
+    void on_one_process(ActionRef action) const override { comm_->on_root(action); }
     bool on_any_process(bool value) const override { return !comm_->all(!value); }
-    void agree_on_every_process(const std::function<void()> &action) const override { comm_->agree(action); }
-    void require_same_on_every_process(const void *bytes, std::size_t size, const std::string &what) const override {
+    void agree_on_every_process(ActionRef action) const override { comm_->agree(action); }
+    void require_same_on_every_process(const void *bytes, std::size_t size, const char *what) const override {
         comm_->require_same(fingerprint(bytes, size), what);
     }
     std::vector<double> local_state(const double *modes, std::size_t direction) const;
@@ -402,7 +407,7 @@ TransformTiming SineEulerMpi::time_transforms(std::size_t flows_per_step, std::i
 }  // namespace
 
 std::unique_ptr<Model> make_sine_euler_mpi(int N, std::shared_ptr<const mpi::Communicator> communicator) {
-    const std::vector<long long> orders = communicator->allgather(static_cast<long long>(N));
+    const std::vector<long long> &orders = communicator->allgather(static_cast<long long>(N));
     // Compared with rank 0's, so that every process names the same pair.
     for (std::size_t rank = 1; rank < orders.size(); ++rank)
         if (orders[rank] != orders[0])
