@@ -118,11 +118,13 @@ check-clang: build
 # (tests/check_valgrind.sh). VALGRIND_SKIP leaves out the
 # two slowest (minutes each under valgrind) and test_expm, whose long double
 # references need x87 80-bit arithmetic that valgrind performs in 64 bits
-# (its assertions then fail), and the MPI tests (test_sine_euler_mpi and
-# test_sine_euler_mpi_observer), which run under mpirun (valgrind reports
-# Open MPI's own allocations and its shared-memory transport).
+# (its assertions then fail), and the MPI tests (test_sine_euler_mpi,
+# test_sine_euler_mpi_observer and test_sine_euler_mpi_allocations), which run
+# under mpirun (valgrind reports Open MPI's own allocations and its
+# shared-memory transport).
 # `make check-valgrind VALGRIND_SKIP=` runs all.
-VALGRIND_SKIP ?= test_compositions test_sine_euler test_expm test_sine_euler_mpi test_sine_euler_mpi_observer
+VALGRIND_SKIP ?= test_compositions test_sine_euler test_expm test_sine_euler_mpi test_sine_euler_mpi_observer \
+                 test_sine_euler_mpi_allocations
 check-valgrind: build
 	@tests/check_valgrind.sh $(BUILD) $(JOBS) $(CURDIR)/include/liepoisson.h $(VALGRIND_SKIP)
 
