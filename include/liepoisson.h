@@ -157,9 +157,11 @@ LPI_API int lpi_get_state(const lpi_system *sys, double *x, size_t n);
 /* Advances nsteps steps of size dt (dt finite and nonzero; negative dt
  * integrates backwards; nsteps >= 0). The time becomes lpi_time + dt * nsteps
  * (LPI_ERR_OVERFLOW when that, or dt times a flow weight of the method,
- * overflows). A step whose result is not finite, or whose callback fails, is
- * rolled back to the state before the call: LPI_ERR_NONFINITE or
- * LPI_ERR_CALLBACK with a message naming the step and the time. With an
+ * overflows; with nsteps == 0 nothing is stepped, and only that dt is finite
+ * and nonzero is checked). A step whose result is not finite, or whose
+ * callback fails, is rolled back to the state before the call:
+ * LPI_ERR_NONFINITE or LPI_ERR_CALLBACK with a message naming the step and
+ * the time. With an
  * observer whose callback returns non-zero, LPI_STOPPED (positive): the
  * state and time are those of a call of that many steps. */
 LPI_API int lpi_step(lpi_system *sys, double dt, int64_t nsteps);
@@ -295,13 +297,14 @@ LPI_API int lpi_sine_euler_size(const lpi_system *sys, int32_t *N);
 /* Modes, n = 2*N*N doubles: entry [a*N + b] is mode (a, b) mod N (FFT order)
  * as interleaved re, im. set checks finiteness and Hermitian symmetry
  * (tolerance 1e-10 * max |w_m|) and stores the symmetrised field; resets the
- * time to 0. The inert mode w_0 is kept as given (its imaginary part must be 0
- * within the tolerance). */
+ * time to 0. The inert mode w_0 keeps its real part (its imaginary part must
+ * be 0 within the tolerance, and is dropped). */
 LPI_API int lpi_sine_euler_set_modes(lpi_system *sys, const double *re_im, size_t n);
 LPI_API int lpi_sine_euler_get_modes(const lpi_system *sys, double *re_im, size_t n);
 /* Real vorticity on the grid, n = N*N: entry [a*N + b] is
  * w(2 pi a / N, 2 pi b / N) = sum_m w_m exp(i (m1 x + m2 y)). Setting modes
- * or a grid whose conversion overflows a double gives LPI_ERR_OVERFLOW. */
+ * or a grid whose conversion overflows a double gives LPI_ERR_OVERFLOW.
+ * Setting a grid, as setting modes, resets the time to 0. */
 LPI_API int lpi_sine_euler_set_grid(lpi_system *sys, const double *w, size_t n);
 LPI_API int lpi_sine_euler_get_grid(const lpi_system *sys, double *w, size_t n);
 
