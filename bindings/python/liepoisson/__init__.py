@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import collections
 import collections.abc
+import contextlib
 import ctypes
 import math
 import numbers
@@ -105,8 +106,18 @@ def _integer(value, what, ctype):
     return v
 
 
+def _zero_dim_of(value, kinds):
+    """Whether value is a 0-d array (numpy's np.asarray(0.5), what numpy
+    arithmetic on arrays often returns) whose dtype kind is one of kinds:
+    a number in an array's clothing. Not bool ("b") nor, for reals, complex."""
+    dtype = getattr(value, "dtype", None)
+    return getattr(value, "shape", None) == () and getattr(dtype, "kind", None) in kinds
+
+
 def _real(value, what):
     """value as a float: TypeError for anything but a real number (no strings)."""
+    if _zero_dim_of(value, ("i", "u", "f")):
+        return float(value)
     if isinstance(value, (bool, str, bytes)) or not isinstance(value, numbers.Real):
         raise TypeError("%s must be a real number, not %s" % (what, type(value).__name__))
     return float(value)
@@ -114,6 +125,8 @@ def _real(value, what):
 
 def _complex(value, what):
     """value as a complex: TypeError for anything but a number (no strings)."""
+    if _zero_dim_of(value, ("i", "u", "f", "c")):
+        return complex(value)
     if isinstance(value, (bool, str, bytes)) or not isinstance(value, numbers.Number):
         raise TypeError("%s must be a complex number, not %s" % (what, type(value).__name__))
     return complex(value)
@@ -359,6 +372,56 @@ def _check_free(status):
 # _OBSERVE_SECONDS; observing does not change the trajectory to the bit, so
 # the cadence may follow the measured speed.
 _OBSERVE_SECONDS = 0.05
+# Before a step of this kind has been timed, its cost is guessed and the looks
+# come this many times as often as the guess asks: the guess is off by up to
+# 40x (the sine-Euler matrix methods cost N^3 a flow, not N^2), and a call
+# cannot widen its cadence later without changing the bits of the trajectory
+# (stopping and stepping on is not the same as one call for split sine-Euler).
+# The time measured by the call then sets the cadence of the next ones.
+_UNMEASURED_MARGIN = 64
+
+
+class _SigintDeferred:
+    """Holds SIGINT's Python handler back through a library call that may
+    enter Python (a piece, a Casimir, an observer). Python runs a handler at
+    the next bytecode of the main thread, which during such a call is the
+    first one of a callback, before it can catch anything: ctypes then prints
+    the exception and hands C an undefined result (a wrong energy, a step
+    count C never meant). A SIGINT is recorded instead and the handler runs
+    once the call has returned, or at an observer's look (run_pending).
+
+    Only the main thread's outermost call installs the recorder; one nested
+    in it (a call from a callback) shares the outer one's record, and one
+    from another thread (which Python never interrupts) does nothing."""
+
+    __slots__ = ("previous", "received", "owner")
+
+    def __enter__(self):
+        self.previous, self.received, self.owner = None, [], False
+        if threading.current_thread() is threading.main_thread():
+            handler = signal.getsignal(signal.SIGINT)
+            outer = getattr(handler, "__self__", None)
+            if isinstance(outer, _SigintDeferred):
+                self.previous, self.received = outer.previous, outer.received
+            elif callable(handler):
+                self.previous, self.owner = handler, True
+                signal.signal(signal.SIGINT, self._record)
+        return self
+
+    def _record(self, signum, frame):
+        self.received.append(signum)
+
+    def run_pending(self):
+        """Runs the held-back handler for a SIGINT received (it may raise)."""
+        if self.received:
+            del self.received[:]
+            self.previous(signal.SIGINT, None)
+
+    def __exit__(self, *exc):
+        if self.owner:
+            signal.signal(signal.SIGINT, self.previous)
+            self.run_pending()  # raising here, the call's own exception is the context
+        return False
 
 
 def _dividing_cadence(every, wanted):
@@ -551,6 +614,9 @@ def _destroy(handle, lock):
 
 
 _BUSY = STATUS.get("LPI_ERR_BUSY", -13)
+_STOPPED = STATUS.get("LPI_STOPPED", 1)
+_NO_DEFERRAL = contextlib.nullcontext()
+_NAN = float("nan")
 _OTHER_THREAD = ("the system is in use by another thread (a system is used by one thread at a "
                  "time: share it under a lock of your own); nothing was changed")
 
@@ -660,8 +726,10 @@ class System:
 
     def _call(self, name, *args):
         """Calls lpi_<name>(handle, *args), raises on a failed (negative)
-        status and returns the status otherwise (LPI_OK, LPI_STOPPED)."""
-        with _Claim(self):
+        status and returns the status otherwise (LPI_OK, LPI_STOPPED). On a
+        system that holds Python callbacks, SIGINT's handler is held back
+        until the call has returned (_SigintDeferred)."""
+        with _Claim(self), (_SigintDeferred() if self._keep else _NO_DEFERRAL):
             del self._pending[:]
             status = getattr(lib, name)(self._h(), *args)
             if status < 0:
@@ -671,6 +739,26 @@ class System:
                     raise cause  # KeyboardInterrupt, SystemExit: not ours to wrap
                 _raise(status, _text(lib.lpi_last_error(self._handle)), cause)
             return status
+
+    def _give_callbacks(self, callbacks, name, *args):
+        """lpi_<name>(handle, *args), a call that hands C the ctypes callbacks
+        to hold. They are kept first: an exception as the call returns (a
+        KeyboardInterrupt) must not free what C now points to. C refusing
+        them (a failed status) is the only case that drops them again."""
+        self._keep.extend(callbacks)
+        try:
+            self._call(name, *args)
+        except LiePoissonError:
+            self._drop(callbacks)
+            raise
+
+    def _drop(self, callbacks):
+        """Removes these ctypes callbacks (by identity) from those kept."""
+        for fn in callbacks:
+            for i, kept in enumerate(self._keep):
+                if kept is fn:
+                    del self._keep[i]
+                    break
 
     def _query(self, function, *args):
         """function(handle, *args) for a function that returns no status (a
@@ -941,16 +1029,19 @@ class System:
         if observer is not None:
             if not callable(observer):
                 raise TypeError("observer must be callable, not %s" % type(observer).__name__)
-        started = time.perf_counter()
-        with _Claim(self):  # the observer set, the step and its removal, as one
-            sigint_every = self._observation_interval(nsteps)
+        # One claim for the observer set, the step, its removal and the
+        # timing kept: once steps are done, nothing may raise BusyError.
+        with _Claim(self):
+            key = self._step_cost_key()
+            sigint_every = self._observation_interval(nsteps, key)
+            started = time.perf_counter()
             if observer is None and not sigint_every:
                 self._call("lpi_step", dt, nsteps)
                 done = nsteps
             else:
-                done = self._step_observed(dt, nsteps, observer, every, sigint_every)
-        if done > 0:
-            self._seconds_per_step = (self._step_cost_key(), (time.perf_counter() - started) / done)
+                done = self._step_observed(dt, nsteps, observer, every, sigint_every, key, started)
+            if done > 0:
+                self._seconds_per_step = (key, (time.perf_counter() - started) / done)
         return done
 
     def integrate(self, t_eval: ArrayIn, dt: float, *, energy: bool = False,
@@ -1052,25 +1143,24 @@ class System:
             out_e = np.array(out_e) if energy else None
         return Trajectory(out_t, out_y, out_e, out_c)
 
-    def _observation_interval(self, nsteps):
+    def _observation_interval(self, nsteps, key):
         """Steps between looks for a SIGINT during step(), or 0 for none: the
         call is short, this is not the main thread (only it runs signal
-        handlers) or SIGINT has no Python handler."""
+        handlers) or SIGINT has no Python handler. key: _step_cost_key()."""
         if nsteps < 2 or threading.current_thread() is not threading.main_thread():
             return 0
         if not callable(signal.getsignal(signal.SIGINT)):
             return 0
-        key = self._step_cost_key()
         measured = self._seconds_per_step
         if measured is not None and measured[0] == key:
             seconds = measured[1]
         else:
-            # Not measured with this method yet: 1e-7 s per flow and state
-            # entry, more than any system takes, or 2e-5 s per flow where the
-            # flows call Python (an overestimate only makes the looks more
-            # frequent, each far cheaper than the steps between them).
+            # Not timed with this method yet: a guess of 1e-7 s per flow and
+            # state entry, or 2e-5 s per flow where the flows call Python,
+            # looked at _UNMEASURED_MARGIN times as often (each look costs a
+            # few microseconds, far less than the steps between them).
             flows = max(key[-1], 1)
-            seconds = flows * (2e-5 if self._keep else 1e-7 * max(self.dim, 1))
+            seconds = flows * (2e-5 if self._keep else 1e-7 * max(self.dim, 1)) * _UNMEASURED_MARGIN
         if seconds * nsteps < _OBSERVE_SECONDS:
             return 0
         return max(1, min(nsteps, int(_OBSERVE_SECONDS / max(seconds, 1e-12))))
@@ -1083,29 +1173,29 @@ class System:
             flows.value = 0
         return (self.method, self.split, self._threads, flows.value)
 
-    def _step_observed(self, dt, nsteps, observer, every, sigint_every):
+    def _step_observed(self, dt, nsteps, observer, every, sigint_every, key, started):
         """lpi_step under one library observer that serves both the caller's
         observer (at the multiples of every) and the SIGINT watch (about every
-        sigint_every steps; 0: none). Returns the steps done."""
+        sigint_every steps; 0: none). Returns the steps done. Called under the
+        claim; key and started time the first call of a method (step())."""
         if observer is None:
             cadence = sigint_every
         elif sigint_every:
             cadence = _dividing_cadence(every, sigint_every)
         else:
             cadence = every
-        # SIGINT only sets a flag during the call; the observer runs the
-        # handler that was in place, and stops the step if that raised.
-        received, raised, stopped_at = [], [], []
-        previous = signal.getsignal(signal.SIGINT) if sigint_every else None
-
-        def run_previous_handler():
-            del received[:]
-            previous(signal.SIGINT, None)
+        # SIGINT only sets a flag during the call whatever its length (the
+        # observer is Python); the observer runs the handler that was in
+        # place, and stops the step if that raised.
+        deferred = _SigintDeferred()
+        raised, stopped_at = [], []
 
         def observe(handle, step, t, user):
             try:
-                if received:
-                    run_previous_handler()
+                # Timed at each look, so that a run Ctrl-C ends still sets the
+                # cadence of the next (step() times a whole run again).
+                self._seconds_per_step = (key, (time.perf_counter() - started) / step)
+                deferred.run_pending()
                 if observer is not None and step % every == 0 and observer(self, step, t):
                     stopped_at.append(step)
                     return 1
@@ -1116,26 +1206,24 @@ class System:
             return 0
 
         c_observer = _lib.OBSERVER_FN(observe)
-        if sigint_every:
-            signal.signal(signal.SIGINT, lambda signum, frame: received.append(signum))
-        try:
+        self._keep.append(c_observer)  # before C holds it, until C has let it go
+        with deferred:
+            start_time = lib.lpi_time(self._handle)
             try:
                 self._call("lpi_set_observer", cadence, c_observer, None)
-                try:
-                    self._call("lpi_step", dt, nsteps)
-                finally:
-                    lib.lpi_set_observer(self._handle, 0, _lib.OBSERVER_FN(), None)  # NULL: removed
+                status = self._call("lpi_step", dt, nsteps)
             finally:
-                if sigint_every:
-                    signal.signal(signal.SIGINT, previous)
+                if lib.lpi_set_observer(self._handle, 0, _lib.OBSERVER_FN(), None) == 0:  # NULL: removed
+                    self._drop((c_observer,))
             if raised:
                 raise raised[0]
-        finally:
-            # A SIGINT after the last observation, or before the step failed
-            # (its exception then becomes the context of KeyboardInterrupt).
-            if received:
-                run_previous_handler()
-        return stopped_at[0] if stopped_at else nsteps
+        if stopped_at:
+            return stopped_at[0]
+        if status == _STOPPED:
+            # C stopped though no observer asked (an observer's result it
+            # could not trust): the steps done are those the time shows.
+            return int(round((lib.lpi_time(self._handle) - start_time) / dt))
+        return nsteps
 
     def energy(self) -> float:
         """The energy of the current state.
@@ -1231,11 +1319,20 @@ class System:
         Returns
         -------
         tuple
-            ``(_from_checkpoint, (bytes, threads))``; unpickling
+            ``(_from_checkpoint, (bytes, threads, planning))``; unpickling
             restores an independent system that continues the trajectory bit
-            for bit (observers are not kept).
+            for bit (observers are not kept). The settings a checkpoint does
+            not hold go with it: the thread count, and a sine-Euler system's
+            FFTW planning, planned again at that rigor (with ``"measure"`` or
+            ``"patient"``, the same plans only where the same FFTW wisdom is
+            known: in this process, or after `fftw_wisdom_import_string`).
         """
-        return (_from_checkpoint, (self.save_bytes(), self._threads))
+        with _Claim(self):  # the settings of the state saved
+            return (_from_checkpoint, (self.save_bytes(), self._threads, self._planning()))
+
+    def _planning(self):
+        """The FFTW planning rigor a copy must plan at; None where there is none."""
+        return None
 
     def __copy__(self) -> "System":
         """An independent system in the same state (through a checkpoint).
@@ -1347,13 +1444,17 @@ class Generic(System):
         c = (c_double * max(nnz, 1))(*[_real(r[3], "bracket coefficient") for r in rows])
         super().__init__("lpi_generic_create", _integer(dim, "dim", "size"), nnz, i, j, k, c)
 
-    def _guard(self, body):
+    def _guard(self, body, out_index):
         """Wraps a callback body: any exception is kept for the caller and
-        reported to the library as failure (never crosses into C)."""
+        reported to the library as failure (never crosses into C). The result
+        (args[out_index]) is NaN until the body writes it, so that a body left
+        early without a status C can trust fails there as non-finite rather
+        than leaving C's default."""
         pending = self._pending  # not self: the callbacks must not keep the system alive
 
         def run(*args):
             try:
+                args[out_index][0] = _NAN
                 body(*args)
                 return 0
             except BaseException as e:  # noqa: B902 - everything must stop here
@@ -1396,10 +1497,9 @@ class Generic(System):
         def energy_body(m, x, out, user):
             out[0] = _real(energy(_callback_view(x, m)), "energy's result")
 
-        g_fn = _lib.GRADIENT_FN(self._guard(grad_body))
-        e_fn = _lib.ENERGY_FN(self._guard(energy_body))
-        self._call("lpi_add_piece", n, idx, g_fn, e_fn, None)
-        self._keep.extend((g_fn, e_fn))
+        g_fn = _lib.GRADIENT_FN(self._guard(grad_body, 2))
+        e_fn = _lib.ENERGY_FN(self._guard(energy_body, 2))
+        self._give_callbacks((g_fn, e_fn), "lpi_add_piece", n, idx, g_fn, e_fn, None)
 
     def add_casimir(self, casimir: Callable[[Any], float]) -> None:
         """Declare a Casimir, which `casimirs` then reports.
@@ -1419,9 +1519,8 @@ class Generic(System):
         def body(dim, x, out, user):
             out[0] = _real(casimir(_callback_view(x, dim)), "Casimir's result")
 
-        fn = _lib.CASIMIR_FN(self._guard(body))
-        self._call("lpi_add_casimir", fn, None)
-        self._keep.append(fn)
+        fn = _lib.CASIMIR_FN(self._guard(body, 2))
+        self._give_callbacks((fn,), "lpi_add_casimir", fn, None)
 
     def __reduce__(self) -> Tuple[Any, ...]:
         """Refuses: a checkpoint cannot hold Python callables.
@@ -1489,10 +1588,9 @@ class Moments(Generic):
                 out[0] = _real(f(u), what)
             return body
 
-        h_fn = _lib.SCALAR_FN(self._guard(scalar_body(h, "h's result")))
-        dh_fn = _lib.SCALAR_FN(self._guard(scalar_body(dh, "dh's result")))
-        self._call("lpi_moments_add_product_piece", h_fn, dh_fn, None)
-        self._keep.extend((h_fn, dh_fn))
+        h_fn = _lib.SCALAR_FN(self._guard(scalar_body(h, "h's result"), 1))
+        dh_fn = _lib.SCALAR_FN(self._guard(scalar_body(dh, "dh's result"), 1))
+        self._give_callbacks((h_fn, dh_fn), "lpi_moments_add_product_piece", h_fn, dh_fn, None)
 
 
 class SineEuler(System):
@@ -1699,6 +1797,9 @@ class SineEuler(System):
     def planning(self, rigor: str) -> None:
         self.set_planning(rigor)
 
+    def _planning(self):
+        return self.planning
+
     def set_planning(self, rigor: str) -> None:
         """Plan the line transforms anew, now, at this FFTW rigor.
 
@@ -1821,12 +1922,15 @@ def load(path: PathLike) -> System:
     return System._adopt(handle)
 
 
-def _from_checkpoint(data: bytes, threads: int) -> System:
-    """A system from checkpoint bytes with the thread count of the system it
-    was saved from (the checkpoint restores everything else)."""
+def _from_checkpoint(data: bytes, threads: int, planning: Optional[str] = None) -> System:
+    """A system from checkpoint bytes with the thread count and FFTW planning
+    of the system it was saved from (the checkpoint restores everything else;
+    pickles without planning come from before it was kept)."""
     system = load_bytes(data)
     if threads != 1:
         system.threads = threads
+    if planning is not None and planning != system.planning:
+        system.planning = planning
     return system
 
 
