@@ -125,6 +125,18 @@ if [ "$have_se" = 1 ]; then
     mkdir -p "$out/p5/figure2.png" "$out/p6/vorticity_000000.png"
     PATH="$ok_path" expect 1 "figure2.png.*directory" report figure2 --out "$out/p5"
     PATH="$ok_path" expect 1 "vorticity_000000.png.*directory" run sine-euler --N 5 --steps 2 --out "$out/p6"
+    # The script and images are the data's: images of steps the new data has
+    # no snapshot of are removed, and vorticity.gp is written with the data
+    # (gnuplot reads it at a byte offset: a script or images of the last run
+    # drew garbage, or another run's snapshots), also without gnuplot.
+    PATH="$ok_path" "$lpi" run sine-euler --N 5 --steps 10 --every 1 --snapshots 5 --out "$out/p12" >/dev/null
+    PATH="$out/no-gnuplot" "$lpi" run sine-euler --N 7 --steps 9 --every 1 --snapshots 3 --out "$out/p12" >/dev/null
+    [ "$(cd "$out/p12" && echo vorticity_*)" = "vorticity_000000.png vorticity_000000.svg" ] ||
+        fail "images of another run's snapshots left: $(ls "$out/p12")"
+    grep -q "vorticity_000009.png" "$out/p12/vorticity.gp" ||
+        fail "vorticity.gp is not written for the data of the run"
+    PATH="$ok_path" "$lpi" run sine-euler --N 5 --steps 2 --snapshots 0 --out "$out/p12" >/dev/null
+    [ -z "$(ls "$out/p12" | grep -e vorticity)" ] || fail "a run without snapshots left images or vorticity.gp"
     # Without gnuplot the plots are skipped, and the run says so.
     rc=0; PATH="$out/no-gnuplot" "$lpi" run sine-euler --N 5 --steps 2 --out "$out/p7" >"$out/stdout" 2>&1 || rc=$?
     [ "$rc" -eq 0 ] && grep -q "gnuplot not found" "$out/stdout" ||

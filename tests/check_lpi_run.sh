@@ -170,7 +170,8 @@ refused "past the run's end" run rigid-body --dt 0.05 --steps 10 --resume "$out/
 refused "--method rk4.*leapfrog" run rigid-body --dt 0.05 --steps 30 --method rk4 --resume "$out/rigid.lpi" \
     --out "$out/bad"
 for method in leapfrog strang; do
-    "$lpi" run rigid-body --dt 0.05 --steps 22 --method $method --resume "$out/rigid.lpi" --out "$out/m" >/dev/null ||
+    rm -rf "$out/r2"; cp -r "$out/r" "$out/r2"
+    "$lpi" run rigid-body --dt 0.05 --steps 22 --method $method --resume "$out/rigid.lpi" --out "$out/r2" >/dev/null ||
         { echo "--resume with the checkpoint's method as --method $method: refused"; exit 1; }
 done
 # --resume reads the interrupted run's CSV back by the rules of the options:
@@ -194,6 +195,14 @@ if [ "$have_sine_euler" = 1 ]; then
     "$lpi" run sine-euler --N 5 --dt 0.05 --steps 4 --out "$out/s" --checkpoint "$out/se5.lpi" >/dev/null
     refused "N = 5, not 7" run sine-euler --N 7 --resume "$out/se5.lpi" --out "$out/bad"
     refused "another" run pendulum --resume "$out/se5.lpi" --out "$out/bad"
+    # Another scene's checkpoint of the same system (figure2 is sine-Euler N =
+    # 7): its rows are not this scene's, and it is refused.
+    "$lpi" run sine-euler --N 7 --dt 0.05 --steps 4 --out "$out/s7" --checkpoint "$out/se7.lpi" >/dev/null
+    refused "neither .*figure2.csv" run figure2 --steps 8 --resume "$out/se7.lpi" --out "$out/s7"
+    # --wisdom naming the --out directory: refused before either is written.
+    refused "is the --out directory" run sine-euler --N 5 --steps 3 --planning measure --wisdom "$out/wout" \
+        --out "$out/wout"
+    [ ! -e "$out/wout" ] || { echo "--wisdom naming --out: a file was written"; exit 1; }
     refused --planning run sine-euler --planning exhaustive --out "$out/bad"
     refused --planning run sine-euler --planning "" --out "$out/bad"
     refused --planning $rb --planning measure
@@ -293,14 +302,49 @@ set -- run rigid-body --every 10 --snapshots 1 --format npy --out "$out/dt"
 cp -r "$out/dt" "$out/dt-kept"
 refused "has no row at step 80" "$@" --steps 100 --dt 0.005 --resume "$out/dt.lpi"
 diff -r "$out/dt-kept" "$out/dt" >/dev/null || { echo "--resume with a smaller --dt: a file was rewritten"; exit 1; }
+# A CSV cut short whose rows are the data's: the data gives the rows.
 sed -i '4,$d' "$out/dt/rigid-body.csv"
-cp "$out/dt/rigid-body.csv" "$out/dt-cut.csv"
-refused "has no row at step 40" "$@" --steps 100 --resume "$out/dt.lpi"
-cmp -s "$out/dt-cut.csv" "$out/dt/rigid-body.csv" || { echo "--resume over a CSV cut short: rewritten"; exit 1; }
+"$lpi" "$@" --steps 40 --resume "$out/dt.lpi" >"$out.out" ||
+    { echo "--resume over a CSV cut short, the data whole: refused"; exit 1; }
+grep -q "ends before the checkpoint's step: its rows up to step 40 are taken from" "$out.out" &&
+    cmp -s "$out/dt-kept/rigid-body.csv" "$out/dt/rigid-body.csv" ||
+    { echo "--resume over a CSV cut short: not the rows of the data"; cat "$out.out"; exit 1; }
 rm "$out/dt/rigid-body.csv"
 refused "another --dt" "$@" --steps 100 --dt 0.005 --resume "$out/dt.lpi"
 diff -r "$out/dt-kept/rigid-body" "$out/dt/rigid-body" >/dev/null ||
     { echo "--resume with a smaller --dt over data alone: the data was rewritten"; exit 1; }
+# The CSV and the data hold two copies of the rows: resumed without the CSV,
+# the rows up to the checkpoint come from the data (they were dropped, the
+# energy error made relative to the checkpoint's step), and the run is the
+# uninterrupted one; without either, the resume is refused, nothing written.
+rm -rf "$out/two" "$out/two-ref"
+set -- run rigid-body --every 10 --out "$out/two"
+"$lpi" "$@" --steps 100 --checkpoint "$out/two.lpi" >/dev/null
+mv "$out/two/rigid-body.csv" "$out/two.csv"
+"$lpi" "$@" --steps 200 --resume "$out/two.lpi" >/dev/null
+"$lpi" run rigid-body --every 10 --steps 200 --out "$out/two-ref" >/dev/null
+cmp -s "$out/two-ref/rigid-body.csv" "$out/two/rigid-body.csv" ||
+    { echo "--resume without the CSV: not the uninterrupted run's rows"; exit 1; }
+refused "neither" run rigid-body --every 10 --steps 200 --out "$out/two-none" --resume "$out/two.lpi"
+[ -z "$(ls "$out/two-none")" ] || { echo "--resume without rows: files written"; exit 1; }
+# Another --dt (by 1e-11, within the old margin), --every or --snapshots than
+# the interrupted run's: refused (their rows were spliced, the library's
+# calls ending elsewhere, so not bit for bit), with or without the data.
+"$lpi" "$@" --steps 100 --checkpoint "$out/two.lpi" >/dev/null
+cp -r "$out/two" "$out/two-kept"
+refused "--dt" "$@" --steps 200 --dt 0.0100000000001 --resume "$out/two.lpi"
+refused "--every" "$@" --steps 200 --every 7 --resume "$out/two.lpi"
+refused "--snapshots" "$@" --steps 200 --snapshots 3 --resume "$out/two.lpi"
+diff -r "$out/two-kept" "$out/two" >/dev/null || { echo "a refused --resume rewrote a file"; exit 1; }
+# Every value of the CSV reads back as written (the energy error had 7 digits).
+awk -F, 'NR > 2 && length($4) < 12 { bad = 1 } END { exit bad }' "$out/two/rigid-body.csv" ||
+    { echo "the CSV's energy error is not written in full"; exit 1; }
+# A run certain to run out of memory keeping its rows is refused before its
+# first step (it failed after all of them, its work lost).
+rc=0; (ulimit -v 1000000; exec timeout 30 "$lpi" run rigid-body --steps 100000000 --every 1 --snapshots 0 \
+    --out "$out/huge-rows") >"$out.out" 2>"$out.err" || rc=$?
+[ "$rc" -eq 1 ] && grep -q "more than is available: write rows less often (--every)" "$out.err" &&
+    ! grep -q "steps 0 to" "$out.out" || { echo "rows past the memory: exit status $rc"; cat "$out.err"; exit 1; }
 # Data that is there but cannot be read back (cut short, not data at all,
 # or a header claiming more than the readers' cap of 2^28 values) is not
 # replaced by the resumed run, which dropped it with a note and lost the
@@ -437,6 +481,7 @@ if [ "$have_sine_euler" = 1 ] && command -v gnuplot >/dev/null 2>&1; then
     pid=$!
     waited=0
     while [ ! -f "$out/draw/vorticity.gp" ] && [ $waited -lt 600 ]; do sleep 0.05; waited=$((waited + 1)); done
+    sleep 0.2
     kill -TERM $pid
     rc=0; wait $pid || rc=$?
     [ "$rc" -eq 143 ] && grep -q "^interrupted .*images were drawn" "$out/draw.out" ||

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <memory>
 
+#include "common.hpp"
 #include "output.hpp"
 
 #if LPI_CLI_HAVE_HDF5
@@ -296,6 +297,56 @@ std::string read_npy(const std::string &path, Array &a, bool tail_allowed) {
     return unreadable.empty() ? why : unreadable;
 }
 
+std::string read_json_attributes(const std::string &path, std::vector<Attribute> &attributes,
+                                 std::vector<std::string> &found) {
+    found.clear();
+    std::string text;
+    const std::string unreadable = read_input(path, text);
+    if (!unreadable.empty()) return unreadable;
+    std::size_t at = 0;
+    auto skip_space = [&] {
+        while (at < text.size() && (text[at] == ' ' || text[at] == '\n' || text[at] == '\t' || text[at] == '\r')) ++at;
+    };
+    auto string_at = [&](std::string &out) {
+        out.clear();
+        if (at >= text.size() || text[at] != '"') return false;
+        for (++at; at < text.size() && text[at] != '"'; ++at) {
+            if (text[at] == '\\' && ++at == text.size()) return false;
+            out += text[at];
+        }
+        return at++ < text.size();
+    };
+    const std::string wrong = path + ": not the attributes lpi writes";
+    skip_space();
+    if (at >= text.size() || text[at++] != '{') return wrong;
+    for (skip_space(); at < text.size() && text[at] != '}';) {
+        std::string key, value;
+        if (!string_at(key)) return wrong;
+        skip_space();
+        if (at >= text.size() || text[at++] != ':') return wrong;
+        skip_space();
+        Attribute read;
+        read.is_text = at < text.size() && text[at] == '"';
+        if (read.is_text) {
+            if (!string_at(read.text)) return wrong;
+        } else {
+            const std::size_t end = text.find_first_of(",} \n", at);
+            if (end == std::string::npos || !decimal_problem(text.substr(at, end - at), read.number).empty())
+                return wrong;
+            at = end;
+        }
+        for (Attribute &attr : attributes)
+            if (attr.name == key && attr.is_text == read.is_text) {
+                if (read.is_text) attr.text = read.text;
+                else attr.number = read.number;
+                found.push_back(key);
+            }
+        skip_space();
+        if (at < text.size() && text[at] == ',') ++at, skip_space();
+    }
+    return at < text.size() ? "" : wrong;
+}
+
 bool is_hdf5_file(const std::string &path) {
     // The signature is at offset 0 or, after a user block, 512, 1024, ...
     // A file that is not regular (a FIFO) is none: its reader says so.
@@ -446,6 +497,37 @@ std::string write_hdf5(const std::string &path, const std::vector<Dataset> &data
     return failure_of([&] { lpi::write_file_atomically(path, image.data(), image.size()); });
 }
 
+std::string read_hdf5_attributes(const std::string &path, std::vector<Attribute> &attributes,
+                                 std::vector<std::string> &found) {
+    quiet_hdf5();
+    found.clear();
+    if (!is_hdf5_file(path)) return "not an HDF5 file";
+    Id file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+    if (!file.ok()) return "HDF5 cannot open it (damaged?)";
+    for (Attribute &attr : attributes) {
+        if (H5Aexists(file.get(), attr.name.c_str()) <= 0) continue;
+        Id a(H5Aopen(file.get(), attr.name.c_str(), H5P_DEFAULT), H5Aclose);
+        Id type(a.ok() ? H5Aget_type(a.get()) : -1, H5Tclose);
+        if (!type.ok()) return "HDF5 cannot read its attribute " + attr.name;
+        const bool text = H5Tget_class(type.get()) == H5T_STRING;
+        if (text != attr.is_text) continue;  // not the attribute lpi writes: as good as none
+        if (text) {
+            if (H5Tis_variable_str(type.get()) <= 0) continue;
+            Id memory(H5Tcopy(H5T_C_S1), H5Tclose);
+            char *value = nullptr;
+            if (!memory.ok() || H5Tset_size(memory.get(), H5T_VARIABLE) < 0 ||
+                H5Tset_cset(memory.get(), H5T_CSET_UTF8) < 0 || H5Aread(a.get(), memory.get(), &value) < 0)
+                return "HDF5 cannot read its attribute " + attr.name;
+            attr.text = value ? value : "";
+            H5free_memory(value);
+        } else if (H5Aread(a.get(), H5T_NATIVE_DOUBLE, &attr.number) < 0) {
+            return "HDF5 cannot read its attribute " + attr.name;
+        }
+        found.push_back(attr.name);
+    }
+    return file.close() ? "" : "HDF5 cannot close it";
+}
+
 std::string read_hdf5(const std::string &path, const std::string &name, Array &a, bool *found) {
     quiet_hdf5();
     *found = false;
@@ -499,6 +581,11 @@ bool have_hdf5() { return false; }
 
 std::string write_hdf5(const std::string &, const std::vector<Dataset> &, const std::vector<Attribute> &,
                        std::vector<std::uint64_t> *) {
+    return "this lpi is built without HDF5";
+}
+
+std::string read_hdf5_attributes(const std::string &, std::vector<Attribute> &, std::vector<std::string> &found) {
+    found.clear();
     return "this lpi is built without HDF5";
 }
 

@@ -73,6 +73,17 @@ bool have_hdf5();
 std::string write_hdf5(const std::string &path, const std::vector<Dataset> &datasets,
                        const std::vector<Attribute> &attributes, std::vector<std::uint64_t> *offsets);
 
+// The root attributes of an HDF5 file named in `attributes` (their names
+// given, is_text telling text from numbers): those found are read, and
+// `found` lists their names. Returns "" or the reason the file cannot be read.
+std::string read_hdf5_attributes(const std::string &path, std::vector<Attribute> &attributes,
+                                 std::vector<std::string> &found);
+
+// The same from attributes.json as lpi writes it (an object of strings and
+// numbers).
+std::string read_json_attributes(const std::string &path, std::vector<Attribute> &attributes,
+                                 std::vector<std::string> &found);
+
 // Whether the file exists and holds the HDF5 signature.
 bool is_hdf5_file(const std::string &path);
 

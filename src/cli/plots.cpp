@@ -229,6 +229,18 @@ std::string PlotScript::with_names(const std::vector<std::string> &images,
     return text;
 }
 
+std::string PlotScript::save_script() const {
+    std::vector<std::string> quoted(images_.size()), quoted_data(data_.size());
+    for (std::size_t i = 0; i < images_.size(); ++i)
+        if (!gnuplot_string(images_[i], quoted[i])) return "cannot name " + dir_ + "/" + images_[i];
+    for (std::size_t i = 0; i < data_.size(); ++i)
+        if (!gnuplot_string(data_[i].file, quoted_data[i])) return "cannot name " + dir_ + "/" + data_[i].file;
+    const std::vector<std::pair<std::string, std::string>> files = {{name_, with_names(quoted, quoted_data)}};
+    return failure_of([&] {
+        for (auto &file : prepared(dir_, files)) file->commit();
+    });
+}
+
 std::string PlotScript::draw() const {
     const std::string script = dir_ + "/" + name_;
     std::vector<std::string> quoted(images_.size()), quoted_data(data_.size());

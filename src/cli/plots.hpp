@@ -94,6 +94,9 @@ public:
     // Saves the script, runs gnuplot and puts the images in place: "" or why
     // not (naming the file).
     std::string draw() const;
+    // Writes the script alone, naming the images it draws (drawn later, or
+    // by hand): "" or why not.
+    std::string save_script() const;
 
 private:
     // The text with each image's and each data file's mark replaced by the

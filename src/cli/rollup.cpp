@@ -78,7 +78,7 @@ int run_rollup(const OwnRun &run) {
         if (!why.empty()) return cannot_write(why), 1;
     }
     std::string rows_text = "time,energy_error,enstrophy_error,high_third_fraction\n";
-    rows_text += format("0,0,0,%.6e\n", high_fraction(s0.enstrophy));
+    rows_text += format("0,0,0,%.17g\n", high_fraction(s0.enstrophy));
     std::vector<Spectra> kept = {s0};
     std::vector<double> kept_times = {0.0};
     // Both files, as far as the run got (also when it is interrupted or a step
@@ -89,7 +89,7 @@ int run_rollup(const OwnRun &run) {
         text += "\n";
         for (std::size_t k = 0; k < K; ++k) {
             text += std::to_string(k + 1);
-            for (const Spectra &s : kept) text += format(",%.6e", s.enstrophy[k]);
+            for (const Spectra &s : kept) text += format(",%.17g", s.enstrophy[k]);
             text += "\n";
         }
         const std::string why = write_output(csv, rows_text);
@@ -120,7 +120,7 @@ int run_rollup(const OwnRun &run) {
         const double fraction = high_fraction(s.enstrophy);
         peak = std::max(peak, fraction);
         if (2 * r > rows) late_sum += fraction, ++late_rows;
-        rows_text += format("%.6g,%.6e,%.6e,%.6e\n", lpi_time(sys), (energy_of(sys) - H0) / H0, (Z - Z0) / Z0,
+        rows_text += format("%.17g,%.17g,%.17g,%.17g\n", lpi_time(sys), (energy_of(sys) - H0) / H0, (Z - Z0) / Z0,
                             fraction);
         if (status == LPI_STOPPED) break;
         progress.update(done);

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "../core/headroom.hpp"
 #include "output.hpp"
 #include "plots.hpp"
 #include "processes.hpp"
@@ -86,33 +88,27 @@ std::string mismatch(lpi_system *fresh, const lpi_system *loaded) {
     return "";
 }
 
-// The step index a time is, to round-off: a resumed run's start.
+// The step index a time is, to the rounding of the time's sum (compensated
+// in the library: an ulp or so): a resumed run's start. A looser margin let
+// a --dt 1e-11 off the interrupted run's resume, splicing two step sizes.
 bool whole_steps(double time, double dt, int64_t &steps) {
     const double s = time / dt;
     if (!(s >= 0.0 && s < 0x1p62)) return false;
     steps = std::llround(s);
-    return std::fabs(s - static_cast<double>(steps)) <= 1e-9 * std::max(1.0, s);
+    return std::fabs(s - static_cast<double>(steps)) <= 8 * DBL_EPSILON * std::max(1.0, s);
 }
-
-// A row of the CSV lpi run writes.
-struct CsvRow {
-    int64_t step = 0;
-    double time = 0.0, energy = 0.0;
-    std::vector<double> casimirs;
-};
 
 // The CSV of an interrupted run, read back by the rules of the options
 // (common.hpp): the header lpi run writes for `casimir_count` Casimirs, then
 // rows of as many fields, each a complete finite decimal number, the steps
 // whole, increasing and below 2^62. Its rows up to and including that of
-// `step`; none when the file is absent or has no rows, or has rows but none
-// at `step` (then `lacks_step`); a last line cut short is left when it
-// follows the row at `step`. `why` says what is wrong with a file that is
-// there ("PATH:LINE: ..."): a value read wrongly would be the reference of
-// every energy error after it.
-std::vector<CsvRow> csv_up_to(const std::string &path, int64_t step, std::size_t casimir_count, bool &lacks_step,
-                              std::string &why) {
-    std::vector<CsvRow> rows;
+// `step` (whether it has one is the caller's to check); none when the file
+// is absent or has no rows; a last line cut short is left when it follows
+// the row at `step`. `why` says what is wrong with a file that is there
+// ("PATH:LINE: ..."): a value read wrongly would be the reference of every
+// energy error after it.
+std::vector<KeptRow> csv_up_to(const std::string &path, int64_t step, std::size_t casimir_count, std::string &why) {
+    std::vector<KeptRow> rows;
     struct stat st;
     if (stat(path.c_str(), &st) != 0 && errno == ENOENT) return rows;
     std::string text;
@@ -151,7 +147,7 @@ std::vector<CsvRow> csv_up_to(const std::string &path, int64_t step, std::size_t
         }
         if (fields.size() != 4 + casimir_count)
             return bad(format("%zu fields, not %zu", fields.size(), 4 + casimir_count));
-        CsvRow row;
+        KeptRow row;
         std::string wrong = whole_problem(fields[0], 0, kMaxSteps, row.step);
         if (!wrong.empty()) return bad("step: " + wrong);
         if (!rows.empty() && row.step <= rows.back().step) return bad("the steps do not increase");
@@ -168,9 +164,13 @@ std::vector<CsvRow> csv_up_to(const std::string &path, int64_t step, std::size_t
         rows.push_back(std::move(row));
     }
     if (line_number == 0) return bad("the file is empty");
-    lacks_step = !found && line_number > 1;
-    if (!found) rows.clear();
     return rows;
+}
+
+// The most characters the CSV of `rows` rows takes: a field of %.17g is at
+// most 24 (sign, 17 digits, point, exponent), and its comma; the header.
+std::size_t csv_text_size(std::size_t rows, std::size_t casimir_count) {
+    return 64 + 16 * casimir_count + rows * 25 * (4 + casimir_count);
 }
 
 // A path as the file system resolves it: the real path of the file, or of
@@ -216,6 +216,8 @@ std::string colliding_paths(const RunOptions &o, const std::vector<std::string> 
     if (!o.wisdom.empty()) written.push_back({"--wisdom", o.wisdom});
     for (std::size_t i = 0; i < written.size(); ++i) {
         const Named &w = written[i];
+        if (same_file(w.path, o.out_dir))
+            return "lpi run: " + w.option + " " + w.path + " is the --out directory: give it another name";
         for (const std::string &output : outputs)
             if (same_file(w.path, output))
                 return "lpi run: " + w.option + " " + w.path + " is " + output +
@@ -355,26 +357,6 @@ int run_command(int argc, char **argv) {
         }
     }
     if (o.threads != 1) check_option(lpi_set_threads(sys, o.threads), sys, "--threads");
-    // Wisdom first, so that any planning (the first step's or --planning's)
-    // uses it; measured plans are written back for the next run. A wisdom
-    // file that cannot be read or written fails as any file does (exit
-    // status 1); only a regular one is read (FFTW would wait on a FIFO).
-    // Each process reads the file, and rank 0 alone writes it: all agree.
-    if (!o.wisdom.empty()) {
-        struct stat wisdom_file;
-        const bool exists = stat(o.wisdom.c_str(), &wisdom_file) == 0;
-        const bool regular = exists && S_ISREG(wisdom_file.st_mode);
-        std::string why;
-        if (exists && !regular) why = "lpi run: --wisdom: " + o.wisdom + " is not a regular file";
-        if (const int agreed = agreed_failure(!why.empty(), why)) return agreed;
-        check_option(regular ? lpi_fftw_wisdom_import_file(o.wisdom.c_str()) : LPI_OK, nullptr, "--wisdom", 1);
-    }
-    if (!o.planning.empty()) {
-        check_option(lpi_sine_euler_set_planning(sys, o.planning.c_str()), sys, "--planning");
-        if (!o.wisdom.empty() && o.planning != "estimate")
-            check_option(writes_output() ? lpi_fftw_wisdom_export_file(o.wisdom.c_str()) : LPI_OK, nullptr,
-                         "--wisdom", 1);
-    }
     // The method in use: --method's, else a new system's default or the
     // checkpoint's (it holds the method).
     const std::string method = lpi_get_method(sys);
@@ -386,7 +368,7 @@ int run_command(int argc, char **argv) {
     int64_t start = 0;
     if (!whole_steps(lpi_time(sys), dt, start)) {
         std::fprintf(stderr, "lpi run: --resume: the checkpoint's time %.17g is not a whole number of "
-                             "steps of %g (resume with the run's --dt)\n", lpi_time(sys), dt);
+                             "steps of %.17g (resume with the run's --dt)\n", lpi_time(sys), dt);
         return 2;
     }
     int64_t end = o.steps;
@@ -430,6 +412,34 @@ int run_command(int argc, char **argv) {
                          static_cast<long long>(shots), data.snapshot_size(), snapshot_values);
             return 2;
         }
+        // All of it must fit besides, with what writing it takes: the rows
+        // (5 values and the Casimirs each) and the snapshots, and at the end
+        // the CSV as one text (csv_text_size) or the data's datasets copied
+        // and made into the file (.npy: its bytes; HDF5: the file in memory,
+        // its image and the integers converted). Short of that, a run ran
+        // out of memory only after all its steps, and lost them.
+        const double held = 8.0 * (static_cast<double>(rows) * (5.0 + row_width) +
+                                    static_cast<double>(shots) * (2.0 + static_cast<double>(data.snapshot_size()))),
+                     csv_text = static_cast<double>(csv_text_size(static_cast<std::size_t>(rows), data.casimir_count)),
+                     needed = held + std::max(csv_text, (o.format == "h5" ? 4.0 : 2.0) * held);
+        // Each process's own memory: all agree.
+        const bool fits = needed < 0x1p62 && lpi::address_space_available(static_cast<std::size_t>(needed));
+        const std::string no_room =
+            fits ? ""
+                 : format("lpi run: %lld rows and %lld snapshots of %zu values need about %.0f MiB of memory to keep "
+                          "and write, more than is available: write rows less often (--every) or fewer snapshots "
+                          "(--snapshots)",
+                          static_cast<long long>(rows), static_cast<long long>(shots), data.snapshot_size(),
+                          needed / 1048576.0);
+        if (const int agreed = agreed_failure(!fits, no_room)) return agreed;
+        // Taken at their full size now: grown by doubling, they held up to
+        // twice as much.
+        for (auto *v : {&data.step, &data.time, &data.energy, &data.energy_error, &data.casimir_drift})
+            v->reserve(static_cast<std::size_t>(rows) + 1);
+        data.casimirs.reserve((static_cast<std::size_t>(rows) + 1) * data.casimir_count);
+        data.snapshot_step.reserve(static_cast<std::size_t>(shots));
+        data.snapshot_time.reserve(static_cast<std::size_t>(shots));
+        data.snapshots.reserve(static_cast<std::size_t>(shots) * data.snapshot_size());
     }
 
     // Every process makes it (or finds it there), each on its own disk.
@@ -449,46 +459,153 @@ int run_command(int argc, char **argv) {
         no_output = output_problem(o.checkpoint);
         if (!no_output.empty()) no_output = "lpi run: --checkpoint: " + no_output;
     }
+    // And the wisdom measured planning writes, probed as the outputs are.
+    if (no_output.empty() && writes_output() && !o.wisdom.empty() && !o.planning.empty() && o.planning != "estimate") {
+        no_output = output_problem(o.wisdom);
+        if (!no_output.empty()) no_output = "lpi run: --wisdom: " + no_output;
+    }
     if (const int agreed = agreed_failure(!no_output.empty(), no_output)) return agreed;
-    std::vector<CsvRow> kept;
-    if (!o.resume.empty()) {
+    // Wisdom once every path is checked (a wisdom file was written before
+    // an --out that could not be made was refused), and before any planning (the first step's or --planning's)
+    // uses it; measured plans are written back for the next run. A wisdom
+    // file that cannot be read or written fails as any file does (exit
+    // status 1); only a regular one is read (FFTW would wait on a FIFO).
+    // Each process reads the file, and rank 0 alone writes it: all agree.
+    if (!o.wisdom.empty()) {
+        struct stat wisdom_file;
+        const bool exists = stat(o.wisdom.c_str(), &wisdom_file) == 0;
+        const bool regular = exists && S_ISREG(wisdom_file.st_mode);
         std::string why;
-        bool lacks_start = false;
-        kept = csv_up_to(csv, start, data.casimir_count, lacks_start, why);
-        int status = why.empty() ? 0 : 1;
-        if (status) why = "lpi run: --resume: " + why;
-        // Rows, but none at the checkpoint's step: a --dt smaller than the
-        // interrupted run's puts that step past them, and a CSV cut short or
-        // older than the checkpoint ends before it. Started anew there, the
-        // CSV lost every row it had.
-        if (!status && lacks_start)
-            status = 2, why = format("lpi run: --resume: %s has no row at step %lld, the checkpoint's (t = %.17g "
-                                     "with --dt %g): the CSV of a run with another --dt, or cut short or older "
-                                     "than the checkpoint; resume with the options of the interrupted run, or "
-                                     "move the CSV aside (or remove it) to start it anew at that step",
-                                     csv.c_str(), static_cast<long long>(start), lpi_time(sys), dt);
-        // The interrupted run's row at the checkpoint's step holds the
-        // checkpoint's time to the bit (both written at the end of the same
-        // call): another time there is another --dt (or --every), whose rows
-        // would be spliced to this run's.
-        const double time_then = kept.empty() ? lpi_time(sys) : kept.back().time;
-        if (!status && time_then != lpi_time(sys))
-            status = 2, why = format("lpi run: --resume: the checkpoint's time %.17g is step %lld of --dt %g, "
-                                     "but %s has t = %.17g at that step: resume with the options of the "
-                                     "interrupted run",
-                                     lpi_time(sys), static_cast<long long>(start), dt, csv.c_str(), time_then);
-        if (const int agreed = agreed_failure(status, why)) return agreed;
-        // And its energy (written from the same state, with 17 digits; the
-        // margin for a sum over another number of processes): another energy
-        // there is another run's CSV, whose rows would be spliced in.
+        if (exists && !regular) why = "lpi run: --wisdom: " + o.wisdom + " is not a regular file";
+        if (const int agreed = agreed_failure(!why.empty(), why)) return agreed;
+        check_option(regular ? lpi_fftw_wisdom_import_file(o.wisdom.c_str()) : LPI_OK, nullptr, "--wisdom", 1);
+    }
+    if (!o.planning.empty()) {
+        check_option(lpi_sine_euler_set_planning(sys, o.planning.c_str()), sys, "--planning");
+        if (!o.wisdom.empty() && o.planning != "estimate")
+            check_option(writes_output() ? lpi_fftw_wisdom_export_file(o.wisdom.c_str()) : LPI_OK, nullptr,
+                         "--wisdom", 1);
+    }
+    // The rows up to the checkpoint's step are the interrupted run's, kept:
+    // the CSV and the data hold two copies of them. Either copy that
+    // reaches the checkpoint (its row there has the checkpoint's time, to
+    // the bit, and energy) gives them, the other checked against it before
+    // it is rewritten; where neither does, the run is refused, every file
+    // left as it was (started anew at the checkpoint's step, the files lost
+    // their rows before it, and the energy error its reference at step 0).
+    std::vector<KeptRow> kept;
+    std::string not_kept;  // why the data's snapshots are not this run's
+    if (!o.resume.empty()) {
         const double H = energy_of(sys);  // collective
-        const double H_then = kept.empty() ? H : kept.back().energy;
-        if (std::fabs(H_then - H) > 1e-12 * std::max(std::fabs(H_then), std::fabs(H)))
-            status = 2, why = format("lpi run: --resume: %s has the energy %.17g at step %lld, but the checkpoint's "
-                                     "state has %.17g: the CSV is another run's (remove it to start it anew at "
-                                     "that step)",
-                                     csv.c_str(), H_then, static_cast<long long>(start), H);
-        if (const int agreed = agreed_failure(status, why)) return agreed;
+        std::string why;
+        std::vector<KeptRow> csv_rows = csv_up_to(csv, start, data.casimir_count, why);
+        if (!why.empty()) why = "lpi run: --resume: " + why;
+        DataRecord record;
+        if (why.empty() && read_data_record(o, start, data, record, why) == 0) why.clear();
+        if (const int agreed = agreed_failure(!why.empty(), why)) return agreed;
+        // "" where `rows`, read from `file`, reach the checkpoint, else why not.
+        auto short_of_checkpoint = [&](const std::vector<KeptRow> &rows, const std::string &file) -> std::string {
+            if (rows.empty() || rows.back().step != start)
+                return format("%s has no row at step %lld, the checkpoint's (t = %.17g with --dt %.17g): the "
+                              "file of a run with another --dt, or cut short or older than the checkpoint",
+                              file.c_str(), static_cast<long long>(start), lpi_time(sys), dt);
+            // Written at the end of the same call as the checkpoint: another
+            // time there is another --dt, whose rows would be spliced in.
+            const KeptRow &last = rows.back();
+            if (last.time != lpi_time(sys))
+                return format("the checkpoint's time %.17g is step %lld of --dt %.17g, but %s has t = %.17g at "
+                              "that step: resume with the options of the interrupted run",
+                              lpi_time(sys), static_cast<long long>(start), dt, file.c_str(), last.time);
+            // Its energy, written from the same state with 17 digits (the
+            // margin for a sum over another number of processes).
+            if (std::fabs(last.energy - H) > 1e-12 * std::max(std::fabs(last.energy), std::fabs(H)))
+                return format("%s has the energy %.17g at step %lld, but the checkpoint's state has %.17g: it is "
+                              "another run's",
+                              file.c_str(), last.energy, static_cast<long long>(start), H);
+            return "";
+        };
+        // The first step at which the two copies differ (-1: none): the
+        // rows at the steps both hold, to the bit.
+        auto first_difference = [&]() -> int64_t {
+            std::size_t j = 0;
+            for (const KeptRow &r : csv_rows) {
+                while (j < record.rows.size() && record.rows[j].step < r.step) ++j;
+                if (j == record.rows.size()) break;
+                if (record.rows[j].step == r.step &&
+                    (std::memcmp(&r.time, &record.rows[j].time, sizeof(double)) != 0 ||
+                     std::memcmp(&r.energy, &record.rows[j].energy, sizeof(double)) != 0))
+                    return r.step;
+            }
+            return -1;
+        };
+        const std::string csv_short = short_of_checkpoint(csv_rows, csv),
+                          data_short = short_of_checkpoint(record.rows, data_path(o));
+        const int64_t differs = first_difference();
+        const std::string another_run =
+            differs < 0 ? "" : format("its row at step %lld is not that of the CSV: it is the data of another run",
+                                      static_cast<long long>(differs));
+        bool data_is_this_runs = false;
+        if (csv_short.empty()) {
+            kept = std::move(csv_rows);
+            not_kept = !record.there ? "no data there" : another_run;
+            data_is_this_runs = not_kept.empty();
+        } else if (data_short.empty() && differs < 0) {
+            // The CSV moved away or cut short: its rows are the data's.
+            std::printf("%s %s: its rows up to step %lld are taken from %s\n", csv.c_str(),
+                        csv_rows.empty() ? "has no rows" : "ends before the checkpoint's step",
+                        static_cast<long long>(start), data_path(o).c_str());
+            kept = std::move(record.rows);
+            data_is_this_runs = true;
+        } else {
+            why = !csv_rows.empty()      ? csv_short
+                  : !record.rows.empty() ? data_short
+                                         : format("neither %s nor the data %s holds the interrupted run's rows",
+                                                  csv.c_str(), data_path(o).c_str());
+            if (!csv_short.empty() && !data_short.empty() && !csv_rows.empty() && !record.rows.empty())
+                why += "; and " + data_short;
+            else if (!csv_short.empty() && data_short.empty())
+                why += "; and " + another_run;
+            why = "lpi run: --resume: " + why +
+                  " (its rows up to the checkpoint's step, the reference of the energy errors, would be lost: "
+                  "resume with the options and --out of the interrupted run)";
+        }
+        if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
+        // The layout of the interrupted run: rows every --every steps,
+        // counted from step 0 (the steps of its library calls: another
+        // --every ends the calls elsewhere, and the flows merged at their
+        // seams round otherwise), and what its data records.
+        for (std::size_t r = 1; r < kept.size() && why.empty(); ++r) {
+            const int64_t expected = static_cast<int64_t>(r) * every;
+            if (kept[r].step == expected || (r + 1 == kept.size() && kept[r].step == start && start < expected &&
+                                             kept[r - 1].step == expected - every))
+                continue;
+            why = format("lpi run: --resume: --every %lld, but the interrupted run's row %zu is at step %lld: "
+                         "resume with its --every (another would end the library's calls elsewhere, and so not "
+                         "bit for bit where the uninterrupted run ends)",
+                         static_cast<long long>(every), r, static_cast<long long>(kept[r].step));
+        }
+        if (data_is_this_runs && why.empty()) {
+            const Attribute *recorded = record.attribute("scene");
+            if (recorded && recorded->text != o.scene)
+                why = format("lpi run: --resume: %s is a run of %s, not %s", data_path(o).c_str(),
+                             recorded->text.c_str(), o.scene.c_str());
+            recorded = record.attribute("dt");
+            if (why.empty() && recorded && std::memcmp(&recorded->number, &dt, sizeof dt) != 0)
+                why = format("lpi run: --resume: --dt %.17g, but %s records a run of --dt %.17g: resume with the "
+                             "options of the interrupted run",
+                             dt, data_path(o).c_str(), recorded->number);
+            recorded = record.attribute("every");
+            if (why.empty() && recorded && recorded->number != static_cast<double>(every))
+                why = format("lpi run: --resume: --every %lld, but %s records a run of --every %.17g: resume "
+                             "with the options of the interrupted run",
+                             static_cast<long long>(every), data_path(o).c_str(), recorded->number);
+            recorded = record.attribute("snapshot_every");
+            if (why.empty() && recorded && recorded->number != static_cast<double>(o.snapshot_every))
+                why = format("lpi run: --resume: --snapshots %lld, but %s records a run of --snapshots %.17g: "
+                             "resume with the options of the interrupted run",
+                             static_cast<long long>(o.snapshot_every), data_path(o).c_str(), recorded->number);
+        }
+        if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
     }
     // The references of the errors and drifts: the first row of the CSV
     // when resuming (step 0, or the step a new file started at; to the bit:
@@ -509,14 +626,11 @@ int run_command(int argc, char **argv) {
         data.casimir_drift.push_back(casimir_drift(spectrum, c, C0));
     };
     if (!kept.empty()) H0 = kept.front().energy, C0 = kept.front().casimirs;
-    for (const CsvRow &r : kept) add_row(r.step, r.time, r.energy, r.casimirs);
+    for (const KeptRow &r : kept) add_row(r.step, r.time, r.energy, r.casimirs);
     if (!o.resume.empty()) {
         std::string why;
-        const int status = keep_snapshots(o, start, lpi_time(sys), data, why);
+        const int status = keep_snapshots(o, start, not_kept, data, why);
         if (const int agreed = agreed_failure(status, why)) return agreed;
-        if (kept.empty())
-            std::printf("%s has no rows: a new file from step %lld, energy error relative to that step\n",
-                        csv.c_str(), static_cast<long long>(start));
         // Data that ends before the last snapshot this run's grid puts
         // before the start (a data file older than the checkpoint, a journal
         // left out) cannot be completed: say which snapshots it lacks.
@@ -543,15 +657,16 @@ int run_command(int argc, char **argv) {
     // its new rows, where rewriting every row at each checkpoint made a run
     // of n rows cost n^2 (20000 rows: 71 s against 0.1 s without checkpoints).
     auto csv_row = [&](std::size_t r) {
-        std::string text = format("%lld,%.17g,%.17g,%.6e", static_cast<long long>(data.step[r]), data.time[r],
+        std::string text = format("%lld,%.17g,%.17g,%.17g", static_cast<long long>(data.step[r]), data.time[r],
                                   data.energy[r], data.energy_error[r]);
         for (std::size_t i = 0; i < data.casimir_count; ++i)
             text += format(",%.17g", data.casimirs[r * data.casimir_count + i]);
         return text + "\n";
     };
     auto csv_text = [&] {
-        std::string text = absolute_error() ? "step,time,energy,absolute_energy_error"
-                                            : "step,time,energy,energy_error";
+        std::string text;
+        text.reserve(csv_text_size(data.step.size(), data.casimir_count));  // not twice that, grown by doubling
+        text += absolute_error() ? "step,time,energy,absolute_energy_error" : "step,time,energy,energy_error";
         for (std::size_t i = 0; i < data.casimir_count; ++i) text += format(",casimir_%zu", i);
         text += "\n";
         for (std::size_t r = 0; r < data.step.size(); ++r) text += csv_row(r);
@@ -569,6 +684,16 @@ int run_command(int argc, char **argv) {
         csv_rows = data.step.size();
         return "";
     };
+    // The scene's description where the run is the scene's own (its
+    // initial state, the default method and step, as figure2's names them);
+    // else what was run, the scene's text being wrong about it.
+    std::string description = it->description;
+    if (!o.init.empty() || method != "leapfrog" || dt != it->run_step) {
+        description = format("%s (a %s system", o.scene.c_str(), lpi_kind(sys));
+        if (data.vorticity) description += format(", N = %d", static_cast<int>(N));
+        description += format("), %s, dt = %g, initial state %s, H(0) = %.6g", method.c_str(), dt,
+                              o.init.empty() ? "the scene's" : ("the vorticity of " + o.init).c_str(), H0);
+    }
     const std::vector<Attribute> attributes = {
         {"scene", o.scene, 0.0, true},
         {"method", method, 0.0, true},
@@ -577,7 +702,7 @@ int run_command(int argc, char **argv) {
         {"snapshot_every", "", static_cast<double>(o.snapshot_every), false, true},
         {"N", "", static_cast<double>(N), false, true},
         {"lpi_version", lpi_version_string(), 0.0, true},
-        {"description", it->description, 0.0, true},
+        {"description", description, 0.0, true},
         {"energy_error", absolute_error() ? "absolute" : "relative", 0.0, true},
     };
     WrittenData written;  // what the last write of the data left
@@ -750,6 +875,11 @@ int run_command(int argc, char **argv) {
         if (!no_data.empty()) why += (why.empty() ? "" : "\n") + no_data;
         if (const int agreed = agreed_failure(!why.empty(), why)) return agreed;
     }
+    // The script and images drawn from the data, put in step with the data
+    // now written (rank 0's; whatever comes of drawing them after).
+    std::string unmatched;
+    if (writes_output() && data.vorticity) unmatched = match_drawings(o, data, written.bytes, dt, method);
+    if (!unmatched.empty()) std::fprintf(stderr, "lpi run: %s\n", unmatched.c_str());
     const double H = energy_of(sys);
     if (interrupted_by) {
         const int64_t stop = stopped_between_rows ? watch.stopped_at : done;
@@ -769,9 +899,10 @@ int run_command(int argc, char **argv) {
     // Rank 0 alone draws the snapshots: main agrees on the exit status.
     if (writes_output() && data.vorticity && !data.snapshot_step.empty()) {
         if (!have_gnuplot()) {
-            std::printf("gnuplot not found: no vorticity images (the snapshots are in %s)\n",
-                        data_path(o).c_str());
-            return 0;
+            std::printf("gnuplot not found: no vorticity images (the snapshots are in %s; %s/vorticity.gp "
+                        "draws them)\n",
+                        data_path(o).c_str(), o.out_dir.c_str());
+            return unmatched.empty() ? 0 : 1;
         }
         const std::string not_drawn = plot_vorticity(o, data, written.bytes, dt, method);
         if (interrupted_by) return interrupted_drawing(not_drawn.empty(), o.out_dir + "/vorticity.gp");
@@ -782,7 +913,7 @@ int run_command(int argc, char **argv) {
         std::printf("wrote %zu vorticity snapshots: %s/vorticity_*.png and .svg\n", data.snapshot_step.size(),
                     o.out_dir.c_str());
     }
-    return 0;
+    return unmatched.empty() ? 0 : 1;
 }
 
 }  // namespace lpi_cli

@@ -1,5 +1,6 @@
 #include "run_data.hpp"
 
+#include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -11,6 +12,7 @@
 #include <cstring>
 
 #include <memory>
+#include <set>
 
 #include "output.hpp"
 #include "plots.hpp"
@@ -344,85 +346,82 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
     return "";
 }
 
-// The snapshots of the interrupted run up to `start`, from its data; a note
-// on stdout (not an error) when there is no data or it is another run's.
-// Data that is there but cannot be read back is refused (status 1): the run
-// would replace it, and the snapshots in it would be lost.
-int keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunData &d, std::string &refusal) {
+namespace {
+
+// Data that is there but cannot be read back: refused (status 1), for the
+// run would replace it, and the rows and snapshots in it would be lost.
+int unreadable(const RunOptions &o, int64_t start, const std::string &why, std::string &refusal) {
+    refusal = format("lpi run: --resume: the data %s cannot be read back (%s): resumed, the run would "
+                     "replace it, and the rows and snapshots up to step %lld in it would be lost; move it aside "
+                     "(or remove it) to resume without them",
+                     data_path(o).c_str(), why.c_str(), static_cast<long long>(start));
+    return 1;
+}
+
+}  // namespace
+
+int read_data_record(const RunOptions &o, int64_t start, const RunData &d, DataRecord &record,
+                     std::string &refusal) {
     refusal.clear();
+    record = DataRecord();
     // No file of the data there (a run killed before it wrote any): nothing
     // to keep, and nothing that writing the data replaces.
-    bool there = false;
     for (const std::string &file : data_files(o, d)) {
         struct stat st;
-        if (stat(file.c_str(), &st) == 0 || errno != ENOENT) there = true;
+        if (stat(file.c_str(), &st) == 0 || errno != ENOENT) record.there = true;
     }
-    auto unreadable = [&](const std::string &why) {
-        refusal = format("lpi run: --resume: the data %s cannot be read back (%s): resumed, the run would "
-                         "replace it, and the snapshots up to step %lld in it would be lost; move it aside (or "
-                         "remove it) to resume without them",
-                         data_path(o).c_str(), why.c_str(), static_cast<long long>(start));
-        return 1;
-    };
-    auto read = [&](const char *name, bool snapshots, Array &a) {
-        return there ? read_data_array(o, name, snapshots, a) : std::string();
-    };
-    Array row_steps, row_times, row_energies;
-    std::string why;  // why the data's snapshots are not this run's
-    for (auto *array : {&row_steps, &row_times, &row_energies}) {
-        const char *name = array == &row_steps ? "step" : array == &row_times ? "time" : "energy";
-        const std::string wrong = read(name, false, *array);
-        if (!wrong.empty()) return unreadable(wrong);
+    if (!record.there) return 0;
+    Array steps, times, energies, casimirs;
+    for (auto *array : {&steps, &times, &energies, &casimirs}) {
+        const char *name = array == &steps ? "step" : array == &times ? "time" : array == &energies ? "energy"
+                                                                                                     : "casimirs";
+        const std::string wrong = read_data_array(o, name, false, *array);
+        if (!wrong.empty()) return unreadable(o, start, wrong, refusal);
     }
+    const std::size_t width = d.casimir_count;
+    if (casimirs.shape.size() != 2 || casimirs.shape[1] != width)
+        return unreadable(o, start, format("its casimirs are not rows of %zu values", width), refusal);
     // A set that a kill cut between two of its files' renames (write_data)
     // holds the arrays of two consecutive writes, of different lengths, which
     // agree on every row and snapshot up to the checkpoint's step: only those
     // are read, and each array must hold them.
-    for (std::size_t i = 0; i < row_steps.values.size() && why.empty(); ++i) {
-        const double step = row_steps.values[i];
-        if (step > static_cast<double>(start)) continue;
-        if (i >= row_times.values.size() || i >= row_energies.values.size())
-            return unreadable(format("its arrays time and energy end before its row at step %.17g", step));
-        if (d.step.empty()) {
-            // No CSV: the data's row at the checkpoint's step holds its
-            // time, as the CSV's does (run.cpp): another time there is
-            // another --dt. Data older than the checkpoint has no such row;
-            // its rows' times are still steps of the run's --dt (to the
-            // rounding of the time's sum), or its snapshots would be spliced
-            // to this run's at another step size.
-            const double time = row_times.values[i];
-            const bool exact = step == static_cast<double>(start);
-            const double expected = start > 0 ? start_time * (step / static_cast<double>(start)) : 0.0;
-            if (exact ? time != start_time : std::fabs(time - expected) > 1e-12 * std::fabs(expected)) {
-                refusal = format("lpi run: --resume: the checkpoint's time %.17g is step %lld of this run's --dt, "
-                                 "but %s has t = %.17g at step %.17g%s: resume with the options of the "
-                                 "interrupted run",
-                                 start_time, static_cast<long long>(start), data_path(o).c_str(), time, step,
-                                 exact ? "" : format(" (not %.17g: another --dt)", expected).c_str());
-                return 2;
-            }
-            continue;
-        }
-        // The CSV's rows (in d) are this run's: they hold the checkpoint's
-        // time. Data whose rows at the same steps differ is another run's,
-        // left there by a run killed before it wrote its own data.
-        const auto at = std::lower_bound(d.step.begin(), d.step.end(), step);
-        if (at == d.step.end() || *at != step) continue;
-        const std::size_t row = static_cast<std::size_t>(at - d.step.begin());
-        if (std::memcmp(&d.time[row], &row_times.values[i], sizeof(double)) != 0 ||
-            std::memcmp(&d.energy[row], &row_energies.values[i], sizeof(double)) != 0)
-            why = format("its row at step %lld is not that of the CSV: it is the data of another run",
-                         static_cast<long long>(step));
+    for (std::size_t i = 0; i < steps.values.size(); ++i) {
+        const double step = steps.values[i], before = i ? steps.values[i - 1] : -1.0;
+        if (!(step >= 0.0 && step < 0x1p62 && step == std::trunc(step) && step > before))
+            return unreadable(o, start, format("its row %zu has no whole step in order", i), refusal);
+        if (step > static_cast<double>(start)) break;
+        if (i >= times.values.size() || i >= energies.values.size() || (i + 1) * width > casimirs.values.size())
+            return unreadable(o, start, format("its arrays end before its row at step %.17g", step), refusal);
+        KeptRow row;
+        row.step = static_cast<int64_t>(step);
+        row.time = times.values[i];
+        row.energy = energies.values[i];
+        row.casimirs.assign(casimirs.values.begin() + static_cast<std::ptrdiff_t>(i * width),
+                            casimirs.values.begin() + static_cast<std::ptrdiff_t>((i + 1) * width));
+        record.rows.push_back(std::move(row));
     }
+    for (const char *name : {"scene", "method"}) record.attributes.push_back({name, "", 0.0, true});
+    for (const char *name : {"dt", "every", "snapshot_every"}) record.attributes.push_back({name, "", 0.0, false});
+    const std::string wrong =
+        o.format == "h5" ? read_hdf5_attributes(data_path(o), record.attributes, record.found)
+                         : read_json_attributes(data_path(o) + "/attributes.json", record.attributes, record.found);
+    if (!wrong.empty()) return unreadable(o, start, wrong, refusal);
+    return 0;
+}
+
+int keep_snapshots(const RunOptions &o, int64_t start, const std::string &not_kept, RunData &d,
+                   std::string &refusal) {
+    refusal.clear();
+    std::string why = not_kept;  // why the data's snapshots are not this run's
     Array steps, times, shots;
     for (auto *array : {&steps, &times, &shots}) {
+        if (!why.empty()) break;
         const char *name = array == &steps ? "snapshot_step" : array == &times ? "snapshot_time"
                            : d.vorticity                   ? "vorticity"
                                                            : "state";
-        const std::string wrong = read(name, true, *array);
-        if (!wrong.empty()) return unreadable(wrong);
+        const std::string wrong = read_data_array(o, name, true, *array);
+        if (!wrong.empty()) return unreadable(o, start, wrong, refusal);
     }
-    if (!there) why = "no data there";
     const std::size_t size = d.snapshot_size();
     std::size_t n = 0;  // the snapshots up to the checkpoint's step
     while (n < steps.values.size() && steps.values[n] <= static_cast<double>(start)) ++n;
@@ -435,7 +434,8 @@ int keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunDat
         const double step = steps.values[k], before = k ? steps.values[k - 1] : -1.0;
         if (!(step >= 0.0 && step < 0x1p62 && step == std::trunc(step) && step > before &&
               std::isfinite(times.values[k])))
-            return unreadable(format("its snapshot %zu has no whole step in order or no finite time", k));
+            return unreadable(o, start, format("its snapshot %zu has no whole step in order or no finite time", k),
+                              refusal);
     }
     if (!why.empty()) {
         std::printf("%s: %s; the data keeps the snapshots from step %lld on\n", data_path(o).c_str(),
@@ -445,7 +445,6 @@ int keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunDat
     d.snapshot_step.assign(steps.values.begin(), steps.values.begin() + static_cast<std::ptrdiff_t>(n));
     d.snapshot_time.assign(times.values.begin(), times.values.begin() + static_cast<std::ptrdiff_t>(n));
     d.snapshots.assign(shots.values.begin(), shots.values.begin() + static_cast<std::ptrdiff_t>(n * size));
-    d.keep_up_to(start);
     return 0;
 }
 
@@ -490,13 +489,18 @@ int initial_grid(const std::string &path, int *N, std::vector<double> &grid, std
 }
 
 
-// Draws every vorticity snapshot of the data as PNG and SVG with gnuplot,
-// which reads the doubles straight from the data file (nothing is copied
-// and nothing deleted).
-std::string plot_vorticity(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
-                           const std::string &method) {
+namespace {
+
+// The image of a snapshot at `step`, without its .png or .svg.
+std::string vorticity_image(int64_t step) {
+    return format("vorticity_%06lld", static_cast<long long>(step));
+}
+
+// The script that draws every vorticity snapshot of the data as PNG and SVG
+// with gnuplot, which reads the doubles straight from the data file.
+PlotScript vorticity_script(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
+                            const std::string &method) {
     const std::size_t N = d.snapshot_shape[0], shots = d.snapshot_step.size();
-    if (shots == 0 || bytes.offset == UINT64_MAX) return "no snapshot data to draw from in " + data_path(o);
     double scale = 0.0;  // one symmetric colour range for every snapshot
     for (double v : d.snapshots) scale = std::max(scale, std::fabs(v));
     if (!(scale > 0.0)) scale = 1.0;
@@ -516,7 +520,7 @@ std::string plot_vorticity(const RunOptions &o, const RunData &d, const Snapshot
     for (std::size_t k = 0; k < shots; ++k) {
         char name[64];
         const int64_t row = static_cast<int64_t>(d.snapshot_step[k]);
-        std::snprintf(name, sizeof name, "vorticity_%06lld", static_cast<long long>(row));
+        std::snprintf(name, sizeof name, "%s", vorticity_image(row).c_str());
         script += format("set title '%s, N = %zu, %s, dt = %g: t = %.6g (step %lld)' noenhanced\n", o.scene.c_str(),
                          N, method.c_str(), dt, d.snapshot_time[k], static_cast<long long>(row));
         for (const auto &terminal : terminals) {
@@ -528,7 +532,42 @@ std::string plot_vorticity(const RunOptions &o, const RunData &d, const Snapshot
         }
     }
     script += "set output\n";
-    return script.draw();
+    return script;
+}
+
+}  // namespace
+
+std::string match_drawings(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
+                           const std::string &method) {
+    std::set<std::string> drawn;
+    for (double step : d.snapshot_step)
+        for (const char *suffix : {".png", ".svg"}) drawn.insert(vorticity_image(static_cast<int64_t>(step)) + suffix);
+    std::string why;
+    if (DIR *dir = opendir(o.out_dir.c_str())) {
+        while (const dirent *entry = readdir(dir)) {
+            const std::string name = entry->d_name;
+            const std::string suffix = name.size() > 4 ? name.substr(name.size() - 4) : "";
+            const bool image = name.rfind("vorticity_", 0) == 0 && (suffix == ".png" || suffix == ".svg") &&
+                               name.find_first_not_of("0123456789", 10) == name.size() - 4;
+            if (image && !drawn.count(name) && unlink((o.out_dir + "/" + name).c_str()) != 0 && why.empty())
+                why = "cannot remove " + o.out_dir + "/" + name + ": " + std::strerror(errno);
+        }
+        closedir(dir);
+    }
+    const std::string script = o.out_dir + "/vorticity.gp";
+    if (d.snapshot_step.empty() || bytes.offset == UINT64_MAX) {
+        if (unlink(script.c_str()) != 0 && errno != ENOENT && why.empty())
+            why = "cannot remove " + script + ": " + std::strerror(errno);
+        return why;
+    }
+    const std::string not_saved = vorticity_script(o, d, bytes, dt, method).save_script();
+    return why.empty() ? not_saved : why;
+}
+
+std::string plot_vorticity(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
+                           const std::string &method) {
+    if (d.snapshot_step.empty() || bytes.offset == UINT64_MAX) return "no snapshot data to draw from in " + data_path(o);
+    return vorticity_script(o, d, bytes, dt, method).draw();
 }
 
 }  // namespace lpi_cli

@@ -98,20 +98,59 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
 // The folder of an HDF5 file's journal: DIR/SCENE.h5-pending.
 std::string journal_path(const RunOptions &o);
 
-// The snapshots of the interrupted run up to `start`, from its data; a note
-// on stdout (not an error) when there is no data or its rows are not the
-// CSV's kept in `d` (another run's data). Returns 0, or the exit status with
-// the message in `refusal`: 1 when data is there but cannot be read back
-// (damaged, or over the readers' cap of 2^28 values per array), for the run
-// would replace it and lose its snapshots; 2, without a CSV, when the data
-// is not that of this run (its time at `start` is not `start_time`).
-int keep_snapshots(const RunOptions &o, int64_t start, double start_time, RunData &d, std::string &refusal);
+// A row of the CSV and of the data (rows x Casimirs there): what a resumed
+// run keeps of the interrupted one.
+struct KeptRow {
+    int64_t step = 0;
+    double time = 0.0, energy = 0.0;
+    std::vector<double> casimirs;
+};
+
+// The interrupted run's data as a resumed run reads it back: whether any
+// file of it is there, its rows up to the checkpoint's step, and the
+// attributes it records (scene, method, dt, every, snapshot_every), those
+// found listed in `found`.
+struct DataRecord {
+    bool there = false;
+    std::vector<KeptRow> rows;
+    std::vector<Attribute> attributes;
+    std::vector<std::string> found;
+    const Attribute *attribute(const std::string &name) const {
+        for (const std::string &f : found)
+            if (f == name)
+                for (const Attribute &a : attributes)
+                    if (a.name == name) return &a;
+        return nullptr;
+    }
+};
+
+// Reads the rows up to `start` and the attributes of the interrupted run's
+// data (shaped as `d`). Returns 0, or 1 with the message in `refusal` when
+// data is there but cannot be read back (damaged, or over the readers' cap
+// of 2^28 values per array): the run would replace it, and lose it.
+int read_data_record(const RunOptions &o, int64_t start, const RunData &d, DataRecord &record,
+                     std::string &refusal);
+
+// The snapshots of the interrupted run up to `start`, from its data, where
+// its rows are this run's (`not_kept` empty); otherwise a note on stdout
+// saying why not (`not_kept`: no data, another run's). Returns 0, or 1 with
+// the message in `refusal` when the snapshots cannot be read back.
+int keep_snapshots(const RunOptions &o, int64_t start, const std::string &not_kept, RunData &d,
+                   std::string &refusal);
 
 // The initial grid of --init into `grid`, checked against the system's N:
 // 0, or the exit status with the message in `why` (each process reads the
 // file, and lpi run agrees on the outcome): 1 when the file cannot be read,
 // 2 when it holds no N x N grid for this run.
 int initial_grid(const std::string &path, int *N, std::vector<double> &grid, std::string &why);
+
+// Puts what is drawn from the data in step with it once it is written: the
+// images of steps it holds no snapshot of are removed, and DIR/vorticity.gp
+// is written for it (removed where it holds no snapshot): gnuplot reads the
+// snapshots at their byte offset, and a script or images left by an earlier
+// run drew another run's data. "" or why not.
+std::string match_drawings(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
+                           const std::string &method);
 
 // Draws every vorticity snapshot of the data as PNG and SVG with gnuplot,
 // which reads the doubles straight from the data file (nothing is copied

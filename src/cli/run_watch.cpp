@@ -1,5 +1,7 @@
 #include "run_watch.hpp"
 
+#include <unistd.h>
+
 #include "processes.hpp"
 
 namespace lpi_cli {
@@ -25,8 +27,10 @@ int interrupted_drawing(bool drawn, const std::string &script) {
     if (drawn)
         std::printf("interrupted after the images were drawn\n");
     else
-        std::printf("interrupted while the images were drawn: none was replaced (%s draws them)\n",
-                    script.c_str());
+        // The script is written for the data before drawing (lpi run), or
+        // reads it by its columns (rollup): where it is there, it draws them.
+        std::printf("interrupted while the images were drawn: none was replaced%s\n",
+                    access(script.c_str(), F_OK) == 0 ? (" (" + script + " draws them)").c_str() : "");
     return 128 + interrupted_by;
 }
 
