@@ -476,12 +476,18 @@ esac
 cmp -s "$out/moments.csv" "$out/ck/moments.csv" || fail "a refused --checkpoint changed moments.csv"
 cmp -s "$out/rigid.csv" "$out/ck/rigid-body.csv" || fail "a failed --checkpoint changed rigid-body.csv"
 # --resume with another --dt: the checkpoint's time at step 10 of 0.1 is
-# step 20 of 0.05 (as the CSV says, or the data without the CSV).
+# step 20 of 0.05 (as the CSV says, or the data, which records the --dt).
 "$lpi" run rigid-body --dt 0.05 --steps 20 --out "$out/dt" --checkpoint "$out/dt.lpi" >/dev/null
+expect 2 "--dt 0.1, but the interrupted run's is 0.05" run rigid-body --dt 0.1 --steps 30 --out "$out/dt" \
+    --resume "$out/dt.lpi"
+for data in "$out/dt/rigid-body.h5" "$out/dt/rigid-body"; do
+    [ ! -e "$data" ] || { mv "$data" "$out/dt-data"; kept_data=$data; }
+done
 expect 2 "resume with the options of the interrupted run" run rigid-body --dt 0.1 --steps 30 --out "$out/dt" \
     --resume "$out/dt.lpi"
+mv "$out/dt-data" "$kept_data"
 rm "$out/dt/rigid-body.csv"
-expect 2 "resume with the options of the interrupted run" run rigid-body --dt 0.1 --steps 30 --out "$out/dt" \
+expect 2 "--dt 0.1, but the interrupted run's is 0.05" run rigid-body --dt 0.1 --steps 30 --out "$out/dt" \
     --resume "$out/dt.lpi"
 # --init: a FIFO is refused, not waited on.
 rm -f "$out/fifo.npy"

@@ -196,9 +196,18 @@ if [ "$have_sine_euler" = 1 ]; then
     refused "N = 5, not 7" run sine-euler --N 7 --resume "$out/se5.lpi" --out "$out/bad"
     refused "another" run pendulum --resume "$out/se5.lpi" --out "$out/bad"
     # Another scene's checkpoint of the same system (figure2 is sine-Euler N =
-    # 7): its rows are not this scene's, and it is refused.
+    # 7) where no file of figure2 is there: new files of figure2 start at the
+    # checkpoint's step, the other scene's files left as they were.
     "$lpi" run sine-euler --N 7 --dt 0.05 --steps 4 --out "$out/s7" --checkpoint "$out/se7.lpi" >/dev/null
-    refused "neither .*figure2.csv" run figure2 --steps 8 --resume "$out/se7.lpi" --out "$out/s7"
+    rm -rf "$out/s7-kept"; cp -r "$out/s7" "$out/s7-kept"
+    "$lpi" run figure2 --steps 8 --resume "$out/se7.lpi" --out "$out/s7" >"$out.out" 2>"$out.err" ||
+        { echo "--resume of another scene's checkpoint, no file of its own there: refused"; cat "$out.err"; exit 1; }
+    grep -q "new files from step 4" "$out.out" && [ "$(sed -n '2s/,.*//p' "$out/s7/figure2.csv")" = 4 ] ||
+        { echo "--resume of another scene's checkpoint: no new files from its step"; cat "$out.out"; exit 1; }
+    for file in sine-euler.csv sine-euler.h5 sine-euler; do
+        [ ! -e "$out/s7-kept/$file" ] || diff -r "$out/s7-kept/$file" "$out/s7/$file" >/dev/null ||
+            { echo "--resume of another scene's checkpoint: $file rewritten"; exit 1; }
+    done
     # --wisdom naming the --out directory: refused before either is written.
     refused "is the --out directory" run sine-euler --N 5 --steps 3 --planning measure --wisdom "$out/wout" \
         --out "$out/wout"
@@ -293,14 +302,18 @@ refused "another run" run rigid-body --inertia 2,3,5 --steps 20 --every 5 --out 
 # A CSV with rows but none at the checkpoint's step: a --dt smaller than the
 # interrupted run's puts that step past its rows, and a CSV cut short ends
 # before it. It was started anew there, every row in it lost (exit 0, a
-# note); now refused (2), every file left as it was. Without the CSV, data
-# at another --dt (its rows' times not this --dt's steps) is refused too:
-# its snapshots were kept, spliced to this run's at half the step size.
+# note); now refused (2), every file left as it was. With the data, which
+# records the run's --dt, the refusal names both. Without the CSV, data at
+# another --dt (its rows' times not this --dt's steps) is refused too: its
+# snapshots were kept, spliced to this run's at half the step size.
 rm -rf "$out/dt" "$out/dt-kept"
 set -- run rigid-body --every 10 --snapshots 1 --format npy --out "$out/dt"
 "$lpi" "$@" --steps 40 --checkpoint "$out/dt.lpi" >/dev/null
 cp -r "$out/dt" "$out/dt-kept"
+refused "--dt 0.005, but the interrupted run's is 0.01" "$@" --steps 100 --dt 0.005 --resume "$out/dt.lpi"
+mv "$out/dt/rigid-body" "$out/dt-data"
 refused "has no row at step 80" "$@" --steps 100 --dt 0.005 --resume "$out/dt.lpi"
+mv "$out/dt-data" "$out/dt/rigid-body"
 diff -r "$out/dt-kept" "$out/dt" >/dev/null || { echo "--resume with a smaller --dt: a file was rewritten"; exit 1; }
 # A CSV cut short whose rows are the data's: the data gives the rows.
 sed -i '4,$d' "$out/dt/rigid-body.csv"
@@ -316,7 +329,7 @@ diff -r "$out/dt-kept/rigid-body" "$out/dt/rigid-body" >/dev/null ||
 # The CSV and the data hold two copies of the rows: resumed without the CSV,
 # the rows up to the checkpoint come from the data (they were dropped, the
 # energy error made relative to the checkpoint's step), and the run is the
-# uninterrupted one; without either, the resume is refused, nothing written.
+# uninterrupted one.
 rm -rf "$out/two" "$out/two-ref"
 set -- run rigid-body --every 10 --out "$out/two"
 "$lpi" "$@" --steps 100 --checkpoint "$out/two.lpi" >/dev/null
@@ -325,8 +338,25 @@ mv "$out/two/rigid-body.csv" "$out/two.csv"
 "$lpi" run rigid-body --every 10 --steps 200 --out "$out/two-ref" >/dev/null
 cmp -s "$out/two-ref/rigid-body.csv" "$out/two/rigid-body.csv" ||
     { echo "--resume without the CSV: not the uninterrupted run's rows"; exit 1; }
-refused "neither" run rigid-body --every 10 --steps 200 --out "$out/two-none" --resume "$out/two.lpi"
-[ -z "$(ls "$out/two-none")" ] || { echo "--resume without rows: files written"; exit 1; }
+# Into an --out without a file of the run (a new or empty directory), new
+# files start at the checkpoint's step, the energy error relative to it (a
+# note says so): the uninterrupted run's rows from that step on.
+rm -rf "$out/two-none"; mkdir "$out/two-none"
+"$lpi" run rigid-body --every 10 --steps 200 --out "$out/two-none" --resume "$out/two.lpi" >"$out.out" 2>"$out.err" ||
+    { echo "--resume into an empty --out: refused"; cat "$out.err"; exit 1; }
+grep -q "new files from step 100, the energy error relative to that step" "$out.out" ||
+    { echo "--resume into an empty --out: no note"; cat "$out.out"; exit 1; }
+awk -F, 'NR > 1 && $1 >= 100' "$out/two-ref/rigid-body.csv" | cut -d, -f1-3,5- > "$out/two-tail"
+tail -n +2 "$out/two-none/rigid-body.csv" | cut -d, -f1-3,5- | cmp -s - "$out/two-tail" &&
+    [ "$(sed -n '2p' "$out/two-none/rigid-body.csv" | cut -d, -f1,4)" = 100,0 ] ||
+    { echo "--resume into an empty --out: not the rows from step 100"; head -3 "$out/two-none/rigid-body.csv"; exit 1; }
+# A file of the run there, but neither copy reaching the checkpoint (a CSV
+# cut before it, no data): refused, the file left as it was.
+rm -rf "$out/two-cut"; mkdir "$out/two-cut"
+head -4 "$out/two.csv" > "$out/two-cut/rigid-body.csv"; cp "$out/two-cut/rigid-body.csv" "$out/two-cut.csv"
+refused "has no row at step 100" run rigid-body --every 10 --steps 200 --out "$out/two-cut" --resume "$out/two.lpi"
+cmp -s "$out/two-cut.csv" "$out/two-cut/rigid-body.csv" && [ "$(ls "$out/two-cut")" = rigid-body.csv ] ||
+    { echo "--resume over a CSV cut short, no data: a file was written"; exit 1; }
 # Another --dt (by 1e-11, within the old margin), --every or --snapshots than
 # the interrupted run's: refused (their rows were spliced, the library's
 # calls ending elsewhere, so not bit for bit), with or without the data.
@@ -336,6 +366,41 @@ refused "--dt" "$@" --steps 200 --dt 0.0100000000001 --resume "$out/two.lpi"
 refused "--every" "$@" --steps 200 --every 7 --resume "$out/two.lpi"
 refused "--snapshots" "$@" --steps 200 --snapshots 3 --resume "$out/two.lpi"
 diff -r "$out/two-kept" "$out/two" >/dev/null || { echo "a refused --resume rewrote a file"; exit 1; }
+# Extended with a larger --steps and no --every (whose default, about 100
+# rows, is then another) nor --snapshots: the interrupted run's are taken,
+# and the run ends bit for bit where the uninterrupted run of the larger
+# --steps with them ends, CSV and data; without the data, the CSV's rows
+# give --every. Without --dt, a run of another step than the scene's takes
+# the data's (it was refused as another --dt).
+rm -rf "$out/ext" "$out/ext-ref" "$out/ext-csv"
+"$lpi" run rigid-body --steps 1000 --snapshots 5 --format npy --out "$out/ext" --checkpoint "$out/ext.lpi" >/dev/null
+cp -r "$out/ext" "$out/ext-csv"; rm -r "$out/ext-csv/rigid-body"
+"$lpi" run rigid-body --steps 2000 --format npy --out "$out/ext" --resume "$out/ext.lpi" >"$out.out" 2>"$out.err" ||
+    { echo "--resume with a larger --steps, no --every: refused"; cat "$out.err"; exit 1; }
+"$lpi" run rigid-body --steps 2000 --every 10 --snapshots 5 --format npy --out "$out/ext-ref" >/dev/null
+cmp -s "$out/ext-ref/rigid-body.csv" "$out/ext/rigid-body.csv" &&
+    diff -r "$out/ext-ref/rigid-body" "$out/ext/rigid-body" >/dev/null ||
+    { echo "--resume with a larger --steps, no --every: not the uninterrupted run's CSV and data"; exit 1; }
+"$lpi" run rigid-body --steps 2000 --format npy --out "$out/ext-csv" --resume "$out/ext.lpi" >/dev/null 2>"$out.err" ||
+    { echo "--resume with a larger --steps, no --every, no data: refused"; cat "$out.err"; exit 1; }
+cmp -s "$out/ext-ref/rigid-body.csv" "$out/ext-csv/rigid-body.csv" ||
+    { echo "--resume with a larger --steps, no --every, no data: not the uninterrupted run's CSV"; exit 1; }
+refused "--every 20, but the interrupted run's is 10" run rigid-body --steps 2000 --every 20 --format npy \
+    --out "$out/ext" --resume "$out/ext.lpi"
+refused "--snapshots 10, but the interrupted run's is 5" run rigid-body --steps 2000 --snapshots 10 --format npy \
+    --out "$out/ext" --resume "$out/ext.lpi"
+rm -rf "$out/ext" "$out/ext-ref"
+"$lpi" run rigid-body --dt 0.02 --steps 100 --every 10 --format npy --out "$out/ext" --checkpoint "$out/ext.lpi" \
+    >/dev/null
+cp "$out/ext/rigid-body.csv" "$out/ext.csv"
+"$lpi" run rigid-body --steps 200 --format npy --out "$out/ext" --resume "$out/ext.lpi" >"$out.out" 2>"$out.err" ||
+    { echo "--resume of a run of another --dt, no --dt: refused"; cat "$out.err"; exit 1; }
+"$lpi" run rigid-body --dt 0.02 --steps 200 --every 10 --format npy --out "$out/ext-ref" >/dev/null
+cmp -s "$out/ext-ref/rigid-body.csv" "$out/ext/rigid-body.csv" &&
+    diff -r "$out/ext-ref/rigid-body" "$out/ext/rigid-body" >/dev/null ||
+    { echo "--resume of a run of another --dt, no --dt: not the uninterrupted run's"; exit 1; }
+rm -r "$out/ext/rigid-body"; cp "$out/ext.csv" "$out/ext/rigid-body.csv"
+refused "another --dt" run rigid-body --steps 200 --format npy --out "$out/ext" --resume "$out/ext.lpi"
 # Every value of the CSV reads back as written (the energy error had 7 digits).
 awk -F, 'NR > 2 && length($4) < 12 { bad = 1 } END { exit bad }' "$out/two/rigid-body.csv" ||
     { echo "the CSV's energy error is not written in full"; exit 1; }

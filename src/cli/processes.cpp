@@ -105,6 +105,14 @@ int agreed_failure(int status, const std::string &why) {
     return status;
 }
 
+bool same_everywhere(int64_t value) {
+    if (world_size == 1) return true;
+    long long least = static_cast<long long>(value), most = least;
+    MPI_Allreduce(MPI_IN_PLACE, &least, 1, MPI_LONG_LONG, MPI_MIN, MPI_COMM_WORLD);
+    MPI_Allreduce(MPI_IN_PLACE, &most, 1, MPI_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
+    return least == most;
+}
+
 #else
 
 void start_processes(int *, char ***) {}
@@ -119,6 +127,8 @@ int agreed_failure(int status, const std::string &why) {
     if (status != 0 && !why.empty()) std::fprintf(stderr, "%s\n", why.c_str());
     return status;
 }
+
+bool same_everywhere(int64_t) { return true; }
 
 #endif
 

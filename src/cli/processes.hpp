@@ -40,5 +40,7 @@ void synchronize();
 // every process succeeded, else on every process the status of the lowest
 // failing rank, whose message rank 0 prints on standard error.
 int agreed_failure(int status, const std::string &why = "");
+// Whether every process has the same `value` (collective).
+bool same_everywhere(int64_t value);
 
 }  // namespace lpi_cli

@@ -98,6 +98,14 @@ bool whole_steps(double time, double dt, int64_t &steps) {
     return std::fabs(s - static_cast<double>(steps)) <= 8 * DBL_EPSILON * std::max(1.0, s);
 }
 
+// `v` in the fewest digits that read back as `v`.
+std::string exact(double v) {
+    for (int digits = 1;; ++digits) {
+        const std::string text = format("%.*g", digits, v);
+        if (digits >= 17 || std::strtod(text.c_str(), nullptr) == v) return text;
+    }
+}
+
 // The CSV of an interrupted run, read back by the rules of the options
 // (common.hpp): the header lpi run writes for `casimir_count` Casimirs, then
 // rows of as many fields, each a complete finite decimal number, the steps
@@ -289,7 +297,7 @@ int run_command(int argc, char **argv) {
                      why_not.c_str());
         return 1;
     }
-    const double dt = o.dt > 0.0 ? o.dt : it->run_step;
+    double dt = o.dt > 0.0 ? o.dt : it->run_step;  // without --dt, resumed: maybe the interrupted run's
     Handle h = it->create();
     if (!init_grid.empty()) {
         int32_t N = 0;  // a scene that takes --init is sine-Euler (Scene::options)
@@ -361,6 +369,52 @@ int run_command(int argc, char **argv) {
     // checkpoint's (it holds the method).
     const std::string method = lpi_get_method(sys);
 
+    // The interrupted run's data, read back before this run's layout is
+    // settled: it records the --dt, --every and --snapshots of that run,
+    // which a resume takes where they are not given (and refuses where they
+    // are given otherwise). A run extended with a larger --steps has another
+    // default --every, and a scene's default step may not be the run's.
+    DataRecord earlier;  // the interrupted run's data
+    std::string dt_whose = o.given.count("--dt") ? "" : ", the scene's";  // where --dt comes from, if not given
+    if (!o.resume.empty()) {
+        std::string why;
+        const int status = read_data_record(o, data, earlier, why);
+        if (const int agreed = agreed_failure(status, why)) return agreed;
+        // The data's --dt where it is another and the data is the run's: its
+        // row at the checkpoint's step under that --dt holds the
+        // checkpoint's time, to the bit (the attribute is the double the run
+        // stepped with). Without --dt, it is taken (the scene's step is no
+        // choice of the user's); another --dt given is refused.
+        const Attribute *recorded = earlier.attribute("dt"), *scene = earlier.attribute("scene");
+        int64_t at = 0;
+        std::vector<KeptRow> rows;
+        std::string unread;  // the data's rows up to `at` are read again, and checked, below
+        const bool recorded_fits =
+            recorded && (!scene || scene->text == o.scene) && recorded->number > 0.0 &&
+            std::isfinite(recorded->number) && std::memcmp(&recorded->number, &dt, sizeof dt) != 0 &&
+            whole_steps(lpi_time(sys), recorded->number, at) &&
+            data_rows_up_to(o, at, data, earlier, rows, unread) == 0 && !rows.empty() && rows.back().step == at &&
+            rows.back().time == lpi_time(sys);
+        if (recorded_fits && o.given.count("--dt"))
+            why = format("lpi run: --resume: --dt %s, but the interrupted run's is %s (%s records it): resume "
+                         "with its --dt, or without --dt (another --dt would splice rows of two step sizes)",
+                         exact(dt).c_str(), exact(recorded->number).c_str(), data_path(o).c_str());
+        if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
+        if (recorded_fits) {
+            std::printf("lpi run: --resume: --dt %s, the interrupted run's (%s records it; the scene's is %s)\n",
+                        exact(recorded->number).c_str(), data_path(o).c_str(), exact(dt).c_str());
+            dt = recorded->number;
+            dt_whose = ", the data's";
+        }
+        int64_t dt_bits = 0;
+        std::memcpy(&dt_bits, &dt, sizeof dt);
+        if (!same_everywhere(dt_bits)) {
+            std::fprintf(stderr, "lpi run: --resume: the processes read different data of the interrupted run "
+                                 "(another --dt): give --dt\n");
+            return 2;
+        }
+    }
+
     // Steps are counted from the start of the whole run, and the lpi_step
     // calls (one per row) end at the multiples of `every` and at the end: an
     // interrupted run resumed with the same options makes the very same
@@ -385,7 +439,185 @@ int run_command(int argc, char **argv) {
                      static_cast<long long>(start), static_cast<long long>(end));
         return 2;
     }
-    const int64_t every = o.every > 0 ? o.every : std::max<int64_t>(1, end / 100);
+    // The rows up to the checkpoint's step are the interrupted run's, kept:
+    // the CSV and the data hold two copies of them. Either copy that
+    // reaches the checkpoint (its row there has the checkpoint's time, to
+    // the bit, and energy) gives them, the other checked against it before
+    // it is rewritten. Where neither file of the run is there (a new or
+    // empty --out), new files start at the checkpoint's step; where one is
+    // there but neither gives the rows, the run is refused, every file left
+    // as it was (started anew at the checkpoint's step, the files lost their
+    // rows before it, and the energy error its reference at step 0).
+    std::vector<KeptRow> kept;
+    std::string not_kept;  // why the data's snapshots are not this run's
+    bool data_is_this_runs = false;
+    // The interrupted run's --every and --snapshots where its files tell
+    // (0 and -1 where they do not), and what tells them.
+    int64_t run_every = 0, run_snapshots = -1;
+    std::string every_from;
+    if (!o.resume.empty()) {
+        const double H = energy_of(sys);  // collective
+        std::string why;
+        struct stat csv_stat;
+        const bool csv_there = stat(csv.c_str(), &csv_stat) == 0 || errno != ENOENT;
+        std::vector<KeptRow> csv_rows = csv_up_to(csv, start, data.casimir_count, why);
+        if (!why.empty()) why = "lpi run: --resume: " + why;
+        std::vector<KeptRow> data_rows;
+        if (why.empty()) data_rows_up_to(o, start, data, earlier, data_rows, why);
+        if (const int agreed = agreed_failure(!why.empty(), why)) return agreed;
+        for (Array *array : {&earlier.steps, &earlier.times, &earlier.energies, &earlier.casimirs}) *array = Array();
+        std::string other_format;  // the data in the other --format, where it is there
+        const bool files_there = data_there(o, data, other_format) || csv_there;
+        // "" where `rows`, read from `file`, reach the checkpoint, else why not.
+        auto short_of_checkpoint = [&](const std::vector<KeptRow> &rows, const std::string &file) -> std::string {
+            if (rows.empty() || rows.back().step != start)
+                return format("%s has no row at step %lld, the checkpoint's (t = %.17g with --dt %s%s): the "
+                              "file of a run with another --dt, or cut short or older than the checkpoint",
+                              file.c_str(), static_cast<long long>(start), lpi_time(sys), exact(dt).c_str(),
+                              dt_whose.c_str());
+            // Written at the end of the same call as the checkpoint: another
+            // time there is another --dt, whose rows would be spliced in.
+            const KeptRow &last = rows.back();
+            if (last.time != lpi_time(sys))
+                return format("the checkpoint's time %.17g is step %lld of --dt %.17g, but %s has t = %.17g at "
+                              "that step: resume with the options of the interrupted run",
+                              lpi_time(sys), static_cast<long long>(start), dt, file.c_str(), last.time);
+            // Its energy, written from the same state with 17 digits (the
+            // margin for a sum over another number of processes).
+            if (std::fabs(last.energy - H) > 1e-12 * std::max(std::fabs(last.energy), std::fabs(H)))
+                return format("%s has the energy %.17g at step %lld, but the checkpoint's state has %.17g: it is "
+                              "another run's",
+                              file.c_str(), last.energy, static_cast<long long>(start), H);
+            return "";
+        };
+        // The first step at which the two copies differ (-1: none): the
+        // rows at the steps both hold, to the bit.
+        auto first_difference = [&]() -> int64_t {
+            std::size_t j = 0;
+            for (const KeptRow &r : csv_rows) {
+                while (j < data_rows.size() && data_rows[j].step < r.step) ++j;
+                if (j == data_rows.size()) break;
+                if (data_rows[j].step == r.step &&
+                    (std::memcmp(&r.time, &data_rows[j].time, sizeof(double)) != 0 ||
+                     std::memcmp(&r.energy, &data_rows[j].energy, sizeof(double)) != 0))
+                    return r.step;
+            }
+            return -1;
+        };
+        const std::string csv_short = short_of_checkpoint(csv_rows, csv),
+                          data_short = short_of_checkpoint(data_rows, data_path(o));
+        const int64_t differs = first_difference();
+        const std::string another_run =
+            differs < 0 ? "" : format("its row at step %lld is not that of the CSV: it is the data of another run",
+                                      static_cast<long long>(differs));
+        std::string rows_from;  // the file the kept rows are read from
+        if (csv_short.empty()) {
+            kept = std::move(csv_rows);
+            rows_from = csv;
+            not_kept = !earlier.there ? "no data there" : another_run;
+            data_is_this_runs = not_kept.empty();
+        } else if (data_short.empty() && differs < 0) {
+            // The CSV moved away or cut short: its rows are the data's.
+            std::printf("%s %s: its rows up to step %lld are taken from %s\n", csv.c_str(),
+                        !csv_there          ? "is not there"
+                        : csv_rows.empty() ? "has no rows"
+                                           : "ends before the checkpoint's step",
+                        static_cast<long long>(start), data_path(o).c_str());
+            kept = std::move(data_rows);
+            rows_from = data_path(o);
+            data_is_this_runs = true;
+        } else if (!files_there) {
+            // A new or empty --out: no rows to lose, and none to splice.
+            std::printf("neither %s nor the data %s is there: new files from step %lld, the energy error "
+                        "relative to that step\n",
+                        csv.c_str(), data_path(o).c_str(), static_cast<long long>(start));
+            not_kept = "no data there";
+        } else {
+            why = !csv_rows.empty()    ? csv_short
+                  : !data_rows.empty() ? data_short
+                                       : format("neither %s nor the data %s holds the interrupted run's rows",
+                                                csv.c_str(), data_path(o).c_str());
+            if (!csv_short.empty() && !data_short.empty() && !csv_rows.empty() && !data_rows.empty())
+                why += "; and " + data_short;
+            else if (!csv_short.empty() && data_short.empty())
+                why += "; and " + another_run;
+            if (!earlier.there && !other_format.empty())
+                why += format("; the data %s is there, of --format %s", other_format.c_str(),
+                              o.format == "h5" ? "npy" : "h5");
+            why = "lpi run: --resume: " + why +
+                  " (its rows up to the checkpoint's step, the reference of the energy errors, would be lost: "
+                  "resume with the options and --out of the interrupted run, or into an --out without its "
+                  "files to start new ones at that step)";
+        }
+        if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
+        // The interrupted run's --every and --snapshots: as its data records
+        // them, else (--every) the step between its rows (the largest: the
+        // first after a new file's start and the last, at a run's end, may be
+        // shorter).
+        if (data_is_this_runs) {
+            auto whole = [](const Attribute *a, double least) {
+                return a && a->number >= least && a->number < 0x1p62 && a->number == std::trunc(a->number);
+            };
+            const Attribute *recorded = earlier.attribute("every");
+            if (whole(recorded, 1.0))
+                run_every = static_cast<int64_t>(recorded->number), every_from = data_path(o) + " records it";
+            recorded = earlier.attribute("snapshot_every");
+            if (whole(recorded, 0.0)) run_snapshots = static_cast<int64_t>(recorded->number);
+        }
+        if (run_every == 0 && kept.size() >= 2) {
+            for (std::size_t r = 1; r < kept.size(); ++r) run_every = std::max(run_every, kept[r].step - kept[r - 1].step);
+            every_from = "the step between the rows of " + rows_from;
+        }
+        // Given otherwise, refused: another --every ends the library's calls
+        // elsewhere (and the flows merged at their seams round otherwise),
+        // another --snapshots splices another layout of snapshots.
+        if (o.every > 0 && run_every > 0 && o.every != run_every)
+            why = format("lpi run: --resume: --every %lld, but the interrupted run's is %lld (%s): resume with "
+                         "its --every, or without --every (another would end the library's calls elsewhere, and "
+                         "so not bit for bit where the uninterrupted run ends)",
+                         static_cast<long long>(o.every), static_cast<long long>(run_every), every_from.c_str());
+        if (why.empty() && run_snapshots >= 0 && o.given.count("--snapshots") && o.snapshot_every != run_snapshots)
+            why = format("lpi run: --resume: --snapshots %lld, but the interrupted run's is %lld (%s records "
+                         "it): resume with its --snapshots, or without --snapshots",
+                         static_cast<long long>(o.snapshot_every), static_cast<long long>(run_snapshots),
+                         data_path(o).c_str());
+        if (run_snapshots >= 0 && !o.given.count("--snapshots")) o.snapshot_every = run_snapshots;
+        if (data_is_this_runs && why.empty()) {
+            const Attribute *recorded = earlier.attribute("scene");
+            if (recorded && recorded->text != o.scene)
+                why = format("lpi run: --resume: %s is a run of %s, not %s", data_path(o).c_str(),
+                             recorded->text.c_str(), o.scene.c_str());
+            recorded = earlier.attribute("dt");
+            if (why.empty() && recorded && std::memcmp(&recorded->number, &dt, sizeof dt) != 0)
+                why = format("lpi run: --resume: --dt %.17g, but %s records a run of --dt %.17g: resume with the "
+                             "options of the interrupted run",
+                             dt, data_path(o).c_str(), recorded->number);
+        }
+        if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
+    }
+    const int64_t every = o.every > 0 ? o.every : run_every > 0 ? run_every : std::max<int64_t>(1, end / 100);
+    if (!same_everywhere(every) || !same_everywhere(o.snapshot_every)) {
+        std::fprintf(stderr, "lpi run: --resume: the processes read different files of the interrupted run "
+                             "(another --every or --snapshots): give --every and --snapshots\n");
+        return 2;
+    }
+    // The layout of the kept rows: every --every steps from the first,
+    // counted from step 0 (the steps of the interrupted run's library calls),
+    // the last one at the run's end where that came before the next.
+    if (!o.resume.empty()) {
+        std::string why;
+        int64_t expected = kept.empty() ? 0 : kept.front().step / every * every;
+        for (std::size_t r = 1; r < kept.size() && why.empty(); ++r) {
+            expected += every;
+            if (kept[r].step == expected || (r + 1 == kept.size() && kept[r].step == start && start < expected))
+                continue;
+            why = format("lpi run: --resume: --every %lld, but the interrupted run's row %zu is at step %lld: "
+                         "resume with its --every (another would end the library's calls elsewhere, and so not "
+                         "bit for bit where the uninterrupted run ends)",
+                         static_cast<long long>(every), r, static_cast<long long>(kept[r].step));
+        }
+        if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
+    }
     // Row r is written after step min(r * every, end).
     auto row_index = [&](int64_t step) { return step / every + (step % every != 0); };
     // The rows and the snapshots are kept in memory until they are written,
@@ -485,127 +717,6 @@ int run_command(int argc, char **argv) {
         if (!o.wisdom.empty() && o.planning != "estimate")
             check_option(writes_output() ? lpi_fftw_wisdom_export_file(o.wisdom.c_str()) : LPI_OK, nullptr,
                          "--wisdom", 1);
-    }
-    // The rows up to the checkpoint's step are the interrupted run's, kept:
-    // the CSV and the data hold two copies of them. Either copy that
-    // reaches the checkpoint (its row there has the checkpoint's time, to
-    // the bit, and energy) gives them, the other checked against it before
-    // it is rewritten; where neither does, the run is refused, every file
-    // left as it was (started anew at the checkpoint's step, the files lost
-    // their rows before it, and the energy error its reference at step 0).
-    std::vector<KeptRow> kept;
-    std::string not_kept;  // why the data's snapshots are not this run's
-    if (!o.resume.empty()) {
-        const double H = energy_of(sys);  // collective
-        std::string why;
-        std::vector<KeptRow> csv_rows = csv_up_to(csv, start, data.casimir_count, why);
-        if (!why.empty()) why = "lpi run: --resume: " + why;
-        DataRecord record;
-        if (why.empty() && read_data_record(o, start, data, record, why) == 0) why.clear();
-        if (const int agreed = agreed_failure(!why.empty(), why)) return agreed;
-        // "" where `rows`, read from `file`, reach the checkpoint, else why not.
-        auto short_of_checkpoint = [&](const std::vector<KeptRow> &rows, const std::string &file) -> std::string {
-            if (rows.empty() || rows.back().step != start)
-                return format("%s has no row at step %lld, the checkpoint's (t = %.17g with --dt %.17g): the "
-                              "file of a run with another --dt, or cut short or older than the checkpoint",
-                              file.c_str(), static_cast<long long>(start), lpi_time(sys), dt);
-            // Written at the end of the same call as the checkpoint: another
-            // time there is another --dt, whose rows would be spliced in.
-            const KeptRow &last = rows.back();
-            if (last.time != lpi_time(sys))
-                return format("the checkpoint's time %.17g is step %lld of --dt %.17g, but %s has t = %.17g at "
-                              "that step: resume with the options of the interrupted run",
-                              lpi_time(sys), static_cast<long long>(start), dt, file.c_str(), last.time);
-            // Its energy, written from the same state with 17 digits (the
-            // margin for a sum over another number of processes).
-            if (std::fabs(last.energy - H) > 1e-12 * std::max(std::fabs(last.energy), std::fabs(H)))
-                return format("%s has the energy %.17g at step %lld, but the checkpoint's state has %.17g: it is "
-                              "another run's",
-                              file.c_str(), last.energy, static_cast<long long>(start), H);
-            return "";
-        };
-        // The first step at which the two copies differ (-1: none): the
-        // rows at the steps both hold, to the bit.
-        auto first_difference = [&]() -> int64_t {
-            std::size_t j = 0;
-            for (const KeptRow &r : csv_rows) {
-                while (j < record.rows.size() && record.rows[j].step < r.step) ++j;
-                if (j == record.rows.size()) break;
-                if (record.rows[j].step == r.step &&
-                    (std::memcmp(&r.time, &record.rows[j].time, sizeof(double)) != 0 ||
-                     std::memcmp(&r.energy, &record.rows[j].energy, sizeof(double)) != 0))
-                    return r.step;
-            }
-            return -1;
-        };
-        const std::string csv_short = short_of_checkpoint(csv_rows, csv),
-                          data_short = short_of_checkpoint(record.rows, data_path(o));
-        const int64_t differs = first_difference();
-        const std::string another_run =
-            differs < 0 ? "" : format("its row at step %lld is not that of the CSV: it is the data of another run",
-                                      static_cast<long long>(differs));
-        bool data_is_this_runs = false;
-        if (csv_short.empty()) {
-            kept = std::move(csv_rows);
-            not_kept = !record.there ? "no data there" : another_run;
-            data_is_this_runs = not_kept.empty();
-        } else if (data_short.empty() && differs < 0) {
-            // The CSV moved away or cut short: its rows are the data's.
-            std::printf("%s %s: its rows up to step %lld are taken from %s\n", csv.c_str(),
-                        csv_rows.empty() ? "has no rows" : "ends before the checkpoint's step",
-                        static_cast<long long>(start), data_path(o).c_str());
-            kept = std::move(record.rows);
-            data_is_this_runs = true;
-        } else {
-            why = !csv_rows.empty()      ? csv_short
-                  : !record.rows.empty() ? data_short
-                                         : format("neither %s nor the data %s holds the interrupted run's rows",
-                                                  csv.c_str(), data_path(o).c_str());
-            if (!csv_short.empty() && !data_short.empty() && !csv_rows.empty() && !record.rows.empty())
-                why += "; and " + data_short;
-            else if (!csv_short.empty() && data_short.empty())
-                why += "; and " + another_run;
-            why = "lpi run: --resume: " + why +
-                  " (its rows up to the checkpoint's step, the reference of the energy errors, would be lost: "
-                  "resume with the options and --out of the interrupted run)";
-        }
-        if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
-        // The layout of the interrupted run: rows every --every steps,
-        // counted from step 0 (the steps of its library calls: another
-        // --every ends the calls elsewhere, and the flows merged at their
-        // seams round otherwise), and what its data records.
-        for (std::size_t r = 1; r < kept.size() && why.empty(); ++r) {
-            const int64_t expected = static_cast<int64_t>(r) * every;
-            if (kept[r].step == expected || (r + 1 == kept.size() && kept[r].step == start && start < expected &&
-                                             kept[r - 1].step == expected - every))
-                continue;
-            why = format("lpi run: --resume: --every %lld, but the interrupted run's row %zu is at step %lld: "
-                         "resume with its --every (another would end the library's calls elsewhere, and so not "
-                         "bit for bit where the uninterrupted run ends)",
-                         static_cast<long long>(every), r, static_cast<long long>(kept[r].step));
-        }
-        if (data_is_this_runs && why.empty()) {
-            const Attribute *recorded = record.attribute("scene");
-            if (recorded && recorded->text != o.scene)
-                why = format("lpi run: --resume: %s is a run of %s, not %s", data_path(o).c_str(),
-                             recorded->text.c_str(), o.scene.c_str());
-            recorded = record.attribute("dt");
-            if (why.empty() && recorded && std::memcmp(&recorded->number, &dt, sizeof dt) != 0)
-                why = format("lpi run: --resume: --dt %.17g, but %s records a run of --dt %.17g: resume with the "
-                             "options of the interrupted run",
-                             dt, data_path(o).c_str(), recorded->number);
-            recorded = record.attribute("every");
-            if (why.empty() && recorded && recorded->number != static_cast<double>(every))
-                why = format("lpi run: --resume: --every %lld, but %s records a run of --every %.17g: resume "
-                             "with the options of the interrupted run",
-                             static_cast<long long>(every), data_path(o).c_str(), recorded->number);
-            recorded = record.attribute("snapshot_every");
-            if (why.empty() && recorded && recorded->number != static_cast<double>(o.snapshot_every))
-                why = format("lpi run: --resume: --snapshots %lld, but %s records a run of --snapshots %.17g: "
-                             "resume with the options of the interrupted run",
-                             static_cast<long long>(o.snapshot_every), data_path(o).c_str(), recorded->number);
-        }
-        if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
     }
     // The references of the errors and drifts: the first row of the CSV
     // when resuming (step 0, or the step a new file started at; to the bit:

@@ -352,16 +352,16 @@ namespace {
 // run would replace it, and the rows and snapshots in it would be lost.
 int unreadable(const RunOptions &o, int64_t start, const std::string &why, std::string &refusal) {
     refusal = format("lpi run: --resume: the data %s cannot be read back (%s): resumed, the run would "
-                     "replace it, and the rows and snapshots up to step %lld in it would be lost; move it aside "
+                     "replace it, and the rows and snapshots %s in it would be lost; move it aside "
                      "(or remove it) to resume without them",
-                     data_path(o).c_str(), why.c_str(), static_cast<long long>(start));
+                     data_path(o).c_str(), why.c_str(),
+                     start < 0 ? "" : format("up to step %lld", static_cast<long long>(start)).c_str());
     return 1;
 }
 
 }  // namespace
 
-int read_data_record(const RunOptions &o, int64_t start, const RunData &d, DataRecord &record,
-                     std::string &refusal) {
+int read_data_record(const RunOptions &o, const RunData &d, DataRecord &record, std::string &refusal) {
     refusal.clear();
     record = DataRecord();
     // No file of the data there (a run killed before it wrote any): nothing
@@ -371,42 +371,71 @@ int read_data_record(const RunOptions &o, int64_t start, const RunData &d, DataR
         if (stat(file.c_str(), &st) == 0 || errno != ENOENT) record.there = true;
     }
     if (!record.there) return 0;
-    Array steps, times, energies, casimirs;
-    for (auto *array : {&steps, &times, &energies, &casimirs}) {
-        const char *name = array == &steps ? "step" : array == &times ? "time" : array == &energies ? "energy"
-                                                                                                     : "casimirs";
+    for (auto *array : {&record.steps, &record.times, &record.energies, &record.casimirs}) {
+        const char *name = array == &record.steps ? "step" : array == &record.times ? "time"
+                           : array == &record.energies                              ? "energy"
+                                                                                    : "casimirs";
         const std::string wrong = read_data_array(o, name, false, *array);
-        if (!wrong.empty()) return unreadable(o, start, wrong, refusal);
+        if (!wrong.empty()) return unreadable(o, -1, wrong, refusal);
     }
     const std::size_t width = d.casimir_count;
-    if (casimirs.shape.size() != 2 || casimirs.shape[1] != width)
-        return unreadable(o, start, format("its casimirs are not rows of %zu values", width), refusal);
-    // A set that a kill cut between two of its files' renames (write_data)
-    // holds the arrays of two consecutive writes, of different lengths, which
-    // agree on every row and snapshot up to the checkpoint's step: only those
-    // are read, and each array must hold them.
-    for (std::size_t i = 0; i < steps.values.size(); ++i) {
-        const double step = steps.values[i], before = i ? steps.values[i - 1] : -1.0;
-        if (!(step >= 0.0 && step < 0x1p62 && step == std::trunc(step) && step > before))
-            return unreadable(o, start, format("its row %zu has no whole step in order", i), refusal);
-        if (step > static_cast<double>(start)) break;
-        if (i >= times.values.size() || i >= energies.values.size() || (i + 1) * width > casimirs.values.size())
-            return unreadable(o, start, format("its arrays end before its row at step %.17g", step), refusal);
-        KeptRow row;
-        row.step = static_cast<int64_t>(step);
-        row.time = times.values[i];
-        row.energy = energies.values[i];
-        row.casimirs.assign(casimirs.values.begin() + static_cast<std::ptrdiff_t>(i * width),
-                            casimirs.values.begin() + static_cast<std::ptrdiff_t>((i + 1) * width));
-        record.rows.push_back(std::move(row));
-    }
+    if (record.casimirs.shape.size() != 2 || record.casimirs.shape[1] != width)
+        return unreadable(o, -1, format("its casimirs are not rows of %zu values", width), refusal);
     for (const char *name : {"scene", "method"}) record.attributes.push_back({name, "", 0.0, true});
     for (const char *name : {"dt", "every", "snapshot_every"}) record.attributes.push_back({name, "", 0.0, false});
     const std::string wrong =
         o.format == "h5" ? read_hdf5_attributes(data_path(o), record.attributes, record.found)
                          : read_json_attributes(data_path(o) + "/attributes.json", record.attributes, record.found);
-    if (!wrong.empty()) return unreadable(o, start, wrong, refusal);
+    if (!wrong.empty()) return unreadable(o, -1, wrong, refusal);
     return 0;
+}
+
+int data_rows_up_to(const RunOptions &o, int64_t start, const RunData &d, const DataRecord &record,
+                    std::vector<KeptRow> &rows, std::string &refusal) {
+    refusal.clear();
+    rows.clear();
+    const std::size_t width = d.casimir_count;
+    const std::vector<double> &steps = record.steps.values, &times = record.times.values,
+                              &energies = record.energies.values, &casimirs = record.casimirs.values;
+    // A set that a kill cut between two of its files' renames (write_data)
+    // holds the arrays of two consecutive writes, of different lengths, which
+    // agree on every row and snapshot up to the checkpoint's step: only those
+    // are read, and each array must hold them.
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+        const double step = steps[i], before = i ? steps[i - 1] : -1.0;
+        if (!(step >= 0.0 && step < 0x1p62 && step == std::trunc(step) && step > before))
+            return unreadable(o, start, format("its row %zu has no whole step in order", i), refusal);
+        if (step > static_cast<double>(start)) break;
+        if (i >= times.size() || i >= energies.size() || (i + 1) * width > casimirs.size())
+            return unreadable(o, start, format("its arrays end before its row at step %.17g", step), refusal);
+        KeptRow row;
+        row.step = static_cast<int64_t>(step);
+        row.time = times[i];
+        row.energy = energies[i];
+        row.casimirs.assign(casimirs.begin() + static_cast<std::ptrdiff_t>(i * width),
+                            casimirs.begin() + static_cast<std::ptrdiff_t>((i + 1) * width));
+        rows.push_back(std::move(row));
+    }
+    return 0;
+}
+
+bool data_there(const RunOptions &o, const RunData &d, std::string &other) {
+    other.clear();
+    auto exists = [](const std::string &path) {
+        struct stat st;
+        return stat(path.c_str(), &st) == 0 || errno != ENOENT;
+    };
+    RunOptions h5 = o, npy = o;
+    h5.format = "h5";
+    npy.format = "npy";
+    bool there = false;
+    for (const RunOptions *format : {&h5, &npy}) {
+        bool this_one = exists(data_path(*format)) || (format == &h5 && exists(journal_path(*format)));
+        for (const std::string &file : data_files(*format, d)) this_one = this_one || exists(file);
+        if (this_one && format->format != o.format && other.empty()) other = data_path(*format);
+        there = there || this_one;
+    }
+    return there;
 }
 
 int keep_snapshots(const RunOptions &o, int64_t start, const std::string &not_kept, RunData &d,

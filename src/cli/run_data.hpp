@@ -107,12 +107,12 @@ struct KeptRow {
 };
 
 // The interrupted run's data as a resumed run reads it back: whether any
-// file of it is there, its rows up to the checkpoint's step, and the
-// attributes it records (scene, method, dt, every, snapshot_every), those
-// found listed in `found`.
+// file of it is there, its row arrays (step, time, energy, casimirs) as read,
+// and the attributes it records (scene, method, dt, every, snapshot_every),
+// those found listed in `found`.
 struct DataRecord {
     bool there = false;
-    std::vector<KeptRow> rows;
+    Array steps, times, energies, casimirs;
     std::vector<Attribute> attributes;
     std::vector<std::string> found;
     const Attribute *attribute(const std::string &name) const {
@@ -124,12 +124,23 @@ struct DataRecord {
     }
 };
 
-// Reads the rows up to `start` and the attributes of the interrupted run's
-// data (shaped as `d`). Returns 0, or 1 with the message in `refusal` when
-// data is there but cannot be read back (damaged, or over the readers' cap
-// of 2^28 values per array): the run would replace it, and lose it.
-int read_data_record(const RunOptions &o, int64_t start, const RunData &d, DataRecord &record,
-                     std::string &refusal);
+// Reads the row arrays and the attributes of the interrupted run's data
+// (shaped as `d`). Returns 0, or 1 with the message in `refusal` when data is
+// there but cannot be read back (damaged, or over the readers' cap of 2^28
+// values per array): the run would replace it, and lose it.
+int read_data_record(const RunOptions &o, const RunData &d, DataRecord &record, std::string &refusal);
+
+// The rows of `record` up to `start` into `rows` (only those are checked: a
+// .npy set that a kill cut between the renames of its files holds arrays of
+// two writes, which agree up to the checkpoint's step). Returns 0, or 1 with
+// the message in `refusal` as read_data_record.
+int data_rows_up_to(const RunOptions &o, int64_t start, const RunData &d, const DataRecord &record,
+                    std::vector<KeptRow> &rows, std::string &refusal);
+
+// Whether a file of the run's data is there in either --format (HDF5, its
+// journal, or the folder of .npy files), and the path of one in the other
+// format than this run's in `other` (empty: none).
+bool data_there(const RunOptions &o, const RunData &d, std::string &other);
 
 // The snapshots of the interrupted run up to `start`, from its data, where
 // its rows are this run's (`not_kept` empty); otherwise a note on stdout
