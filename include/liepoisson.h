@@ -22,7 +22,9 @@
  * getters, lpi_save, ...) - are allowed; and lpi_dim, lpi_time,
  * lpi_casimir_count, lpi_kind, lpi_get_method, lpi_get_split and
  * lpi_last_error, which return no status, always answer. Calls on other
- * handles are not affected.
+ * handles are not affected, except handles spread over MPI processes
+ * (liepoisson_mpi.h), which a callback of another handle may not call
+ * (LPI_ERR_INVALID).
  *
  * Kinds: a function defined for some kinds of system only (lpi_rigid_body_exact,
  * lpi_add_piece, lpi_add_casimir, lpi_poisson_rank,

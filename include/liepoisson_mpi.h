@@ -38,7 +38,10 @@ extern "C" {
  * different N. The handle must be
  * destroyed (lpi_destroy, collective) before MPI_Finalize; a call on it
  * after MPI_Finalize returns LPI_ERR_INVALID. Observers may read the system,
- * making the same calls on every process (see lpi_sine_euler_create_mpi(3)). */
+ * making the same calls on every process (see lpi_sine_euler_create_mpi(3));
+ * a callback of another system may not call it, nor create or load one
+ * (LPI_ERR_INVALID: a process whose callback failed would leave the others
+ * waiting). */
 LPI_API int lpi_sine_euler_create_mpi(lpi_system **out, int32_t N, MPI_Comm comm);
 
 /* Collective: the checkpoint file at path (read by rank 0) as a sine-Euler

@@ -405,11 +405,17 @@ refused "another --dt" run rigid-body --steps 200 --format npy --out "$out/ext" 
 awk -F, 'NR > 2 && length($4) < 12 { bad = 1 } END { exit bad }' "$out/two/rigid-body.csv" ||
     { echo "the CSV's energy error is not written in full"; exit 1; }
 # A run certain to run out of memory keeping its rows is refused before its
-# first step (it failed after all of them, its work lost).
-rc=0; (ulimit -v 1000000; exec timeout 30 "$lpi" run rigid-body --steps 100000000 --every 1 --snapshots 0 \
-    --out "$out/huge-rows") >"$out.out" 2>"$out.err" || rc=$?
-[ "$rc" -eq 1 ] && grep -q "more than is available: write rows less often (--every)" "$out.err" &&
-    ! grep -q "steps 0 to" "$out.out" || { echo "rows past the memory: exit status $rc"; cat "$out.err"; exit 1; }
+# first step (it failed after all of them, its work lost). Under
+# AddressSanitizer, whose shadow memory no address-space limit leaves room
+# for, the build without it checks this.
+if ldd "$lpi" 2>/dev/null | grep -q libasan; then
+    echo "check_lpi_run: the memory check of rows left to the build without AddressSanitizer"
+else
+    rc=0; (ulimit -v 1000000; exec timeout 30 "$lpi" run rigid-body --steps 100000000 --every 1 --snapshots 0 \
+        --out "$out/huge-rows") >"$out.out" 2>"$out.err" || rc=$?
+    [ "$rc" -eq 1 ] && grep -q "more than is available: write rows less often (--every)" "$out.err" &&
+        ! grep -q "steps 0 to" "$out.out" || { echo "rows past the memory: exit status $rc"; cat "$out.err"; exit 1; }
+fi
 # Data that is there but cannot be read back (cut short, not data at all,
 # or a header claiming more than the readers' cap of 2^28 values) is not
 # replaced by the resumed run, which dropped it with a note and lost the

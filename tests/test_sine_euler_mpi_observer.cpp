@@ -4,8 +4,9 @@
 // collective (the others hung there), also when the others' observers read
 // the system meanwhile (their calls met the failing process's end of the
 // agreement: a truncated message, then a hang in the next call). And a
-// handle used after MPI_Finalize is refused, not aborted. Run under mpirun
-// with 2 processes.
+// handle used after MPI_Finalize is refused, not aborted. Different calls
+// with the same arguments are refused, and so are calls on another spread
+// system from an observer. Run under mpirun with 2 processes.
 #include <mpi.h>
 
 #include <cstdio>
@@ -106,6 +107,70 @@ void test_observers_making_different_calls(void **) {
     lpi_destroy(sys);
 }
 
+// Two calls that take the same arguments, one on each process: refused on
+// both (they paired different collectives: a truncated message, a hang).
+void test_different_calls_with_the_same_arguments(void **) {
+    lpi_system *sys = observed_system();
+    double v = 0.0;
+    const int status = rank_ == 0 ? lpi_energy(sys, &v) : lpi_sine_euler_enstrophy(sys, &v);
+    assert_int_equal(status, LPI_ERR_INVALID);
+    assert_non_null(std::strstr(lpi_last_error(sys), "different calls"));
+    assert_int_equal(lpi_step(sys, 0.01, 2), LPI_OK);
+    lpi_destroy(sys);
+}
+
+int different_reads(const lpi_system *sys, int64_t, double, void *) {
+    double x[49];
+    const int status = rank_ == 0 ? lpi_get_state(sys, x, 49) : lpi_sine_euler_get_grid(sys, x, 49);
+    if (status != LPI_OK) observer_status = status;
+    return 0;
+}
+
+void test_observers_making_different_reads(void **) {
+    lpi_system *sys = observed_system();
+    observer_status = LPI_OK;
+    assert_int_equal(lpi_set_observer(sys, 1, different_reads, nullptr), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.01, 3), LPI_OK);
+    assert_int_equal(observer_status, LPI_ERR_INVALID);
+    assert_int_equal(lpi_set_observer(sys, 0, nullptr, nullptr), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.01, 3), LPI_OK);
+    lpi_destroy(sys);
+}
+
+// An observer of one spread system reading another, or making a new one,
+// while the last process's observer throws: those calls are refused on
+// every process (the others waited for ever in the other system's
+// collectives for the process that had left).
+lpi_system *other = nullptr;
+int create_status = LPI_OK;
+int reading_another_system(const lpi_system *, int64_t step, double, void *) {
+    if (rank_ == size_ - 1 && step == 2) throw std::runtime_error("boom on the last process");
+    double h = 0.0;
+    const int status = lpi_energy(other, &h);
+    if (status != LPI_OK) observer_status = status;
+    lpi_system *made = nullptr;
+    create_status = lpi_sine_euler_create_mpi(&made, 7, MPI_COMM_WORLD);
+    lpi_destroy(made);
+    return 0;
+}
+
+void test_observer_calling_another_spread_system(void **) {
+    lpi_system *sys = observed_system();
+    other = observed_system();
+    observer_status = LPI_OK;
+    assert_int_equal(lpi_set_observer(sys, 1, reading_another_system, nullptr), LPI_OK);
+    LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.01, 5), LPI_ERR_CALLBACK, "lpi_step");
+    assert_int_equal(observer_status, LPI_ERR_INVALID);
+    assert_non_null(std::strstr(lpi_last_error(other), "not called from a callback of another system"));
+    assert_int_equal(create_status, LPI_ERR_INVALID);
+    // Both systems are still in step.
+    assert_int_equal(lpi_set_observer(sys, 0, nullptr, nullptr), LPI_OK);
+    assert_int_equal(lpi_step(sys, 0.01, 2), LPI_OK);
+    assert_int_equal(lpi_step(other, 0.01, 2), LPI_OK);
+    lpi_destroy(other);
+    lpi_destroy(sys);
+}
+
 }  // namespace
 
 int main(int argc, char **argv) {
@@ -115,7 +180,10 @@ int main(int argc, char **argv) {
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
     const CMUnitTest tests[] = {cmocka_unit_test(test_observer_throwing_on_one_process),
                                 cmocka_unit_test(test_observers_reading_while_one_throws),
-                                cmocka_unit_test(test_observers_making_different_calls)};
+                                cmocka_unit_test(test_observers_making_different_calls),
+                                cmocka_unit_test(test_different_calls_with_the_same_arguments),
+                                cmocka_unit_test(test_observers_making_different_reads),
+                                cmocka_unit_test(test_observer_calling_another_spread_system)};
     const int status = lpi_run_tests(tests);
     // A handle still held at MPI_Finalize: its calls are refused (MPI would
     // abort the program), and it is destroyed without MPI.

@@ -129,6 +129,8 @@ public:
     Claim &operator=(const Claim &) = delete;
 
     const char *refused() const { return refused_; }
+    // Entered from the handle's own observer.
+    bool nested() const { return nested_ != Activity::Idle; }
     // The handle is about to be freed with its claim (lpi_destroy).
     void release_with_handle() { claimed_ = false, nested_ = Activity::Idle; }
     // The refusal's message goes to the calling thread's slot, not the handle's.
@@ -159,9 +161,15 @@ public:
     explicit Arguments(const A &...arguments) noexcept {
         (add(arguments), ...);
     }
-    // FNV-1a of the words (nothing is allocated: a call may be refused for
-    // want of memory only inside its guard).
-    std::uint64_t fingerprint() const { return hash_; }
+    // FNV-1a of the function's name and the words (nothing is allocated: a
+    // call may be refused for want of memory only inside its guard). The
+    // name is in it: lpi_energy and lpi_sine_euler_enstrophy take the same
+    // words, and on two processes paired different collectives.
+    std::uint64_t fingerprint(const char *function) const {
+        std::uint64_t hash = hash_;
+        for (const char *c = function; *c; ++c) hash = (hash ^ static_cast<unsigned char>(*c)) * 1099511628211ull;
+        return hash;
+    }
 
 private:
     void mix(std::uint64_t word) noexcept {
@@ -191,6 +199,31 @@ private:
     std::uint64_t hash_ = 1469598103934665603ull;
 };
 
+// Guarded calls in progress on this thread: more than one inside a call is a
+// call from a callback the library runs (an observer, a piece).
+inline int &calls_in_progress() noexcept {
+    thread_local int calls = 0;
+    return calls;
+}
+class CallInProgress {
+public:
+    CallInProgress() noexcept : from_callback_(calls_in_progress()++ > 0) {}
+    ~CallInProgress() { --calls_in_progress(); }
+    CallInProgress(const CallInProgress &) = delete;
+    CallInProgress &operator=(const CallInProgress &) = delete;
+    bool from_callback() const { return from_callback_; }
+
+private:
+    bool from_callback_;
+};
+// A system spread over processes is called from a callback only where the
+// callback is its own observer's: the others run on each process alone, and
+// a process whose callback failed would leave the rest waiting in the
+// collectives of such a call. Refused alike on every process that makes it.
+constexpr const char *kSpreadFromCallback =
+    "a system spread over processes is not called from a callback of another system (its observer "
+    "may read it): a process whose callback failed would leave the others waiting; nothing was changed";
+
 // Runs body() with sys claimed (Claim); maps lpi::Error to its status,
 // std::bad_alloc and std::length_error to LPI_ERR_NO_MEMORY and anything else
 // to LPI_ERR_INTERNAL, recording the message on sys (or the thread when sys
@@ -202,16 +235,21 @@ private:
 template <class Body>
 int run_guarded(const lpi_system *sys, bool mutates, const char *function, const Arguments *arguments,
                 Body &&body) {
+    const CallInProgress call;
     Claim claim(sys, mutates);
     if (const char *why = claim.refused()) {
         record(claim.by_another_thread() ? nullptr : sys, function, why);
         return LPI_ERR_BUSY;
     }
+    if (sys && call.from_callback() && !claim.nested() && sys->system.model().distributed()) {
+        record(sys, function, kSpreadFromCallback);
+        return LPI_ERR_INVALID;
+    }
     try {
         if (sys && arguments) {
-            const std::uint64_t fingerprint = arguments->fingerprint();
+            const std::uint64_t fingerprint = arguments->fingerprint(function);
             sys->system.model().require_same_on_every_process(&fingerprint, sizeof fingerprint,
-                                                              "arguments to this call");
+                                                              "arguments to this call (or made different calls)");
         }
         if constexpr (std::is_void_v<decltype(body())>) {
             body();

@@ -22,8 +22,14 @@ namespace {
 
 // The processes compare their arguments (as every call on a spread handle
 // does, src/capi/handle.hpp) before one of them can refuse them alone.
-void require_same_arguments(const lpi::mpi::Communicator &comm, const Arguments &arguments) {
-    comm.require_same(static_cast<long long>(arguments.fingerprint()), "arguments to this call");
+void require_same_arguments(const lpi::mpi::Communicator &comm, const char *function, const Arguments &arguments) {
+    comm.require_same(static_cast<long long>(arguments.fingerprint(function)), "arguments to this call (or made different calls)");
+}
+
+// Made from a callback of a system, a collective call on comm would leave
+// the processes where the callback did not fail waiting.
+void refuse_from_a_callback() {
+    if (lpi::capi::calls_in_progress() > 1) lpi::fail(LPI_ERR_INVALID, lpi::capi::kSpreadFromCallback);
 }
 
 // A refused file's path leads the message, as in lpi_load (I/O errors name
@@ -45,8 +51,10 @@ extern "C" {
 LPI_API int lpi_sine_euler_create_mpi(lpi_system **out, int32_t N, MPI_Comm comm) {
     if (out) *out = nullptr;
     return guarded(nullptr, "lpi_sine_euler_create_mpi", [&] {
+        refuse_from_a_callback();
         auto communicator = lpi::mpi::Communicator::duplicate(comm);
-        require_same_arguments(*communicator, Arguments(out));  // N: compared by the model, named
+        // N: compared by the model, named.
+        require_same_arguments(*communicator, "lpi_sine_euler_create_mpi", Arguments(out));
         require(out, "out");
         std::unique_ptr<lpi::Model> model = lpi::make_sine_euler_mpi(N, communicator);
         // The handle's states are allocated here: one process short of memory
@@ -61,9 +69,10 @@ LPI_API int lpi_sine_euler_create_mpi(lpi_system **out, int32_t N, MPI_Comm comm
 LPI_API int lpi_load_mpi(lpi_system **out, const char *path, MPI_Comm comm) {
     if (out) *out = nullptr;
     return guarded(nullptr, "lpi_load_mpi", [&] {
+        refuse_from_a_callback();
         const auto communicator = lpi::mpi::Communicator::duplicate(comm);
         const lpi::mpi::Communicator &reader = *communicator;
-        require_same_arguments(reader, Arguments(out, Text{path}));
+        require_same_arguments(reader, "lpi_load_mpi", Arguments(out, Text{path}));
         require(out, "out");
         require_path(path);
         // Rank 0 reads; every process decodes the same bytes. Whatever a

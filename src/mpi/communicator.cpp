@@ -55,6 +55,20 @@ int outcome_of(ActionRef action, std::string &message) {
     }
 }
 
+// Fails with status, as every process that comes here does; the message
+// (it allocates) is left empty where there is no memory for it, so that the
+// status stays the others'.
+template <class Message>
+[[noreturn]] void fail_alike(lpi_status status, Message &&message) {
+    std::string text;
+    try {
+        text = message();
+    } catch (...) {
+        text.clear();
+    }
+    fail(status, text);
+}
+
 // The longest message an agreement shares (its buffer is allocated once).
 constexpr std::size_t kMessageCapacity = 2048;
 
@@ -134,8 +148,8 @@ void Communicator::check(int code, const char *call) const {
 
 void Communicator::require_running() const {
     if (!mpi_running())
-        fail(LPI_ERR_INVALID, "MPI is finalised: a system spread over processes is destroyed before "
-                              "MPI_Finalize");
+        fail(LPI_ERR_INVALID, "MPI is finalised: destroy a system spread over processes (lpi_destroy) "
+                              "before MPI_Finalize");
 }
 
 void Communicator::alltoallv(const double *send, const std::vector<int> &send_counts,
@@ -186,16 +200,22 @@ void Communicator::require_same(long long value, const char *what) const {
         if (failed < 0 && headers_[2 * r + 1] != LPI_OK) failed = r;
     }
     if (failed >= 0)
-        fail(LPI_ERR_CALLBACK, "rank " + std::to_string(failed) + " failed in its observer and left it while "
-                               "this process called the system from its own");
+        fail_alike(LPI_ERR_CALLBACK, [&] {
+            return "rank " + std::to_string(failed) + " failed in its observer and left it while this "
+                   "process called the system from its own";
+        });
     if (ended >= 0)
-        fail(LPI_ERR_INVALID, "rank " + std::to_string(ended) + " had returned from its observer while this "
-                              "process called the system from its own (the observers of a system spread "
-                              "over processes make the same calls)");
+        fail_alike(LPI_ERR_INVALID, [&] {
+            return "rank " + std::to_string(ended) + " had returned from its observer while this process "
+                   "called the system from its own (the observers of a system spread over processes make "
+                   "the same calls; one that retries a refused call for ever keeps the others waiting)";
+        });
     for (int r = 1; r < size_; ++r)
         if (headers_[2 * r + 1] != headers_[1])
-            fail(LPI_ERR_INVALID, std::string("the processes passed different ") + what +
-                                      " (every process must make the same calls with the same arguments)");
+            fail_alike(LPI_ERR_INVALID, [&] {
+                return std::string("the processes passed different ") + what +
+                       " (every process must make the same calls with the same arguments)";
+            });
 }
 
 double Communicator::max(double value) const {
@@ -249,9 +269,10 @@ void Communicator::share_outcome(int status, const std::string &message) const {
     check(MPI_Bcast(&length, 1, MPI_INT, failed, comm_), "MPI_Bcast");
     if (rank_ == failed) std::copy(message.begin(), message.begin() + length, message_.begin());
     check(MPI_Bcast(message_.data(), length, MPI_CHAR, failed, comm_), "MPI_Bcast");
-    std::string text(message_.data(), static_cast<std::size_t>(length));
-    if (size_ > 1 && failed != 0) text = "on rank " + std::to_string(failed) + ": " + text;
-    fail(static_cast<lpi_status>(headers_[2 * failed + 1]), text);
+    fail_alike(static_cast<lpi_status>(headers_[2 * failed + 1]), [&] {
+        const std::string text(message_.data(), static_cast<std::size_t>(length));
+        return size_ > 1 && failed != 0 ? "on rank " + std::to_string(failed) + ": " + text : text;
+    });
 }
 
 void Communicator::agree(ActionRef action) const {
