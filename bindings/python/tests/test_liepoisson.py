@@ -12,15 +12,10 @@ import unittest.mock
 import weakref
 
 import liepoisson as lp
+from support import np, as_list, SO3
 
-np = lp.np
 TJ4 = 1.0 / (2.0 - 2.0 ** (1.0 / 3.0))  # Yoshida's triple jump, outer weight
-SO3 = [(0, 1, 2, -1.0), (0, 2, 1, 1.0), (1, 2, 0, -1.0)]
 INERTIA = (1.0, 2.0, 3.0)
-
-
-def as_list(a):
-    return [float(v) for v in (a.tolist() if np is not None and isinstance(a, np.ndarray) else a)]
 
 
 def distance(a, b):

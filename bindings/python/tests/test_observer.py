@@ -6,13 +6,9 @@ import threading
 import unittest
 
 import liepoisson as lp
+from support import np, as_list
 
-np = lp.np
 DT = 0.01
-
-
-def as_list(a):
-    return [float(v) for v in (a.tolist() if np is not None and isinstance(a, np.ndarray) else a)]
 
 
 def body(method="yoshida-6"):
