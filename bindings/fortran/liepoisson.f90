@@ -1,4 +1,5 @@
-! liepoisson for Fortran 2003+: the module liepoisson.
+! liepoisson for Fortran 2018 (error stop with a message made at run time;
+! gfortran builds it by default): the module liepoisson.
 !
 ! Two layers over the C library (include/liepoisson.h):
 !   c_lpi_<name>  bind(C) interfaces of every public function, exactly as in C;
@@ -21,7 +22,9 @@
 ! negative dim (LPI_ERR_INVALID), sine-Euler arrays not N x N and the four
 ! bracket arrays of lpi_generic_create differing in length, and an array for
 ! lpi_rigid_body_exact of other than 3 values (LPI_ERR_SIZE).
-! lpi_last_error does not describe these; the stop message does.
+! lpi_last_error does not describe these (it keeps the message of the
+! library's last failure on the handle, which may be an older call's): the
+! stop message does, and with status present the code alone tells them.
 ! Every wrapper is recursive: a callback may call the library again (on
 ! another handle, or read its own from an observer), which a procedure not
 ! declared so may not be (gfortran -fcheck=recursion stopped such a call).
@@ -363,11 +366,12 @@ module liepoisson
             real(c_double), intent(inout) :: psi(*)
             integer(c_size_t), value :: n
         end function
+        ! The buffers as addresses: both NULL (c_null_ptr) with n = 0 asks for
+        ! the shell count, which an array argument could not pass.
         integer(c_int) function c_lpi_sine_euler_spectrum(sys, energy, enstrophy, n, shells) &
                 bind(C, name="lpi_sine_euler_spectrum")
-            import :: c_int, c_ptr, c_double, c_size_t
-            type(c_ptr), value :: sys
-            real(c_double), intent(inout) :: energy(*), enstrophy(*)
+            import :: c_int, c_ptr, c_size_t
+            type(c_ptr), value :: sys, energy, enstrophy
             integer(c_size_t), value :: n
             integer(c_size_t), intent(out) :: shells
         end function
@@ -444,9 +448,16 @@ module liepoisson
         c_lpi_fftw_wisdom_export_file, c_lpi_fftw_wisdom_import_string, &
         c_lpi_fftw_wisdom_export_string, c_lpi_save, c_lpi_load, c_lpi_save_buffer, c_lpi_load_buffer
 
-    ! lpi_step takes a default or 64-bit step count.
+    ! lpi_step, lpi_set_observer and lpi_sine_euler_fft_floor take a default
+    ! or 64-bit count, as C's int64_t.
     interface lpi_step
         module procedure lpi_step_i4, lpi_step_i8
+    end interface
+    interface lpi_set_observer
+        module procedure lpi_set_observer_i4, lpi_set_observer_i8
+    end interface
+    interface lpi_sine_euler_fft_floor
+        module procedure lpi_sine_euler_fft_floor_i4, lpi_sine_euler_fft_floor_i8
     end interface
 
     public :: lpi_version_string, lpi_version_number, lpi_kind, lpi_get_method, lpi_get_split, &
@@ -731,10 +742,20 @@ contains
         call finish(c_lpi_step(sys, dt, nsteps), sys, status)
     end subroutine
 
-    ! Sets the observer of lpi_step (every >= 1); without fn, removes it.
-    recursive subroutine lpi_set_observer(sys, every, fn, user, status)
+    ! Sets the observer of lpi_step (every >= 1, a default or 64-bit
+    ! integer); without fn, removes it.
+    recursive subroutine lpi_set_observer_i4(sys, every, fn, user, status)
         type(c_ptr), intent(in) :: sys
-        integer, intent(in) :: every
+        integer(c_int32_t), intent(in) :: every
+        procedure(lpi_observer_fn), optional :: fn
+        type(c_ptr), intent(in), optional :: user
+        integer, intent(out), optional :: status
+        call lpi_set_observer_i8(sys, int(every, c_int64_t), fn, user, status)
+    end subroutine
+
+    recursive subroutine lpi_set_observer_i8(sys, every, fn, user, status)
+        type(c_ptr), intent(in) :: sys
+        integer(c_int64_t), intent(in) :: every
         procedure(lpi_observer_fn), optional :: fn
         type(c_ptr), intent(in), optional :: user
         integer, intent(out), optional :: status
@@ -744,7 +765,7 @@ contains
         if (present(user)) u = user
         f = c_null_funptr
         if (present(fn)) f = c_funloc(fn)
-        call finish(c_lpi_set_observer(sys, int(every, c_int64_t), f, u), sys, status)
+        call finish(c_lpi_set_observer(sys, every, f, u), sys, status)
     end subroutine
 
     recursive real(c_double) function lpi_time(sys)
@@ -1029,13 +1050,21 @@ contains
                     sys, status)
     end subroutine
 
-    recursive subroutine lpi_sine_euler_fft_floor(sys, nsteps, seconds_per_step, transforms_per_step, status)
+    recursive subroutine lpi_sine_euler_fft_floor_i4(sys, nsteps, seconds_per_step, transforms_per_step, status)
         type(c_ptr), intent(in) :: sys
-        integer, intent(in) :: nsteps
+        integer(c_int32_t), intent(in) :: nsteps
         real(c_double), intent(out) :: seconds_per_step, transforms_per_step
         integer, intent(out), optional :: status
-        call finish(c_lpi_sine_euler_fft_floor(sys, int(nsteps, c_int64_t), seconds_per_step, &
-                                               transforms_per_step), sys, status)
+        call lpi_sine_euler_fft_floor_i8(sys, int(nsteps, c_int64_t), seconds_per_step, transforms_per_step, &
+                                         status)
+    end subroutine
+
+    recursive subroutine lpi_sine_euler_fft_floor_i8(sys, nsteps, seconds_per_step, transforms_per_step, status)
+        type(c_ptr), intent(in) :: sys
+        integer(c_int64_t), intent(in) :: nsteps
+        real(c_double), intent(out) :: seconds_per_step, transforms_per_step
+        integer, intent(out), optional :: status
+        call finish(c_lpi_sine_euler_fft_floor(sys, nsteps, seconds_per_step, transforms_per_step), sys, status)
     end subroutine
 
     ! rigor: "estimate" (the default), "measure" or "patient".
@@ -1112,15 +1141,21 @@ contains
     ! energy(k), enstrophy(k): shell k (k - 1/2 <= |n| < k + 1/2), k = 1 ..
     ! shells; the arrays need at least `shells` elements (LPI_ERR_SIZE, with
     ! shells set, otherwise).
+    ! Both arrays empty: the query of the shell count (shells set, LPI_OK).
     recursive subroutine lpi_sine_euler_spectrum(sys, energy, enstrophy, shells, status)
         type(c_ptr), intent(in) :: sys
-        real(c_double), intent(inout) :: energy(:), enstrophy(:)
+        real(c_double), intent(inout), target, contiguous :: energy(:), enstrophy(:)
         integer, intent(out) :: shells
         integer, intent(out), optional :: status
         integer(c_size_t) :: count
+        type(c_ptr) :: e, z
         count = 0
-        call finish(c_lpi_sine_euler_spectrum(sys, energy, enstrophy, &
-                        int(min(size(energy), size(enstrophy)), c_size_t), count), sys, status)
+        e = c_null_ptr
+        z = c_null_ptr
+        if (size(energy) > 0) e = c_loc(energy)
+        if (size(enstrophy) > 0) z = c_loc(enstrophy)
+        call finish(c_lpi_sine_euler_spectrum(sys, e, z, int(min(size(energy), size(enstrophy)), c_size_t), &
+                                              count), sys, status)
         shells = int(count)
     end subroutine
 

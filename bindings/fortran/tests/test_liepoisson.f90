@@ -117,7 +117,7 @@ contains
         call lpi_rigid_body_create(sys, 1.0_c_double, 2.0_c_double, 3.0_c_double)
         call lpi_set_state(sys, m)
         calls = 0
-        call lpi_set_observer(sys, 5, stop_second, c_loc(calls))
+        call lpi_set_observer(sys, 5_c_int64_t, stop_second, c_loc(calls))  ! a 64-bit every, as C takes
         call lpi_step(sys, 0.01_c_double, 100, status)
         call check(status == LPI_STOPPED, "observer stops lpi_step with LPI_STOPPED")
         call check(calls == 2, "observer called twice, its own handle refused (BUSY)")
@@ -384,7 +384,7 @@ contains
         type(c_ptr) :: sys
         complex(c_double_complex) :: w(0:n - 1, 0:n - 1), back(0:n - 1, 0:n - 1), s
         real(c_double) :: grid(0:n - 1, 0:n - 1), grid2(0:n - 1, 0:n - 1), t0(4), t1(4), e
-        real(c_double) :: lambda(0:n - 1, 0:n - 1), energy(8), enstrophy(8), h
+        real(c_double) :: lambda(0:n - 1, 0:n - 1), energy(8), enstrophy(8), no_values(0), h, seconds, transforms
         character(len=*), parameter :: wisdom_path = "test_fortran_nul.wisdom"
         integer :: status, a, b, m1, m2, size_n, shells
         logical :: exists
@@ -456,8 +456,12 @@ contains
         call lpi_energy(sys, e)
         h = 0.5_c_double * sum(lambda * abs(w)**2)
         call check(abs(e - h) < 1e-14_c_double, "SQG energy is 1/2 sum |w|^2 / |m|")
+        call lpi_sine_euler_spectrum(sys, no_values, no_values, shells, status)
+        call check(status == LPI_OK .and. shells == 4, "two empty arrays ask for the shell count")
         call lpi_sine_euler_spectrum(sys, energy, enstrophy, shells)
         call check(shells == 4, "N = 7 has 4 shells (|m| up to 3 sqrt 2)")
+        call lpi_sine_euler_fft_floor(sys, 2_c_int64_t, seconds, transforms)
+        call check(seconds > 0 .and. transforms > 0, "the FFT floor, 64-bit step count")
         call check(abs(sum(energy(1:shells)) - e) < 1e-14_c_double, "energy shells add up to H")
         call lpi_sine_euler_get_stream(sys, grid2)
         lambda(0, 1) = 2
