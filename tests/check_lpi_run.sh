@@ -401,6 +401,37 @@ cmp -s "$out/ext-ref/rigid-body.csv" "$out/ext/rigid-body.csv" &&
     { echo "--resume of a run of another --dt, no --dt: not the uninterrupted run's"; exit 1; }
 rm -r "$out/ext/rigid-body"; cp "$out/ext.csv" "$out/ext/rigid-body.csv"
 refused "another --dt" run rigid-body --steps 200 --format npy --out "$out/ext" --resume "$out/ext.lpi"
+# A run that ends off the --every grid (the default --every 12 of 1234 steps)
+# is extended bit for bit, and so is the extension: its final checkpoint is
+# the last row on the grid, and the end row after it is replaced. The end's
+# state was saved: the extension split the last call of the uninterrupted
+# run, spliced the end row in (1224, 1234, 1236) and could not be resumed
+# again (refused as another --every).
+rm -rf "$out/off" "$out/off-ref"
+set -- run pendulum --format npy --out "$out/off" --checkpoint "$out/off.lpi"
+"$lpi" "$@" --steps 1234 >"$out.out"
+grep -q "checkpoint: .*off.lpi (step 1224, the last row on the --every grid" "$out.out" ||
+    { echo "a run ending off the grid: its checkpoint is not the last row on the grid"; cat "$out.out"; exit 1; }
+for steps in 3000 5000; do
+    "$lpi" "$@" --steps $steps --resume "$out/off.lpi" >/dev/null 2>"$out.err" ||
+        { echo "extended from a run ending off the grid, to $steps steps: refused"; cat "$out.err"; exit 1; }
+done
+"$lpi" run pendulum --format npy --steps 5000 --every 12 --out "$out/off-ref" >/dev/null
+cmp -s "$out/off-ref/pendulum.csv" "$out/off/pendulum.csv" &&
+    diff -r "$out/off-ref/pendulum" "$out/off/pendulum" >/dev/null ||
+    { echo "1234, 3000, then 5000 steps: not the uninterrupted run's CSV and data"; exit 1; }
+# Snapshots too: 25 steps (rows 0, 10, 20, 25), extended to 50, are the
+# uninterrupted run's (rows 0, 10, ..., 50; snapshots at steps 0 and 30).
+if [ "$have_sine_euler" = 1 ]; then
+    rm -rf "$out/off" "$out/off-ref"
+    set -- run sine-euler --N 7 --every 10 --snapshots 3 --format npy
+    "$lpi" "$@" --steps 25 --out "$out/off" --checkpoint "$out/off.lpi" >/dev/null
+    "$lpi" "$@" --steps 50 --out "$out/off" --resume "$out/off.lpi" >/dev/null
+    "$lpi" "$@" --steps 50 --out "$out/off-ref" >/dev/null
+    cmp -s "$out/off-ref/sine-euler.csv" "$out/off/sine-euler.csv" &&
+        diff -r "$out/off-ref/sine-euler" "$out/off/sine-euler" >/dev/null ||
+        { echo "sine-euler 25 steps extended to 50: not the uninterrupted run's CSV and data"; exit 1; }
+fi
 # Every value of the CSV reads back as written (the energy error had 7 digits).
 awk -F, 'NR > 2 && length($4) < 12 { bad = 1 } END { exit bad }' "$out/two/rigid-body.csv" ||
     { echo "the CSV's energy error is not written in full"; exit 1; }

@@ -618,6 +618,13 @@ int run_command(int argc, char **argv) {
         }
         if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
     }
+    // A checkpoint off the grid (the end of a run that an earlier lpi saved
+    // there, or one the grid of another --every puts there) cannot be
+    // continued bit for bit; its row, the end of a shorter call, is dropped
+    // (and a snapshot there), and the run goes on to the next row on the
+    // grid, so that the files keep the layout a later resume reads.
+    const bool drop_start_row = !o.resume.empty() && start % every != 0 && kept.size() > 1 && kept.back().step == start;
+    if (drop_start_row) kept.pop_back();
     // Row r is written after step min(r * every, end).
     auto row_index = [&](int64_t step) { return step / every + (step % every != 0); };
     // The rows and the snapshots are kept in memory until they are written,
@@ -740,7 +747,7 @@ int run_command(int argc, char **argv) {
     for (const KeptRow &r : kept) add_row(r.step, r.time, r.energy, r.casimirs);
     if (!o.resume.empty()) {
         std::string why;
-        const int status = keep_snapshots(o, start, not_kept, data, why);
+        const int status = keep_snapshots(o, drop_start_row ? start - 1 : start, not_kept, data, why);
         if (const int agreed = agreed_failure(status, why)) return agreed;
         // Data that ends before the last snapshot this run's grid puts
         // before the start (a data file older than the checkpoint, a journal
@@ -916,7 +923,8 @@ int run_command(int argc, char **argv) {
     // step 0's, or, resumed, the checkpoint step's where the data kept none
     // (no data there, another run's, or one that ends before that step),
     // taken from this state, the one the interrupted run had there.
-    if (o.resume.empty() || data.snapshot_step.empty() || data.snapshot_step.back() < static_cast<double>(start))
+    if (!drop_start_row &&
+        (o.resume.empty() || data.snapshot_step.empty() || data.snapshot_step.back() < static_cast<double>(start)))
         snapshot(start);
     save(start, true);
     Watch watch;
@@ -964,7 +972,14 @@ int run_command(int argc, char **argv) {
         progress.update(done);
     }
     progress.finish();
-    if (stopped_between_rows && !o.checkpoint.empty()) {
+    // A run that ends off the --every grid ends in a call shorter than the
+    // uninterrupted longer run's (which goes on to the next multiple of
+    // --every): a run extended from the end state would split that call in
+    // two. So its final checkpoint too is that of the last call's start, the
+    // last row on the grid, and an extension replaces the rows after it.
+    const bool off_grid_end = !stopped_between_rows && done % every != 0 && !call_start_checkpoint.empty();
+    const int64_t saved_step = stopped_between_rows || off_grid_end ? watch.call_start : done;
+    if ((stopped_between_rows || off_grid_end) && !o.checkpoint.empty()) {
         Handle at_call_start;  // one process's system: rank 0 alone saves it
         write_checkpoint(done, true, [&](const lpi_system *&saved) {
             if (!writes_output()) return static_cast<int>(LPI_OK);
@@ -974,7 +989,7 @@ int run_command(int argc, char **argv) {
             if (status == LPI_OK) status = lpi_save(at_call_start.get(), o.checkpoint.c_str());
             return status;
         });
-    } else if (!stopped_between_rows) {
+    } else if (!stopped_between_rows && !off_grid_end) {
         save(done, true, true);
     }
     // Rank 0 alone writes the CSV and the data: each, whether or not the
@@ -998,11 +1013,16 @@ int run_command(int argc, char **argv) {
         if (!o.checkpoint.empty())
             std::printf("; %s holds step %lld (the last row on the --every grid): the same command with "
                         "--resume %s continues it",
-                        o.checkpoint.c_str(), static_cast<long long>(done), o.checkpoint.c_str());
+                        o.checkpoint.c_str(), static_cast<long long>(saved_step), o.checkpoint.c_str());
         std::printf("\n");
         return 128 + interrupted_by;
     }
-    if (!o.checkpoint.empty()) std::printf("checkpoint: %s\n", o.checkpoint.c_str());
+    if (!o.checkpoint.empty() && saved_step != done)
+        std::printf("checkpoint: %s (step %lld, the last row on the --every grid: an extension of the run "
+                    "resumes there)\n",
+                    o.checkpoint.c_str(), static_cast<long long>(saved_step));
+    else if (!o.checkpoint.empty())
+        std::printf("checkpoint: %s\n", o.checkpoint.c_str());
     std::printf("done: t = %g, %.3f CPU seconds, %s energy error %.3e; wrote %s and %s\n", lpi_time(sys),
                 cpu_seconds() - t0, absolute_error() ? "absolute (H(0) = 0)" : "relative",
                 absolute_error() ? H - H0 : (H - H0) / std::fabs(H0), csv.c_str(), data_path(o).c_str());
