@@ -299,6 +299,27 @@ rm -rf "$out/stale"
 "$lpi" run rigid-body --inertia 2,3,5 --steps 10 --every 5 --out "$out/stale" --checkpoint "$out/stale.lpi" >/dev/null
 "$lpi" run rigid-body --inertia 1,2,3 --steps 10 --every 5 --out "$out/stale" >/dev/null
 refused "another run" run rigid-body --inertia 2,3,5 --steps 20 --every 5 --out "$out/stale" --resume "$out/stale.lpi"
+# The CSV and the data both reaching the checkpoint but differing before it
+# (an energy edited in the CSV, a Casimir, a row deleted): refused (2),
+# naming the step and both values, every file left as it was. The data was
+# taken for another run's, its snapshots dropped and its rows overwritten
+# with the edited CSV's (exit 0); a deleted row was refused as another --every.
+rm -rf "$out/edit" "$out/edit-kept"
+edit_run="run rigid-body --every 10 --snapshots 2 --format npy --out $out/edit"
+"$lpi" $edit_run --steps 100 --checkpoint "$out/edit.lpi" >/dev/null
+cp -r "$out/edit" "$out/edit-kept"
+edited() {  # edited AWK-PROGRAM MESSAGE-PART: the CSV so edited is refused, nothing rewritten
+    awk -F, -v OFS=, "$1" "$out/edit-kept/rigid-body.csv" > "$out/edit/rigid-body.csv"
+    cp "$out/edit/rigid-body.csv" "$out/edit.csv"
+    refused "$2" $edit_run --steps 200 --resume "$out/edit.lpi"
+    cmp -s "$out/edit.csv" "$out/edit/rigid-body.csv" &&
+        diff -r "$out/edit-kept/rigid-body" "$out/edit/rigid-body" >/dev/null ||
+        { echo "--resume over a CSV that differs from the data: a file was rewritten"; exit 1; }
+}
+edited 'NR == 4 { d = substr($3, 8, 1); $3 = substr($3, 1, 7) (d + 1) % 10 substr($3, 9) } 1' \
+    "differ: at step 20, .*rigid-body.csv has energy 0.5775.*, .*rigid-body has 0.5775.*remove .*rigid-body.csv"
+edited 'NR == 5 { $5 = $5 + 1e-9 } 1' "differ: at step 30, .*rigid-body.csv has casimir_0"
+edited 'NR != 6' "differ: .*rigid-body has a row at step 40, .*rigid-body.csv has none"
 # A CSV with rows but none at the checkpoint's step: a --dt smaller than the
 # interrupted run's puts that step past its rows, and a CSV cut short ends
 # before it. It was started anew there, every row in it lost (exit 0, a

@@ -490,33 +490,57 @@ int run_command(int argc, char **argv) {
                               file.c_str(), last.energy, static_cast<long long>(start), H);
             return "";
         };
-        // The first step at which the two copies differ (-1: none): the
-        // rows at the steps both hold, to the bit.
-        auto first_difference = [&]() -> int64_t {
-            std::size_t j = 0;
-            for (const KeptRow &r : csv_rows) {
-                while (j < data_rows.size() && data_rows[j].step < r.step) ++j;
-                if (j == data_rows.size()) break;
-                if (data_rows[j].step == r.step &&
-                    (std::memcmp(&r.time, &data_rows[j].time, sizeof(double)) != 0 ||
-                     std::memcmp(&r.energy, &data_rows[j].energy, sizeof(double)) != 0))
-                    return r.step;
+        // The first difference of the two copies ("": none), up to the
+        // last step both reach: a step that one holds and the other not, or
+        // a value (time, energy, a Casimir) not the same to the bit.
+        auto difference = [&]() -> std::string {
+            const int64_t limit = std::min(csv_rows.empty() ? -1 : csv_rows.back().step,
+                                           data_rows.empty() ? -1 : data_rows.back().step);
+            const std::string data_file = data_path(o);
+            for (std::size_t i = 0, j = 0;; ++i, ++j) {
+                const bool in_csv = i < csv_rows.size() && csv_rows[i].step <= limit,
+                           in_data = j < data_rows.size() && data_rows[j].step <= limit;
+                if (!in_csv && !in_data) return "";
+                if (!in_csv || !in_data || csv_rows[i].step != data_rows[j].step) {
+                    const bool csv_has = in_csv && (!in_data || csv_rows[i].step < data_rows[j].step);
+                    return format("%s has a row at step %lld, %s has none", (csv_has ? csv : data_file).c_str(),
+                                  static_cast<long long>(csv_has ? csv_rows[i].step : data_rows[j].step),
+                                  (csv_has ? data_file : csv).c_str());
+                }
+                const KeptRow &a = csv_rows[i], &b = data_rows[j];
+                std::vector<std::pair<std::string, std::pair<double, double>>> values = {
+                    {"time", {a.time, b.time}}, {"energy", {a.energy, b.energy}}};
+                for (std::size_t k = 0; k < a.casimirs.size() && k < b.casimirs.size(); ++k)
+                    values.push_back({format("casimir_%zu", k), {a.casimirs[k], b.casimirs[k]}});
+                for (const auto &v : values)
+                    if (std::memcmp(&v.second.first, &v.second.second, sizeof(double)) != 0)
+                        return format("at step %lld, %s has %s %.17g, %s has %.17g", static_cast<long long>(a.step),
+                                      csv.c_str(), v.first.c_str(), v.second.first, data_file.c_str(),
+                                      v.second.second);
             }
-            return -1;
         };
         const std::string csv_short = short_of_checkpoint(csv_rows, csv),
                           data_short = short_of_checkpoint(data_rows, data_path(o));
-        const int64_t differs = first_difference();
+        const std::string differs = difference();
         const std::string another_run =
-            differs < 0 ? "" : format("its row at step %lld is not that of the CSV: it is the data of another run",
-                                      static_cast<long long>(differs));
+            differs.empty() ? "" : format("its rows are not those of the CSV (%s): it is the data of another run",
+                                          differs.c_str());
+        // Both copies reach the checkpoint but differ: one was changed since
+        // lpi wrote it, and which is not for lpi to guess (taking either
+        // overwrites the other).
+        if (csv_short.empty() && data_short.empty() && !differs.empty())
+            why = format("lpi run: --resume: the CSV and the data, two copies of the rows up to the checkpoint's "
+                         "step, differ: %s. One was changed since lpi wrote it: remove %s to resume from the "
+                         "data's rows, or move %s aside to resume from the CSV's (its snapshots then lost)",
+                         differs.c_str(), csv.c_str(), data_path(o).c_str());
+        if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
         std::string rows_from;  // the file the kept rows are read from
         if (csv_short.empty()) {
             kept = std::move(csv_rows);
             rows_from = csv;
             not_kept = !earlier.there ? "no data there" : another_run;
             data_is_this_runs = not_kept.empty();
-        } else if (data_short.empty() && differs < 0) {
+        } else if (data_short.empty() && differs.empty()) {
             // The CSV moved away or cut short: its rows are the data's.
             std::printf("%s %s: its rows up to step %lld are taken from %s\n", csv.c_str(),
                         !csv_there          ? "is not there"
