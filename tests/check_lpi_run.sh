@@ -200,7 +200,7 @@ if [ "$have_sine_euler" = 1 ]; then
     # checkpoint's step, the other scene's files left as they were.
     "$lpi" run sine-euler --N 7 --dt 0.05 --steps 4 --out "$out/s7" --checkpoint "$out/se7.lpi" >/dev/null
     rm -rf "$out/s7-kept"; cp -r "$out/s7" "$out/s7-kept"
-    "$lpi" run figure2 --steps 8 --resume "$out/se7.lpi" --out "$out/s7" >"$out.out" 2>"$out.err" ||
+    "$lpi" run figure2 --steps 8 --dt 0.05 --every 2 --resume "$out/se7.lpi" --out "$out/s7" >"$out.out" 2>"$out.err" ||
         { echo "--resume of another scene's checkpoint, no file of its own there: refused"; cat "$out.err"; exit 1; }
     grep -q "new files from step 4" "$out.out" && [ "$(sed -n '2s/,.*//p' "$out/s7/figure2.csv")" = 4 ] ||
         { echo "--resume of another scene's checkpoint: no new files from its step"; cat "$out.out"; exit 1; }
@@ -361,9 +361,19 @@ cmp -s "$out/two-ref/rigid-body.csv" "$out/two/rigid-body.csv" ||
     { echo "--resume without the CSV: not the uninterrupted run's rows"; exit 1; }
 # Into an --out without a file of the run (a new or empty directory), new
 # files start at the checkpoint's step, the energy error relative to it (a
-# note says so): the uninterrupted run's rows from that step on.
+# note says so): the uninterrupted run's rows from that step on. The
+# checkpoint does not record --dt and --every, and no file there does: both
+# must be given (the scene's defaults went on at another step, the times
+# wrong: here --dt 0.02 took the checkpoint's t = 1 for step 50).
 rm -rf "$out/two-none"; mkdir "$out/two-none"
-"$lpi" run rigid-body --every 10 --steps 200 --out "$out/two-none" --resume "$out/two.lpi" >"$out.out" 2>"$out.err" ||
+refused "does not record the interrupted run's --dt and --every" run rigid-body --every 10 --steps 200 \
+    --out "$out/two-none" --resume "$out/two.lpi"
+refused "does not record the interrupted run's --dt and --every" run rigid-body --dt 0.01 --steps 200 \
+    --out "$out/two-none" --resume "$out/two.lpi"
+refused "not a whole number of steps of 0.0299" run rigid-body --dt 0.03 --every 10 --steps 200 \
+    --out "$out/two-none" --resume "$out/two.lpi"
+[ -z "$(ls "$out/two-none")" ] || { echo "a refused --resume into an empty --out wrote files"; exit 1; }
+"$lpi" run rigid-body --dt 0.01 --every 10 --steps 200 --out "$out/two-none" --resume "$out/two.lpi" >"$out.out" 2>"$out.err" ||
     { echo "--resume into an empty --out: refused"; cat "$out.err"; exit 1; }
 grep -q "new files from step 100, the energy error relative to that step" "$out.out" ||
     { echo "--resume into an empty --out: no note"; cat "$out.out"; exit 1; }

@@ -550,6 +550,14 @@ int run_command(int argc, char **argv) {
             kept = std::move(data_rows);
             rows_from = data_path(o);
             data_is_this_runs = true;
+        } else if (!files_there && (!o.given.count("--dt") || !o.given.count("--every"))) {
+            // The checkpoint (the library's format) holds no --dt nor
+            // --every, and no file of the run records them: the scene's
+            // defaults would go on at another step, the time wrong.
+            why = format("lpi run: --resume: neither %s nor the data %s is there, and the checkpoint does not "
+                         "record the interrupted run's --dt and --every: give them (--dt and --every as that run "
+                         "had them) to start new files at the checkpoint's step",
+                         csv.c_str(), data_path(o).c_str());
         } else if (!files_there) {
             // A new or empty --out: no rows to lose, and none to splice.
             std::printf("neither %s nor the data %s is there: new files from step %lld, the energy error "
