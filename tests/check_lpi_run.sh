@@ -320,6 +320,25 @@ edited 'NR == 4 { d = substr($3, 8, 1); $3 = substr($3, 1, 7) (d + 1) % 10 subst
     "differ: at step 20, .*rigid-body.csv has energy 0.5775.*, .*rigid-body has 0.5775.*remove .*rigid-body.csv"
 edited 'NR == 5 { $5 = $5 + 1e-9 } 1' "differ: at step 30, .*rigid-body.csv has casimir_0"
 edited 'NR != 6' "differ: .*rigid-body has a row at step 40, .*rigid-body.csv has none"
+# The run's data in the other --format only: refused (2), naming it, every
+# file left as it was. It was ignored ("no data there"): its options not
+# taken, its snapshots split across two files.
+rm -rf "$out/fmt-probe"
+if "$lpi" run rigid-body --steps 1 --format h5 --out "$out/fmt-probe" >/dev/null 2>&1; then
+    for formats in "h5 npy" "npy h5"; do
+        set -- $formats
+        rm -rf "$out/fmt" "$out/fmt-kept"
+        "$lpi" run rigid-body --steps 100 --every 10 --snapshots 2 --format $1 --out "$out/fmt" \
+            --checkpoint "$out/fmt.lpi" >/dev/null
+        cp -r "$out/fmt" "$out/fmt-kept"
+        refused "the data of the interrupted run is .*, of --format $1.*resume with --format $1, or move" \
+            run rigid-body --steps 200 --format $2 --out "$out/fmt" --resume "$out/fmt.lpi"
+        diff -r "$out/fmt-kept" "$out/fmt" >/dev/null ||
+            { echo "--resume --format $2 over data of --format $1: a file was written"; exit 1; }
+    done
+else
+    echo "not checked: --resume with the data in the other --format (no HDF5)"
+fi
 # A CSV with rows but none at the checkpoint's step: a --dt smaller than the
 # interrupted run's puts that step past its rows, and a CSV cut short ends
 # before it. It was started anew there, every row in it lost (exit 0, a

@@ -528,7 +528,14 @@ int run_command(int argc, char **argv) {
         // Both copies reach the checkpoint but differ: one was changed since
         // lpi wrote it, and which is not for lpi to guess (taking either
         // overwrites the other).
-        if (csv_short.empty() && data_short.empty() && !differs.empty())
+        // The run's data in the other --format: ignored, its options were
+        // not taken and its snapshots were split across two files.
+        if (!earlier.there && !other_format.empty())
+            why = format("lpi run: --resume: the data of the interrupted run is %s, of --format %s, and there is "
+                         "none of --format %s: resume with --format %s, or move %s aside",
+                         other_format.c_str(), o.format == "h5" ? "npy" : "h5", o.format.c_str(),
+                         o.format == "h5" ? "npy" : "h5", other_format.c_str());
+        else if (csv_short.empty() && data_short.empty() && !differs.empty())
             why = format("lpi run: --resume: the CSV and the data, two copies of the rows up to the checkpoint's "
                          "step, differ: %s. One was changed since lpi wrote it: remove %s to resume from the "
                          "data's rows, or move %s aside to resume from the CSV's (its snapshots then lost)",
@@ -573,9 +580,6 @@ int run_command(int argc, char **argv) {
                 why += "; and " + data_short;
             else if (!csv_short.empty() && data_short.empty())
                 why += "; and " + another_run;
-            if (!earlier.there && !other_format.empty())
-                why += format("; the data %s is there, of --format %s", other_format.c_str(),
-                              o.format == "h5" ? "npy" : "h5");
             why = "lpi run: --resume: " + why +
                   " (its rows up to the checkpoint's step, the reference of the energy errors, would be lost: "
                   "resume with the options and --out of the interrupted run, or into an --out without its "
