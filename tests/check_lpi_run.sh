@@ -128,6 +128,15 @@ if [ "$rc" -eq 0 ]; then
     else
         echo "not checked: the vorticity snapshots (no gnuplot)"
     fi
+    # Another scene's run in the same --out removes only its own earlier
+    # images (those its last vorticity.gp drew), not sine-euler's at steps it
+    # has no snapshot of (it removed every vorticity_STEP image there).
+    rm -rf "$out/shared"
+    "$lpi" run sine-euler --N 5 --steps 4 --every 1 --snapshots 2 --out "$out/shared" >/dev/null
+    for f in vorticity_000004.png vorticity_000004.svg; do [ -e "$out/shared/$f" ] || : > "$out/shared/$f"; done
+    "$lpi" run sqg --N 5 --steps 3 --every 1 --snapshots 1 --out "$out/shared" >/dev/null
+    [ -e "$out/shared/vorticity_000004.png" ] && [ -e "$out/shared/vorticity_000004.svg" ] ||
+        { echo "an sqg run removed sine-euler's images in the same --out: $(ls "$out/shared")"; exit 1; }
 elif grep -q "sine-euler is not available in this build" "$out.err"; then
     have_sine_euler=0
     echo "not checked: sine-Euler runs and checkpoints (no FFTW in this build)"

@@ -571,17 +571,29 @@ std::string match_drawings(const RunOptions &o, const RunData &d, const Snapshot
     std::set<std::string> drawn;
     for (double step : d.snapshot_step)
         for (const char *suffix : {".png", ".svg"}) drawn.insert(vorticity_image(static_cast<int64_t>(step)) + suffix);
-    std::string why;
-    if (DIR *dir = opendir(o.out_dir.c_str())) {
-        while (const dirent *entry = readdir(dir)) {
-            const std::string name = entry->d_name;
+    // The images the script of this scene's last run drew (its titles name
+    // the scene) that this data does not: another scene's in the same --out,
+    // and images lpi did not write, are not this run's to remove.
+    std::string why, old_script;
+    struct stat st;
+    const std::string script_path = o.out_dir + "/vorticity.gp";
+    if (stat(script_path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && read_input(script_path, old_script).empty() &&
+        old_script.find("\nset title '" + o.scene + ", ") != std::string::npos) {
+        const std::string prefix = "set output '";
+        for (std::size_t from = 0; from < old_script.size();) {
+            std::size_t end = old_script.find('\n', from);
+            if (end == std::string::npos) end = old_script.size();
+            const std::string line = old_script.substr(from, end - from);
+            from = end + 1;
+            if (line.rfind(prefix, 0) != 0 || line.size() < prefix.size() + 1 || line.back() != '\'') continue;
+            const std::string name = line.substr(prefix.size(), line.size() - prefix.size() - 1);
             const std::string suffix = name.size() > 4 ? name.substr(name.size() - 4) : "";
             const bool image = name.rfind("vorticity_", 0) == 0 && (suffix == ".png" || suffix == ".svg") &&
                                name.find_first_not_of("0123456789", 10) == name.size() - 4;
-            if (image && !drawn.count(name) && unlink((o.out_dir + "/" + name).c_str()) != 0 && why.empty())
+            if (image && !drawn.count(name) && unlink((o.out_dir + "/" + name).c_str()) != 0 && errno != ENOENT &&
+                why.empty())
                 why = "cannot remove " + o.out_dir + "/" + name + ": " + std::strerror(errno);
         }
-        closedir(dir);
     }
     const std::string script = o.out_dir + "/vorticity.gp";
     if (d.snapshot_step.empty() || bytes.offset == UINT64_MAX) {

@@ -156,7 +156,8 @@ int keep_snapshots(const RunOptions &o, int64_t start, const std::string &not_ke
 int initial_grid(const std::string &path, int *N, std::vector<double> &grid, std::string &why);
 
 // Puts what is drawn from the data in step with it once it is written: the
-// images of steps it holds no snapshot of are removed, and DIR/vorticity.gp
+// images that DIR/vorticity.gp, where it is this scene's, drew of steps the
+// data holds no snapshot of are removed (not another scene's), and DIR/vorticity.gp
 // is written for it (removed where it holds no snapshot): gnuplot reads the
 // snapshots at their byte offset, and a script or images left by an earlier
 // run drew another run's data. "" or why not.
