@@ -1,6 +1,5 @@
 #include "run_data.hpp"
 
-#include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
