@@ -430,6 +430,11 @@ void test_refusals_leave_x_unchanged(void **) {
     lpi::SparseExponential shear(4, shear_terms);
     assert_int_equal(shear.depth(), 1);
     expect_refusal(shear, huge, 1e10, x, LPI_ERR_NONFINITE, "component 2");
+    // A kick: one node of one term.
+    const std::vector<lpi::SparseTerm> kick_terms = {{2, 3, 0, 1.0}};
+    lpi::SparseExponential kick(4, kick_terms);
+    assert_int_equal(kick.depth(), 1);
+    expect_refusal(kick, &huge[1], 1e10, x, LPI_ERR_NONFINITE, "component 2");
     // A rotation generator beyond 2^32 squarings, and a hyperbolic plane whose
     // exponential overflows.
     const std::vector<lpi::SparseTerm> plane = {{0, 3, 0, 1.0}, {3, 0, 1, 1.0}};
@@ -450,6 +455,7 @@ void test_refusals_leave_x_unchanged(void **) {
     const double one[2] = {1.0, 1.0};
     expect_refusal(series, one, 1.0, edge, LPI_ERR_NONFINITE, "component 1");
     expect_refusal(shear, one, 1.0, edge, LPI_ERR_NONFINITE, "component 1");
+    expect_refusal(kick, one, 1.0, edge, LPI_ERR_NONFINITE, "component 2");
     const double turn[2] = {0.5, -0.5};  // a rotation by 0.5: 1.5e308 (cos + sin) > DBL_MAX
     expect_refusal(closed, turn, 1.0, edge, LPI_ERR_NONFINITE, "component 0");
     const double small = 0.5;
@@ -580,6 +586,25 @@ void test_shear(void **) {
     const double exact2 = x[2] + (2.5L * s1 + 1.5L * s0) * x[0];  // the flow for times s_p
     assert_true(std::fabs(z[2] - exact2) <= 4 * 2.2e-16 * std::fabs(exact2));
     assert_true(z[1] == y[1] && z[4] == y[4]);
+
+    // A kick (one node, one term: applied without the loops) takes the bits
+    // of the same term among others, zeros of either sign included.
+    const std::vector<lpi::SparseTerm> kick_terms = {{2, 0, 1, 2.5}};
+    lpi::SparseExponential kick(5, kick_terms);
+    assert_int_equal(kick.depth(), 1);
+    const double zeros[][2] = {{0.0, 0.0}, {-0.0, 0.0}, {0.0, -0.0}, {-0.0, -0.0}, {1.1, -0.0}, {-0.0, 2.2}};
+    for (const auto &pair : zeros)
+        for (double sign : {1.0, -1.0}) {
+            std::vector<double> a = x, b = x;
+            a[0] = b[0] = pair[0];
+            a[2] = b[2] = pair[1];
+            kick.apply(g, sign * t, a.data());
+            shear.apply(g, sign * t, b.data());
+            assert_true(std::memcmp(&a[2], &b[2], sizeof(double)) == 0);
+            a[2] = b[2];
+            for (std::size_t i = 0; i < x.size(); ++i)
+                if (i != 1 && i != 4) assert_true(std::memcmp(&a[i], &b[i], sizeof(double)) == 0);
+        }
 }
 
 // A component the flow contracts keeps its relative accuracy, however far:

@@ -343,6 +343,9 @@ private:
     LPI_TARGET_FMA void scale_fma(double *x);
 #endif
     bool shear(double *x);  // depth 1, x untouched on failure
+    // shear_ with one node of one term (a kick): shear's arithmetic without
+    // its loops, s_p formed here (the same bits).
+    bool single_shear(const double *g, double t, double *x);
     void apply_plane(double t, double *x);  // a block of order 1 or 2
     // The plane's elliptic flows: M = exp(t A) as three shears (see
     // elliptic_shears), applied to x0, x1.
@@ -363,6 +366,7 @@ private:
     ExpmPath path_ = ExpmPath::Nilpotent;
     std::size_t depth_ = 0;
     bool shear_ = false;  // depth 1, one term a position: shear() applies it
+    bool single_shear_ = false;  // and one node of one term: single_shear()
     // A plane whose t A is [[0, b], [-b, 0]], b = rotation_coefficient_ s_p
     // (so(3)'s axes, e(2)'s rotation): rotate() applies it.
     bool rotation_ = false;
