@@ -11,8 +11,9 @@
 //      given the same structure constants (the general plan, made when the
 //      piece is added); and the squeeze S(x2) (the paper's H2 without x6:
 //      every moment scaled by its weight) vs one exponential and its powers;
-//      each piece alone, called back to back, and V then T in turn, as a
-//      splitting calls them: each moves the fixed indices of the other, so
+//      each piece alone, called back to back, and pairs in turn (e(2)'s kick
+//      and rotation, V then T, S then V), as a splitting calls them: each
+//      moves the fixed indices of the other, so
 //      one flow cannot start before the last has finished, while calls of
 //      one piece alone overlap in the processor (its fixed indices, and
 //      with them most of its work, do not depend on the last call), which
@@ -382,7 +383,9 @@ void piece_flows() {
                 [&quartic](double t, double *x) { potential_flow(quartic, t, x); }, mm, x0, 0.05);
     report_pair("(c) T, generic: general plan", kBefore.kinetic, piece_flow(gm, 1), gm,
                 [&quartic](double t, double *x) { kinetic_flow(quartic, t, x); }, mm, x0, 0.05);
-    std::printf("  V then T, as a splitting calls them (each moves the other's fixed indices):\n");
+    std::printf("  pieces in turn, as a splitting calls them (each moves the other's fixed indices):\n");
+    report_pair("(b) e(2) kick, rotation", NAN, in_turn(model_of(e2), {0, 1}), model_of(e2),
+                in_turn(model_of(pendulum), {0, 1}), model_of(pendulum), p0, 0.1, 2);
     const Flow hand_pair = [&quartic](double t, double *x) {
         if (t > 0) {
             potential_flow(quartic, t, x);
@@ -397,12 +400,25 @@ void piece_flows() {
     report_pair("(c) V, T: generic (general)", NAN, in_turn(gm, {0, 1}), gm, hand_pair, mm, x0,
                 0.05, 2);
     lpi_destroy(declared);
+    // The squeeze with V: S moves V's fixed x1 and x4, V moves S's x2.
     lpi_system *squeeze = nullptr;
     check(lpi_moments_create(&squeeze), nullptr, "moments");
-    const int32_t momentum[1] = {1};
+    const int32_t momentum[1] = {1}, potential[2] = {0, 3};
     check(lpi_add_piece(squeeze, 1, momentum, squeeze_gradient, squeeze_energy, nullptr), squeeze, "S");
+    check(lpi_add_piece(squeeze, 2, potential, quartic_gradient, quartic_energy, nullptr), squeeze, "V");
     lpi::Model &sm = model_of(squeeze);
     const UserGradient squeezing = opaque_gradient(squeeze_gradient);
+    const Flow hand_squeeze = [&squeezing, &quartic](double t, double *x) {
+        if (t > 0) {
+            squeeze_flow(squeezing, t, x);
+            potential_flow(quartic, t, x);
+        } else {
+            potential_flow(quartic, t, x);
+            squeeze_flow(squeezing, t, x);
+        }
+    };
+    report_pair("(c) S, V: moments (compiled)", NAN, in_turn(sm, {0, 1}), sm, hand_squeeze, sm, x0, 0.05, 2);
+    std::printf("  and alone, called back to back:\n");
     report_pair("(c) moments squeeze S(x2)", kBefore.squeeze, piece_flow(sm, 0), sm,
                 [&squeezing](double t, double *x) { squeeze_flow(squeezing, t, x); }, sm, x0, 0.05);
     lpi_destroy(squeeze);
