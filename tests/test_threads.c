@@ -9,8 +9,10 @@
  * under ThreadSanitizer by `make check-tsan`. */
 #define _GNU_SOURCE
 #include <dlfcn.h>
+#include <math.h>
 #include <pthread.h>
 #include <sched.h>
+#include <stdatomic.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -19,6 +21,13 @@
 #endif
 
 #include "lpi_test.h"
+
+/* Valgrind runs one thread at a time (a race a test sets up cannot happen),
+ * and has its own mappings (an address-space limit leaves no room). */
+static int under_valgrind(void) {
+    const char *preload = getenv("LD_PRELOAD");
+    return preload && strstr(preload, "vgpreload");
+}
 
 enum { kKinds = 6, kCopies = 2, kMaxDim = 2 * 15 * 15 };
 
@@ -233,9 +242,7 @@ static void test_refused_threads_give_a_status(void **state) {
     /* An address-space limit does not mix with a sanitizer's shadow memory
      * and allocator, or with valgrind's own mappings. */
     LPI_SKIP_UNDER_A_SANITIZER();
-    const char *preload = getenv("LD_PRELOAD");
-    if (preload && strstr(preload, "vgpreload"))
-        LPI_SKIP("thread limits under a low RLIMIT_AS: not under valgrind");
+    if (under_valgrind()) LPI_SKIP("thread limits under a low RLIMIT_AS: not under valgrind");
     fflush(stdout);
     const pid_t child = fork();
     assert_true(child >= 0);
@@ -402,6 +409,198 @@ static void test_fork_after_threads(void **state) {
                  WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : WTERMSIG(wait_status));
 }
 
+/* The child's exit: 0 when it ended by itself with status 0, else fails. */
+static void expect_child_passed(pid_t child, const char *what) {
+    int wait_status = 0;
+    assert_int_equal(waitpid(child, &wait_status, 0), child);
+    if (!WIFEXITED(wait_status) || WEXITSTATUS(wait_status) != 0)
+        fail_msg("%s: the child of fork %s %d", what, WIFEXITED(wait_status) ? "failed check" : "was killed by signal",
+                 WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : WTERMSIG(wait_status));
+}
+
+/* An observer that forks in the middle of a two-thread step: the child ends
+ * the step (its flows on one thread, the same bits) where libgomp's team
+ * waited for ever for the parent's threads. */
+static int fork_at_step_5(const lpi_system *sys, int64_t step, double t, void *user) {
+    (void)sys, (void)t;
+    if (step == 5) {
+        fflush(stdout);
+        *(pid_t *)user = fork();
+        if (*(pid_t *)user == 0) alarm(60);
+    }
+    return 0;
+}
+enum { kForkN = 47 }; /* several blocks of lines a flow: two threads share them */
+static lpi_system *smooth_field(void) {
+    lpi_system *sys = NULL;
+    if (lpi_sine_euler_create(&sys, kForkN) != LPI_OK) return NULL;
+    static double grid[kForkN * kForkN];
+    for (int a = 0; a < kForkN; ++a)
+        for (int b = 0; b < kForkN; ++b)
+            grid[a * kForkN + b] = cos(2 * M_PI * a / kForkN) + 0.5 * sin(2 * M_PI * (a + 2 * b) / kForkN);
+    if (lpi_sine_euler_set_grid(sys, grid, kForkN * kForkN) != LPI_OK) return NULL;
+    return sys;
+}
+static void test_fork_inside_a_step(void **state) {
+    (void)state;
+    static double parent[2 * kForkN * kForkN], w[2 * kForkN * kForkN];
+    const size_t n = 2 * kForkN * kForkN;
+    if (modes_after_steps(smooth_field(), 1, 10, parent, n) != LPI_OK)
+        LPI_SKIP("fork inside a step: built without FFTW");
+    lpi_system *sys = smooth_field();
+    const int threads = lpi_set_threads(sys, 2);
+    if (threads == LPI_ERR_UNSUPPORTED) {
+        lpi_destroy(sys);
+        LPI_SKIP("fork inside a step: built without OpenMP");
+    }
+    assert_int_equal(threads, LPI_OK);
+    pid_t child = -1;
+    assert_int_equal(lpi_set_observer(sys, 1, fork_at_step_5, &child), LPI_OK);
+    const int status = lpi_step(sys, 0.01, 10);
+    if (child == 0) {
+        const int got = lpi_sine_euler_get_modes(sys, w, n);
+        _exit(status != LPI_OK || got != LPI_OK ? 1 : memcmp(w, parent, sizeof w) != 0 ? 2 : 0);
+    }
+    assert_true(child > 0);
+    assert_int_equal(status, LPI_OK);
+    assert_int_equal(lpi_sine_euler_get_modes(sys, w, n), LPI_OK);
+    assert_memory_equal(w, parent, sizeof w);
+    lpi_destroy(sys);
+    expect_child_passed(child, "fork inside a two-thread step");
+}
+
+/* A host's own OpenMP region on a thread, then a fork from it: the child asks
+ * for two threads there. libgomp's team would wait for ever for the
+ * parent's threads, which the library cannot see were started: refused
+ * (LPI_ERR_UNSUPPORTED), where lpi_set_threads hung; libomp runs them. */
+#ifdef _OPENMP
+static void *host_region_then_fork(void *result) {
+    int sum = 0;
+#pragma omp parallel num_threads(2) reduction(+ : sum)
+    sum += 1;
+    fflush(stdout);
+    const pid_t child = fork();
+    if (child == 0) {
+        alarm(60);
+        lpi_system *sys = sine_euler_15();
+        const int status = lpi_set_threads(sys, 2);
+        const int libomp = dlsym(RTLD_DEFAULT, "kmp_get_stacksize_s") != NULL;
+        if (status != (libomp ? LPI_OK : LPI_ERR_UNSUPPORTED)) _exit(1);
+        if (!libomp && !strstr(lpi_last_error(sys), "fork")) _exit(2);
+        double w[2 * 15 * 15];
+        if (lpi_set_threads(sys, 1) != LPI_OK || lpi_step(sys, 0.01, 20) != LPI_OK ||
+            lpi_sine_euler_get_modes(sys, w, 2 * 15 * 15) != LPI_OK)
+            _exit(3);
+        _exit(0);
+    }
+    *(pid_t *)result = sum == 2 || sum == 1 ? child : -1;
+    return NULL;
+}
+#endif
+static void test_fork_after_a_host_region(void **state) {
+    (void)state;
+#ifndef _OPENMP
+    LPI_SKIP("a host region before fork: this test is built without OpenMP");
+#else
+    double w[2 * 15 * 15];
+    if (fifteen_after_20_steps(1, w) != LPI_OK) LPI_SKIP("a host region before fork: built without FFTW");
+    if (fifteen_after_20_steps(2, w) == LPI_ERR_UNSUPPORTED)
+        LPI_SKIP("a host region before fork: the library is built without OpenMP");
+    pthread_t host;
+    pid_t child = -1;
+    assert_int_equal(pthread_create(&host, NULL, host_region_then_fork, &child), 0);
+    assert_int_equal(pthread_join(host, NULL), 0);
+    assert_true(child > 0);
+    expect_child_passed(child, "a host region, then fork");
+#endif
+}
+
+/* Another thread planning (a new system, FFTW's patient planner) while the
+ * process forks: the child's first plan waited for ever for the planner
+ * lock the other thread held at the fork; the fork now waits for it. */
+static atomic_int keep_planning = 1;
+static void *plan_in_a_loop(void *unused) {
+    (void)unused;
+    while (keep_planning) {
+        lpi_system *sys = NULL;
+        if (lpi_sine_euler_create(&sys, 45) != LPI_OK) break;
+        lpi_sine_euler_set_planning(sys, "patient");
+        lpi_step(sys, 0.01, 1);
+        lpi_destroy(sys);
+    }
+    return NULL;
+}
+static void test_fork_while_another_thread_plans(void **state) {
+    (void)state;
+    if (under_valgrind()) LPI_SKIP("fork while another thread plans: valgrind runs one thread at a time");
+    double w[2 * 15 * 15];
+    if (fifteen_after_20_steps(1, w) != LPI_OK) LPI_SKIP("fork while planning: built without FFTW");
+    keep_planning = 1;
+    pthread_t planner;
+    assert_int_equal(pthread_create(&planner, NULL, plan_in_a_loop, NULL), 0);
+    for (int i = 0; i < 5; ++i) {
+        usleep(20000);
+        fflush(stdout);
+        const pid_t child = fork();
+        assert_true(child >= 0);
+        if (child == 0) {
+            alarm(60);
+            double v[2 * 15 * 15];
+            _exit(fifteen_after_20_steps(1, v) != LPI_OK ? 1 : memcmp(v, w, sizeof v) != 0 ? 2 : 0);
+        }
+        expect_child_passed(child, "fork while another thread plans");
+    }
+    keep_planning = 0;
+    assert_int_equal(pthread_join(planner, NULL), 0);
+}
+
+/* A host planning with FFTW on its own thread while the library plans: FFTW's
+ * planner is the process's, and the library's own lock did not cover the
+ * host's plans (the heap corrupted: "double free", or FFTW's assertions). */
+#if LPI_TEST_WITH_FFTW
+#include <fftw3.h>
+static atomic_int host_plans = 1;
+static void *host_plans_with_fftw(void *count) {
+    fftw_complex *buffer = fftw_alloc_complex(64);
+    long plans = 0;
+    while (host_plans) {
+        fftw_plan plan = fftw_plan_dft_1d(17 + (int)(plans % 40), buffer, buffer, FFTW_FORWARD, FFTW_ESTIMATE);
+        fftw_destroy_plan(plan);
+        ++plans;
+    }
+    fftw_free(buffer);
+    *(long *)count = plans;
+    return NULL;
+}
+#endif
+static void test_host_plans_beside_the_library(void **state) {
+    (void)state;
+#if !LPI_TEST_WITH_FFTW
+    LPI_SKIP("a host's own FFTW plans: the library is built without FFTW");
+#else
+    if (under_valgrind()) LPI_SKIP("a host's own FFTW plans: valgrind runs one thread at a time");
+    host_plans = 1;
+    long plans = 0;
+    pthread_t host;
+    assert_int_equal(pthread_create(&host, NULL, host_plans_with_fftw, &plans), 0);
+    for (int i = 0; i < 40; ++i) {
+        lpi_system *sys = NULL;
+        const int N = 3 + 2 * (i % 20);
+        assert_int_equal(lpi_sine_euler_create(&sys, N), LPI_OK);
+        double grid[41 * 41] = {0};
+        grid[1] = 1.0, grid[N] = 2.0;
+        assert_int_equal(lpi_sine_euler_set_grid(sys, grid, (size_t)N * N), LPI_OK);
+        assert_int_equal(lpi_step(sys, 0.01, 1), LPI_OK);
+        assert_int_equal(lpi_sine_euler_set_planning(sys, "measure"), LPI_OK);
+        assert_int_equal(lpi_step(sys, 0.01, 1), LPI_OK);
+        assert_int_equal(lpi_destroy(sys), LPI_OK);
+    }
+    host_plans = 0;
+    assert_int_equal(pthread_join(host, NULL), 0);
+    print_message("the host made %ld plans beside the library's\n", plans);
+#endif
+}
+
 static void test_thread_count_bound(void **state) {
     (void)state;
     lpi_system *sys = sine_euler_15();
@@ -547,6 +746,10 @@ int main(void) {
         cmocka_unit_test(test_steps_inside_a_host_parallel_region),
         cmocka_unit_test(test_threads_asked_inside_a_host_parallel_region),
         cmocka_unit_test(test_fork_after_threads),
+        cmocka_unit_test(test_fork_inside_a_step),
+        cmocka_unit_test(test_fork_after_a_host_region),
+        cmocka_unit_test(test_fork_while_another_thread_plans),
+        cmocka_unit_test(test_host_plans_beside_the_library),
         cmocka_unit_test(test_another_thread_is_refused),
         cmocka_unit_test(test_two_threads_at_once),
     };

@@ -2,6 +2,7 @@
 #include "lapack.hpp"
 
 #include <dlfcn.h>
+#include <pthread.h>
 #include <sched.h>
 
 #include <algorithm>
@@ -73,6 +74,10 @@ void require_openblas_memory(std::size_t bytes, const std::string &for_what, con
 
 const Routines &routines() {
     static std::mutex mutex;
+    // As the FFTW planner's (transforms.cpp): a fork(2) while another thread
+    // held it left the child's copy locked for ever.
+    [[maybe_unused]] static const int released_after_fork =
+        pthread_atfork([] { mutex.lock(); }, [] { mutex.unlock(); }, [] { mutex.unlock(); });
     static Routines loaded;
     std::lock_guard<std::mutex> lock(mutex);
     if (loaded.zheevd) return loaded;

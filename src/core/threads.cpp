@@ -3,6 +3,7 @@
 #include <cctype>
 #include <condition_variable>
 #include <cstdlib>
+#include <cstring>
 #include <mutex>
 #include <string>
 #include <system_error>
@@ -13,7 +14,9 @@
 #include "lpi_config.h"
 
 #include <dlfcn.h>
+#include <fcntl.h>
 #include <pthread.h>
+#include <unistd.h>
 
 #if LPI_HAVE_OPENMP
 #include <omp.h>
@@ -193,26 +196,49 @@ thread_local int ready = 1;
 // In a child of fork(2) no thread of the parent's teams exists. libgomp does
 // not rebuild a thread's pool there: a team started on the forking thread
 // waits forever for threads that were not copied, so the child handler marks
-// that thread's pool lost when it had one (a new thread of the child starts a
-// pool of its own). libomp starts afresh in a child, and its teams need new
-// threads, which the probe is to check first.
+// that thread's pool lost when it may have had one (a new thread of the
+// child starts a pool of its own). The library knows its own teams; a host's
+// (its own parallel regions before the fork) it cannot see, so a parent with
+// any other thread at the fork counts as one that may have had a team: a
+// child's lpi_set_threads waited for ever there. libomp starts afresh in a
+// child, and its teams need new threads, which the probe is to check first.
 thread_local bool pool_lost = false;
+// Threads of the process just before the last fork (0: unknown).
+long threads_at_fork = 0;
+// From /proc/self/stat (field 20), with calls that are safe in any fork
+// handler; 0 when it cannot be read.
+long count_threads() {
+    const int fd = ::open("/proc/self/stat", O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return 0;
+    char text[1024];
+    const ssize_t length = ::read(fd, text, sizeof text - 1);
+    ::close(fd);
+    if (length <= 0) return 0;
+    text[length] = '\0';
+    // The name (field 2) is in parentheses and may hold spaces: count from
+    // the last ')', which field 3 follows.
+    const char *p = std::strrchr(text, ')');
+    for (int field = 2; p && field < 20; ++field) p = std::strchr(p + 1, ' ');
+    return p ? std::strtol(p + 1, nullptr, 10) : 0;
+}
+void count_threads_before_fork() { threads_at_fork = count_threads(); }
 void forget_pool_in_child() {
     if (kmp_runtime())
         ready = 1;
-    else if (ready > 1)
+    else if (ready > 1 || threads_at_fork != 1)
         pool_lost = true;
 }
-[[maybe_unused]] const int fork_handler = pthread_atfork(nullptr, nullptr, forget_pool_in_child);
+[[maybe_unused]] const int fork_handler = pthread_atfork(count_threads_before_fork, nullptr, forget_pool_in_child);
 
 }  // namespace
 
 void prepare_thread_team(int n) {
     if (n > 1 && pool_lost)
         fail(LPI_ERR_UNSUPPORTED, "cannot run " + std::to_string(n) + " threads on this thread of a child of "
-                                  "fork(2): the library ran OpenMP threads on it before the fork, and "
-                                  "libgomp does not start them again in a child (use one thread here, or "
-                                  "another thread of the child)");
+                                  "fork(2): this thread may hold a team of OpenMP threads of the parent (the "
+                                  "library's, or the host's: the parent had other threads at the fork), and "
+                                  "libgomp does not start them again in a child, but waits for them for ever "
+                                  "(use one thread here, or another thread of the child)");
     if (n <= ready) {
         if (n > 1) ready = n;
         return;
@@ -233,9 +259,12 @@ void prepare_thread_team(int n) {
     ready = n;
 }
 
+int team_size_here(int n) { return n > 1 && pool_lost ? 1 : n; }
+
 #else
 
 void prepare_thread_team(int) {}
+int team_size_here(int n) { return n; }
 
 #endif
 

@@ -27,6 +27,12 @@ void check_thread_count(int n);
 // cause, when the system refuses a thread. Without OpenMP, or n <= 1, nothing.
 void prepare_thread_team(int n);
 
+// The threads a team asked for n may have on the calling thread now: 1 where
+// its OpenMP pool was lost to a fork(2) since the call prepared it (an
+// observer that forks in the middle of a step: the child's team would wait
+// for ever), else n. Results are the same for every thread count.
+int team_size_here(int n);
+
 // Starts `count` threads (default stack size) that all exist at once and
 // joins them: for a library that starts as many when it is loaded, and ends
 // the process when the system refuses one (a threaded OpenBLAS). Throws

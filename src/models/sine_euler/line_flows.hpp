@@ -9,8 +9,10 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <thread>
 
 #include "../../core/error.hpp"
+#include "../../core/threads.hpp"
 #include "kernels.hpp"
 #include "lpi_config.h"
 #include "projective_line.hpp"
@@ -54,6 +56,32 @@ inline void spin_pause() {
 #endif
 }
 
+// A wait for another thread of the team: spins, then yields the processor.
+// With more threads than free processors the thread waited for may be the
+// one not running, and a wait that only spun held the processor it needed
+// for the rest of its time slice: 3 and 4 threads on a 2-core host took 9 to
+// 19 s for two steps at N = 125, against 0.15 s on one. The spins cover a
+// block's transform (about 13 us at N = 125), the usual wait, so a team on
+// free processors never yields; `yield_at` is 16 where the team has more
+// threads than the process has processors.
+class TeamWait {
+public:
+    explicit TeamWait(int yield_at) : yield_at_(yield_at) {}
+    void operator()() {
+        if (++spins_ < yield_at_) {
+            spin_pause();
+            return;
+        }
+        spins_ = 0;
+        std::this_thread::yield();
+    }
+    void reset() { spins_ = 0; }
+
+private:
+    int spins_ = 0;
+    int yield_at_;
+};
+
 // Writes the phase tables of the transformed line spectrum (write_phase),
 // then, for every block b of `lines` lines and a block buffer x, calls
 // gather(b, x) (the lines out of the modes), transform(b, x) (forward,
@@ -81,7 +109,9 @@ void run_line_flows(LineTransforms &T, int N, int lines, int threads, double fac
     const int blocks = blocks_of(lines);
     auto phase = [&](int l) { write_phase(N, l, factor, T.spectrum(), T.phase()); };
 #if LPI_HAVE_OPENMP
+    threads = team_size_here(threads);
     if (threads > 1 && blocks > 1) {
+        const int yield_at = threads > omp_get_num_procs() ? 16 : 1 << 12;
         enum : int { kEmpty, kGathered, kTransformed };
         std::atomic<int> *stage = T.handover();
         for (int b = 0; b < blocks; ++b) stage[b].store(kEmpty, std::memory_order_relaxed);
@@ -119,30 +149,37 @@ void run_line_flows(LineTransforms &T, int N, int lines, int threads, double fac
                 // The writer: gather up to a ring ahead, scatter in order,
                 // transform when neither can go on.
                 int gathered = 0, scattered = 0;
+                TeamWait wait(yield_at);
                 while (scattered < blocks) {
                     if (gathered < blocks && gathered - scattered < ring) {
                         gather(gathered, buffer(gathered));
                         stage[gathered].store(kGathered, std::memory_order_release);
                         ++gathered;
+                        wait.reset();
                     } else if (stage[scattered].load(std::memory_order_acquire) == kTransformed) {
                         scatter(scattered, buffer(scattered));
                         ++scattered;
+                        wait.reset();
                     } else {
                         int b = next_transform.load(std::memory_order_relaxed);
                         if (b < gathered && phase_tables_written() &&
-                            next_transform.compare_exchange_strong(b, b + 1))
+                            next_transform.compare_exchange_strong(b, b + 1)) {
                             transform_and_hand_back(b);
-                        else
-                            spin_pause();
+                            wait.reset();
+                        } else {
+                            wait();
+                        }
                     }
                 }
             } else {
                 const int range = this_thread() - 1;
                 for (int l = N * range / transformers; l < N * (range + 1) / transformers; ++l) phase(l);
                 phases_written.fetch_add(1, std::memory_order_release);
-                while (!phase_tables_written()) spin_pause();
+                TeamWait wait(yield_at);
+                while (!phase_tables_written()) wait();
                 for (int b; (b = next_transform.fetch_add(1)) < blocks;) {
-                    while (stage[b].load(std::memory_order_acquire) != kGathered) spin_pause();
+                    wait.reset();
+                    while (stage[b].load(std::memory_order_acquire) != kGathered) wait();
                     transform_and_hand_back(b);
                 }
             }
@@ -194,7 +231,7 @@ inline double time_line_transforms(LineTransforms &T, int N, int lines, int thre
         // As run_line_flows: one thread runs plain loops and enters no
         // OpenMP region (libgomp exits the process when it cannot allocate
         // a region's team).
-        if (threads > 1 && blocks > 1) {
+        if (team_size_here(threads) > 1 && blocks > 1) {
 #pragma omp parallel for num_threads(threads) schedule(static)
             for (int b = 0; b < blocks; ++b) transform_block(b, T.block(static_cast<std::size_t>(this_thread())));
             continue;

@@ -10,6 +10,8 @@
 #include <mutex>
 #include <new>
 
+#include <pthread.h>
+
 
 #include "../../core/error.hpp"
 #include "../../core/files.hpp"
@@ -26,8 +28,26 @@
 
 namespace lpi {
 
+#if LPI_HAVE_FFTW && LPI_HAVE_FFTW_THREADS
+namespace {
+// The library's lock (below) serialises its own plans; FFTW's planner is the
+// process's, and a host planning on another thread beside them corrupted its
+// heap ("double free"). FFTW's own planner lock, taken by every plan and
+// destroy_plan whoever calls them, covers both. Installed as the library
+// loads: installed while a host's thread was inside the planner, the hook
+// released a lock that plan had never taken (FFTW aborted).
+[[maybe_unused]] const bool planner_thread_safe = (fftw_make_planner_thread_safe(), true);
+}  // namespace
+#endif
+
 std::mutex &fftw_planner_mutex() {
     static std::mutex mutex;
+    // A fork(2) while another thread planned left the child's copy locked,
+    // and its next plan waited for ever: the fork waits for the planner, and
+    // both processes release it. (No thread forks while it holds it: no user
+    // code runs under it.)
+    [[maybe_unused]] static const int released_after_fork =
+        pthread_atfork([] { mutex.lock(); }, [] { mutex.unlock(); }, [] { mutex.unlock(); });
     return mutex;
 }
 
