@@ -47,7 +47,7 @@ if [ "$have_h5" = 1 ]; then
 fi
 # The raw data is kept beside the images drawn from it.
 if command -v gnuplot >/dev/null 2>&1; then
-    for f in vorticity_000000.png vorticity_000012.svg; do [ -s "$out/npy/$f" ] || fail "no $f"; done
+    for f in sine-euler_vorticity_000000.png sine-euler_vorticity_000012.svg; do [ -s "$out/npy/$f" ] || fail "no $f"; done
     [ -s "$v" ] || fail "the snapshot data was removed after plotting"
 fi
 

@@ -86,7 +86,7 @@ if [ "$have_se" = 1 ]; then
         [ ! -e "$out/INJECTED2" ] || fail "a gnuplot command in --out was run"
     fi
     # A plot that is not drawn fails the command, naming the file.
-    PATH="$bad_path" expect 1 "vorticity.gp.*fake gnuplot" run sine-euler --N 5 --steps 2 --out "$out/p1"
+    PATH="$bad_path" expect 1 "sine-euler_vorticity.gp.*fake gnuplot" run sine-euler --N 5 --steps 2 --out "$out/p1"
     PATH="$bad_path" expect 1 "figure2.gp.*fake gnuplot" report figure2 --out "$out/p2"
     PATH="$bad_path" expect 1 "sine-euler-long.gp.*fake gnuplot" report sine-euler-long --N 5 --T 5 --out "$out/p3"
     PATH="$bad_path" expect 1 "rollup.gp.*fake gnuplot" run rollup --N 5 --steps 3 --out "$out/p4"
@@ -95,7 +95,7 @@ if [ "$have_se" = 1 ]; then
     PATH="$ok_path" "$lpi" run sine-euler --N 5 --steps 2 --out "$out/p8" >/dev/null
     PATH="$ok_path" "$lpi" run rollup --N 5 --steps 3 --out "$out/p9" >/dev/null
     (cd "$out" && md5sum p8/*.png p8/*.svg p9/*.png p9/*.svg > "$out/images.md5")
-    PATH="$out/empty-gnuplot:$PATH" expect 1 "vorticity_000000.png (it is empty" run sine-euler --N 5 --steps 2 \
+    PATH="$out/empty-gnuplot:$PATH" expect 1 "sine-euler_vorticity_000000.png (it is empty" run sine-euler --N 5 --steps 2 \
         --out "$out/p8"
     PATH="$out/cut-gnuplot:$PATH" expect 1 "rollup.svg (the SVG is cut short" run rollup --N 5 --steps 3 --out "$out/p9"
     (cd "$out" && md5sum -c --quiet "$out/images.md5") || fail "an unfinished image replaced a good one"
@@ -125,21 +125,22 @@ if [ "$have_se" = 1 ]; then
     expect 1 "figure2.csv.*directory" report figure2 --out "$out/p10"
     ! grep -q -e "^== figure2" -e "files are in" "$out/stdout" ||
         { cat "$out/stdout"; fail "lpi report with an unwritable CSV ran, or said its files were written"; }
-    mkdir -p "$out/p5/figure2.png" "$out/p6/vorticity_000000.png"
+    mkdir -p "$out/p5/figure2.png" "$out/p6/sine-euler_vorticity_000000.png"
     PATH="$ok_path" expect 1 "figure2.png.*directory" report figure2 --out "$out/p5"
-    PATH="$ok_path" expect 1 "vorticity_000000.png.*directory" run sine-euler --N 5 --steps 2 --out "$out/p6"
+    PATH="$ok_path" expect 1 "sine-euler_vorticity_000000.png.*directory" run sine-euler --N 5 --steps 2 --out "$out/p6"
     # The script and images are the data's: images of steps the new data has
-    # no snapshot of are removed, and vorticity.gp is written with the data
+    # no snapshot of are removed, and SCENE_vorticity.gp is written with the data
     # (gnuplot reads it at a byte offset: a script or images of the last run
     # drew garbage, or another run's snapshots), also without gnuplot.
     PATH="$ok_path" "$lpi" run sine-euler --N 5 --steps 10 --every 1 --snapshots 5 --out "$out/p12" >/dev/null
     PATH="$out/no-gnuplot" "$lpi" run sine-euler --N 7 --steps 9 --every 1 --snapshots 3 --out "$out/p12" >/dev/null
-    [ "$(cd "$out/p12" && echo vorticity_*)" = "vorticity_000000.png vorticity_000000.svg" ] ||
+    [ "$(cd "$out/p12" && echo sine-euler_vorticity_*)" = \
+        "sine-euler_vorticity_000000.png sine-euler_vorticity_000000.svg" ] ||
         fail "images of another run's snapshots left: $(ls "$out/p12")"
-    grep -q "vorticity_000009.png" "$out/p12/vorticity.gp" ||
-        fail "vorticity.gp is not written for the data of the run"
+    grep -q "sine-euler_vorticity_000009.png" "$out/p12/sine-euler_vorticity.gp" ||
+        fail "sine-euler_vorticity.gp is not written for the data of the run"
     PATH="$ok_path" "$lpi" run sine-euler --N 5 --steps 2 --snapshots 0 --out "$out/p12" >/dev/null
-    [ -z "$(ls "$out/p12" | grep -e vorticity)" ] || fail "a run without snapshots left images or vorticity.gp"
+    [ -z "$(ls "$out/p12" | grep -e vorticity)" ] || fail "a run without snapshots left images or sine-euler_vorticity.gp"
     # Without gnuplot the plots are skipped, and the run says so.
     rc=0; PATH="$out/no-gnuplot" "$lpi" run sine-euler --N 5 --steps 2 --out "$out/p7" >"$out/stdout" 2>&1 || rc=$?
     [ "$rc" -eq 0 ] && grep -q "gnuplot not found" "$out/stdout" ||

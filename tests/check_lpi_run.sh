@@ -123,20 +123,61 @@ rc=0
 if [ "$rc" -eq 0 ]; then
     have_sine_euler=1
     if command -v gnuplot >/dev/null 2>&1; then
-        n=$(ls "$out"/vorticity_*.png | wc -l)
+        n=$(ls "$out"/sine-euler_vorticity_*.png | wc -l)
         [ "$n" -eq 3 ] || { echo "expected 3 vorticity snapshots, got $n"; exit 1; }
     else
         echo "not checked: the vorticity snapshots (no gnuplot)"
     fi
-    # Another scene's run in the same --out removes only its own earlier
-    # images (those its last vorticity.gp drew), not sine-euler's at steps it
-    # has no snapshot of (it removed every vorticity_STEP image there).
-    rm -rf "$out/shared"
-    "$lpi" run sine-euler --N 5 --steps 4 --every 1 --snapshots 2 --out "$out/shared" >/dev/null
-    for f in vorticity_000004.png vorticity_000004.svg; do [ -e "$out/shared/$f" ] || : > "$out/shared/$f"; done
-    "$lpi" run sqg --N 5 --steps 3 --every 1 --snapshots 1 --out "$out/shared" >/dev/null
-    [ -e "$out/shared/vorticity_000004.png" ] && [ -e "$out/shared/vorticity_000004.svg" ] ||
-        { echo "an sqg run removed sine-euler's images in the same --out: $(ls "$out/shared")"; exit 1; }
+    # Two scenes run into one --out each keep their own images and script
+    # (SCENE_vorticity_STEP.png and .svg, SCENE_vorticity.gp), byte for byte
+    # as each wrote them (unprefixed, the second drew over the first's at the
+    # steps both have and left the first's others beside its own). A run
+    # removes only its own stale images: not another scene's, nor the
+    # unprefixed vorticity_STEP images and vorticity.gp of earlier versions.
+    rm -rf "$out/shared"; mkdir -p "$out/shared"
+    old="vorticity_000000.png vorticity_000004.svg vorticity.gp"
+    for f in $old; do echo "an earlier version's" > "$out/shared/$f"; done
+    (cd "$out/shared" && md5sum $old > "$out/old.md5")
+    # own SCENE: the names of the scene's script and images in --out; drawn
+    # SCENE K: they are its script and, with gnuplot, a PNG and an SVG of
+    # each of its K snapshots; kept: the files of the MD5-FILE, and no other.
+    own() {
+        (cd "$out/shared" && for f in "$1"_vorticity.gp "$1"_vorticity_*; do if [ -e "$f" ]; then echo "$f"; fi; done)
+    }
+    drawn() {  # drawn SCENE SNAPSHOTS
+        want=1; command -v gnuplot >/dev/null 2>&1 && want=$((1 + 2 * $2))
+        n=$(own "$1" | wc -l)
+        [ "$n" -eq "$want" ] ||
+            { echo "$1 in a shared --out: $n files of its snapshots, expected $want:"; ls "$out/shared"; exit 1; }
+    }
+    kept() {  # kept SCENE MD5-FILE WHAT
+        (cd "$out/shared" && md5sum -c --quiet "$2") && [ "$(own "$1" | wc -l)" -eq "$(wc -l < "$2")" ] ||
+            { echo "$3 changed $1's images or script: $(ls "$out/shared")"; exit 1; }
+    }
+    "$lpi" run sine-euler --N 5 --steps 10 --every 1 --snapshots 3 --checkpoint "$out/shared-se.lpi" \
+        --out "$out/shared" >/dev/null
+    drawn sine-euler 4
+    (cd "$out/shared" && own sine-euler | xargs md5sum > "$out/se.md5")
+    "$lpi" run sqg --N 5 --steps 6 --every 1 --snapshots 2 --out "$out/shared" >/dev/null
+    drawn sqg 4
+    kept sine-euler "$out/se.md5" "an sqg run into the same --out"
+    (cd "$out/shared" && own sqg | xargs md5sum > "$out/sqg.md5")
+    # sine-euler resumed (extended to step 16): sqg's files are untouched.
+    "$lpi" run sine-euler --N 5 --steps 16 --resume "$out/shared-se.lpi" --out "$out/shared" >/dev/null
+    drawn sine-euler 6
+    kept sqg "$out/sqg.md5" "a resumed sine-euler run into the same --out"
+    (cd "$out/shared" && own sine-euler | xargs md5sum > "$out/se.md5")
+    # sqg again with other snapshots removes its own stale images (steps 2
+    # and 4), and only those.
+    "$lpi" run sqg --N 5 --steps 6 --every 1 --snapshots 3 --out "$out/shared" >/dev/null
+    drawn sqg 3
+    ! own sqg | grep -q -e "_00000[24]\." || { echo "sqg's stale images left: $(ls "$out/shared")"; exit 1; }
+    kept sine-euler "$out/se.md5" "an sqg run with other snapshots into the same --out"
+    (cd "$out/shared" && md5sum -c --quiet "$out/old.md5") ||
+        { echo "lpi run changed an earlier version's vorticity images or script: $(ls "$out/shared")"; exit 1; }
+    # --checkpoint may not be a name of the scene's snapshot images in --out.
+    refused "snapshot images" run sine-euler --N 5 --steps 2 --out "$out/shared" \
+        --checkpoint "$out/shared/sine-euler_vorticity_000002.svg"
 elif grep -q "sine-euler is not available in this build" "$out.err"; then
     have_sine_euler=0
     echo "not checked: sine-Euler runs and checkpoints (no FFTW in this build)"
@@ -641,7 +682,7 @@ if [ "$have_sine_euler" = 1 ] && command -v gnuplot >/dev/null 2>&1; then
     "$lpi" run sine-euler --N 9 --steps 600 --every 1 --snapshots 1 --out "$out/draw" >"$out/draw.out" 2>&1 &
     pid=$!
     waited=0
-    while [ ! -f "$out/draw/vorticity.gp" ] && [ $waited -lt 600 ]; do sleep 0.05; waited=$((waited + 1)); done
+    while [ ! -f "$out/draw/sine-euler_vorticity.gp" ] && [ $waited -lt 600 ]; do sleep 0.05; waited=$((waited + 1)); done
     sleep 0.2
     kill -TERM $pid
     rc=0; wait $pid || rc=$?

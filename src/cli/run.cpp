@@ -230,13 +230,12 @@ std::string colliding_paths(const RunOptions &o, const std::vector<std::string> 
             if (same_file(w.path, output))
                 return "lpi run: " + w.option + " " + w.path + " is " + output +
                        ", which this run writes: give it another name";
-        // The snapshot images are named by their steps: vorticity_STEP.png and .svg.
+        // The snapshot images are named by the scene and their steps:
+        // SCENE_vorticity_STEP.png and .svg.
         const std::size_t slash = w.path.find_last_of('/');
         const std::string name = slash == std::string::npos ? w.path : w.path.substr(slash + 1);
         const std::string dir = slash == std::string::npos ? "." : w.path.substr(0, std::max<std::size_t>(slash, 1));
-        const std::string suffix = name.size() > 4 ? name.substr(name.size() - 4) : "";
-        const bool image = name.rfind("vorticity_", 0) == 0 && (suffix == ".png" || suffix == ".svg");
-        if (image && same_file(dir, o.out_dir))
+        if (is_vorticity_image(o.scene, name) && same_file(dir, o.out_dir))
             return "lpi run: " + w.option + " " + w.path + " is a name of the snapshot images this run draws in " +
                    o.out_dir + ": give it another name";
         if (!o.init.empty() && same_file(w.path, o.init))
@@ -343,10 +342,11 @@ int run_command(int argc, char **argv) {
                                          : std::vector<std::size_t>{lpi_dim(sys)};
     data.casimir_count = lpi_casimir_count(sys);
     const std::string csv = o.out_dir + "/" + o.scene + ".csv";
-    // What this run writes (the vorticity images besides, by their steps).
+    // What this run writes (the vorticity images besides, SCENE_vorticity_STEP by their steps).
     std::vector<std::string> outputs = data_files(o, data);
     outputs.insert(outputs.begin(), csv);
-    outputs.push_back(o.out_dir + "/vorticity.gp");
+    const std::string vorticity_script = o.out_dir + "/" + vorticity_script_name(o.scene);
+    outputs.push_back(vorticity_script);
     const std::string collision = colliding_paths(o, outputs);
     if (!collision.empty()) {
         std::fprintf(stderr, "%s\n", collision.c_str());
@@ -1066,19 +1066,18 @@ int run_command(int argc, char **argv) {
     // Rank 0 alone draws the snapshots: main agrees on the exit status.
     if (writes_output() && data.vorticity && !data.snapshot_step.empty()) {
         if (!have_gnuplot()) {
-            std::printf("gnuplot not found: no vorticity images (the snapshots are in %s; %s/vorticity.gp "
-                        "draws them)\n",
-                        data_path(o).c_str(), o.out_dir.c_str());
+            std::printf("gnuplot not found: no vorticity images (the snapshots are in %s; %s draws them)\n",
+                        data_path(o).c_str(), vorticity_script.c_str());
             return unmatched.empty() ? 0 : 1;
         }
         const std::string not_drawn = plot_vorticity(o, data, written.bytes, dt, method);
-        if (interrupted_by) return interrupted_drawing(not_drawn.empty(), o.out_dir + "/vorticity.gp");
+        if (interrupted_by) return interrupted_drawing(not_drawn.empty(), vorticity_script);
         if (!not_drawn.empty()) {
             std::fprintf(stderr, "lpi run: %s\n", not_drawn.c_str());
             return 1;
         }
-        std::printf("wrote %zu vorticity snapshots: %s/vorticity_*.png and .svg\n", data.snapshot_step.size(),
-                    o.out_dir.c_str());
+        std::printf("wrote %zu vorticity snapshots: %s/%s_vorticity_*.png and .svg\n", data.snapshot_step.size(),
+                    o.out_dir.c_str(), o.scene.c_str());
     }
     return unmatched.empty() ? 0 : 1;
 }

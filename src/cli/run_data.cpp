@@ -517,11 +517,23 @@ int initial_grid(const std::string &path, int *N, std::vector<double> &grid, std
 }
 
 
+std::string vorticity_script_name(const std::string &scene) { return scene + "_vorticity.gp"; }
+
+bool is_vorticity_image(const std::string &scene, const std::string &name) {
+    const std::string prefix = scene + "_vorticity_";
+    const std::string suffix = name.size() > 4 ? name.substr(name.size() - 4) : "";
+    return name.rfind(prefix, 0) == 0 && (suffix == ".png" || suffix == ".svg") &&
+           name.size() > prefix.size() + 4 &&
+           name.find_first_not_of("0123456789", prefix.size()) == name.size() - 4;
+}
+
 namespace {
 
-// The image of a snapshot at `step`, without its .png or .svg.
-std::string vorticity_image(int64_t step) {
-    return format("vorticity_%06lld", static_cast<long long>(step));
+// The image of this scene's snapshot at `step`, without its .png or .svg:
+// SCENE_vorticity_STEP, named by the scene as its CSV and data are, so that
+// scenes run into one --out each keep their own.
+std::string vorticity_image(const std::string &scene, int64_t step) {
+    return format("%s_vorticity_%06lld", scene.c_str(), static_cast<long long>(step));
 }
 
 // The script that draws every vorticity snapshot of the data as PNG and SVG
@@ -532,7 +544,7 @@ PlotScript vorticity_script(const RunOptions &o, const RunData &d, const Snapsho
     double scale = 0.0;  // one symmetric colour range for every snapshot
     for (double v : d.snapshots) scale = std::max(scale, std::fabs(v));
     if (!(scale > 0.0)) scale = 1.0;
-    PlotScript script(o.out_dir, "vorticity.gp");
+    PlotScript script(o.out_dir, vorticity_script_name(o.scene));
     // Grid point (a, b) is x = 2 pi a / N, y = 2 pi b / N: the axes count
     // x / 2 pi, each pixel centred on its point. The array is [a][b], b
     // fastest: gnuplot reads it with x and y swapped back (transpose).
@@ -546,9 +558,8 @@ PlotScript vorticity_script(const RunOptions &o, const RunData &d, const Snapsho
     const char *terminals[][2] = {{"pngcairo size 720,640 enhanced font ',12'", "png"},
                                   {"svg size 720,640 enhanced font 'Helvetica,12' background '#ffffff'", "svg"}};
     for (std::size_t k = 0; k < shots; ++k) {
-        char name[64];
         const int64_t row = static_cast<int64_t>(d.snapshot_step[k]);
-        std::snprintf(name, sizeof name, "%s", vorticity_image(row).c_str());
+        const std::string name = vorticity_image(o.scene, row);
         script += format("set title '%s, N = %zu, %s, dt = %g: t = %.6g (step %lld)' noenhanced\n", o.scene.c_str(),
                          N, method.c_str(), dt, d.snapshot_time[k], static_cast<long long>(row));
         for (const auto &terminal : terminals) {
@@ -569,13 +580,16 @@ std::string match_drawings(const RunOptions &o, const RunData &d, const Snapshot
                            const std::string &method) {
     std::set<std::string> drawn;
     for (double step : d.snapshot_step)
-        for (const char *suffix : {".png", ".svg"}) drawn.insert(vorticity_image(static_cast<int64_t>(step)) + suffix);
-    // The images the script of this scene's last run drew (its titles name
-    // the scene) that this data does not: another scene's in the same --out,
-    // and images lpi did not write, are not this run's to remove.
+        for (const char *suffix : {".png", ".svg"})
+            drawn.insert(vorticity_image(o.scene, static_cast<int64_t>(step)) + suffix);
+    // The images the script of this scene's last run drew (its name and its
+    // titles name the scene) that this data does not, and only those named
+    // SCENE_vorticity_STEP: another scene's in the same --out, the unprefixed
+    // vorticity_STEP images of earlier versions and images lpi did not write
+    // are not this run's to remove.
     std::string why, old_script;
     struct stat st;
-    const std::string script_path = o.out_dir + "/vorticity.gp";
+    const std::string script_path = o.out_dir + "/" + vorticity_script_name(o.scene);
     if (stat(script_path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && read_input(script_path, old_script).empty() &&
         old_script.find("\nset title '" + o.scene + ", ") != std::string::npos) {
         const std::string prefix = "set output '";
@@ -586,15 +600,12 @@ std::string match_drawings(const RunOptions &o, const RunData &d, const Snapshot
             from = end + 1;
             if (line.rfind(prefix, 0) != 0 || line.size() < prefix.size() + 1 || line.back() != '\'') continue;
             const std::string name = line.substr(prefix.size(), line.size() - prefix.size() - 1);
-            const std::string suffix = name.size() > 4 ? name.substr(name.size() - 4) : "";
-            const bool image = name.rfind("vorticity_", 0) == 0 && (suffix == ".png" || suffix == ".svg") &&
-                               name.find_first_not_of("0123456789", 10) == name.size() - 4;
-            if (image && !drawn.count(name) && unlink((o.out_dir + "/" + name).c_str()) != 0 && errno != ENOENT &&
-                why.empty())
+            if (is_vorticity_image(o.scene, name) && !drawn.count(name) &&
+                unlink((o.out_dir + "/" + name).c_str()) != 0 && errno != ENOENT && why.empty())
                 why = "cannot remove " + o.out_dir + "/" + name + ": " + std::strerror(errno);
         }
     }
-    const std::string script = o.out_dir + "/vorticity.gp";
+    const std::string &script = script_path;
     if (d.snapshot_step.empty() || bytes.offset == UINT64_MAX) {
         if (unlink(script.c_str()) != 0 && errno != ENOENT && why.empty())
             why = "cannot remove " + script + ": " + std::strerror(errno);

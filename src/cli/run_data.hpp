@@ -155,12 +155,23 @@ int keep_snapshots(const RunOptions &o, int64_t start, const std::string &not_ke
 // 2 when it holds no N x N grid for this run.
 int initial_grid(const std::string &path, int *N, std::vector<double> &grid, std::string &why);
 
+// The name of the script that draws a scene's snapshots, in --out:
+// SCENE_vorticity.gp. Its images are SCENE_vorticity_STEP.png and .svg,
+// named by the scene as its CSV and data are.
+std::string vorticity_script_name(const std::string &scene);
+
+// Whether `name` (a file name, no directory) is one of the scene's snapshot
+// images: SCENE_vorticity_ followed by digits and .png or .svg.
+bool is_vorticity_image(const std::string &scene, const std::string &name);
+
 // Puts what is drawn from the data in step with it once it is written: the
-// images that DIR/vorticity.gp, where it is this scene's, drew of steps the
-// data holds no snapshot of are removed (not another scene's), and DIR/vorticity.gp
-// is written for it (removed where it holds no snapshot): gnuplot reads the
-// snapshots at their byte offset, and a script or images left by an earlier
-// run drew another run's data. "" or why not.
+// images that DIR/SCENE_vorticity.gp, where it is this scene's, drew of steps
+// the data holds no snapshot of are removed (only SCENE_vorticity_STEP images:
+// not another scene's, nor the unprefixed vorticity_STEP ones of earlier
+// versions), and DIR/SCENE_vorticity.gp is written for it (removed where it
+// holds no snapshot): gnuplot reads the snapshots at their byte offset, and a
+// script or images left by an earlier run drew another run's data. "" or why
+// not.
 std::string match_drawings(const RunOptions &o, const RunData &d, const SnapshotBytes &bytes, double dt,
                            const std::string &method);
 
