@@ -183,7 +183,7 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
             {"qg", "quasi-geostrophy, lambda = 1/(|n|^2 + kd^2), kd = " + format_number(kd) + ", N = " +
                        std::to_string(N),
              [N, kd] { return qg_system(N, kd); }, {"--kd"}},
-            {"topography", "2D Euler over a smooth random topography h (q = w + h), N = " + std::to_string(N),
+            {"topography", "2D Euler over a smooth random topography h (its field: q = w + h), N = " + std::to_string(N),
              [N] { return topography_system(N); }, {}},
         };
         for (const auto &member : family) {
