@@ -187,7 +187,6 @@ std::vector<Case> build_cases(bool quick) {
         k.period = 2.0 * kPi / scale;
         k.factors = {1e-3, 0.1, 1.0, 1e3};
         k.steps = quick ? 100 : n;
-        k.pade_growth = true;
         cases.push_back(k);
     }
     {

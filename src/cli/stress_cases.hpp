@@ -29,7 +29,6 @@ struct Case {
     // own round-off) + per_flow * flows * growth(factor), growth = 1 except
     // for the generic Pade path (each squaring doubles its error).
     double drift_floor = 1e-15;
-    bool pade_growth = false;
     // A status a Poisson method may return here (rolled back) instead of
     // stepping: LPI_ERR_NONFINITE where the exact flow of a piece overflows,
     // LPI_ERR_INVALID where a generic flow needs too many squarings.
