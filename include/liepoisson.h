@@ -395,8 +395,8 @@ LPI_API int lpi_sine_euler_spectrum(const lpi_system *sys, double *energy, doubl
 LPI_API int lpi_set_threads(lpi_system *sys, int32_t n);
 
 /* FFTW wisdom (shared by the whole process; planning is serialised inside the
- * library, and with the host's own plans by FFTW's planner lock, which the
- * library turns on as it loads; wisdom calls of the host's own are not). Built without FFTW3: LPI_ERR_UNSUPPORTED. export_string writes at
+ * library, and with the host's own plans through FFTW's planner hooks, which
+ * the library sets as it loads; wisdom calls of the host's own are not). Built without FFTW3: LPI_ERR_UNSUPPORTED. export_string writes at
  * most size bytes including the NUL and sets *length to the length without
  * it; with buf == NULL and size == 0 it only queries the length (LPI_OK),
  * otherwise size <= *length gives LPI_ERR_SIZE with buf untouched.

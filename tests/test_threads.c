@@ -14,6 +14,8 @@
 #include <sched.h>
 #include <stdatomic.h>
 #include <sys/resource.h>
+#include <sys/time.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #ifdef _OPENMP
@@ -601,6 +603,99 @@ static void test_host_plans_beside_the_library(void **state) {
 #endif
 }
 
+/* The host plans on another thread while the process forks: the child's
+ * plan found the planner's lock taken for ever (the lock the library put
+ * around every FFTW plan, the host's too). */
+#if LPI_TEST_WITH_FFTW
+static void *host_plans_alone(void *unused) {
+    (void)unused;
+    fftw_complex *buffer = fftw_alloc_complex(64);
+    while (host_plans) fftw_destroy_plan(fftw_plan_dft_1d(31, buffer, buffer, FFTW_FORWARD, FFTW_ESTIMATE));
+    fftw_free(buffer);
+    return NULL;
+}
+#endif
+static void test_fork_while_the_host_plans(void **state) {
+    (void)state;
+#if !LPI_TEST_WITH_FFTW
+    LPI_SKIP("fork while the host plans: the library puts no lock around the host's plans in this build");
+#else
+    if (under_valgrind()) LPI_SKIP("fork while the host plans: valgrind runs one thread at a time");
+    host_plans = 1;
+    pthread_t host;
+    assert_int_equal(pthread_create(&host, NULL, host_plans_alone, NULL), 0);
+    for (int i = 0; i < 20; ++i) {
+        fflush(stdout);
+        const pid_t child = fork();
+        assert_true(child >= 0);
+        if (child == 0) {
+            alarm(60);
+            fftw_complex buffer[17];
+            fftw_destroy_plan(fftw_plan_dft_1d(17, buffer, buffer, FFTW_FORWARD, FFTW_ESTIMATE));
+            double w[2 * 15 * 15];
+            _exit(fifteen_after_20_steps(1, w) != LPI_OK ? 1 : 0);
+        }
+        expect_child_passed(child, "fork while the host plans");
+    }
+    host_plans = 0;
+    assert_int_equal(pthread_join(host, NULL), 0);
+#endif
+}
+
+/* fork(2) from a signal handler that interrupted the library's planning on
+ * the same thread: the fork handler waited for the lock its own thread
+ * held. Run by this program again (`forks-from-a-signal-handler`), a
+ * process that has had no other thread: in one that had, glibc's fork
+ * takes malloc's locks, which the interrupted code may hold. */
+static const char *program_path;
+static void fork_and_leave(int signal) {
+    (void)signal;
+    const pid_t child = fork();
+    if (child == 0) _exit(0);
+    if (child > 0) waitpid(child, NULL, 0);
+}
+static int forks_from_a_signal_handler(void) {
+    signal(SIGALRM, fork_and_leave);
+    const struct itimerval every_2_ms = {{0, 2000}, {0, 2000}};
+    setitimer(ITIMER_REAL, &every_2_ms, NULL);
+    for (int i = 0; i < 100; ++i) {
+        lpi_system *sys = NULL;
+        if (lpi_sine_euler_create(&sys, 15 + 2 * (i % 10)) != LPI_OK) return 1;
+        lpi_sine_euler_set_planning(sys, "measure");
+        lpi_step(sys, 0.01, 1);
+        lpi_destroy(sys);
+    }
+    return 0;
+}
+static void test_fork_from_a_signal_handler(void **state) {
+    (void)state;
+    double w[2 * 15 * 15];
+    if (fifteen_after_20_steps(1, w) != LPI_OK) LPI_SKIP("fork from a signal handler: built without FFTW");
+    if (under_valgrind()) LPI_SKIP("fork from a signal handler: a timer every 2 ms is too often for valgrind");
+#ifdef LPI_TEST_SANITIZER
+    /* A sanitizer's allocator takes its locks in fork, which the interrupted
+     * code may hold (ThreadSanitizer reports the handler's fork itself). */
+    LPI_SKIP("fork from a signal handler: not under " LPI_TEST_SANITIZER ", whose fork takes its allocator's locks");
+#endif
+    fflush(stdout);
+    const pid_t runner = fork();
+    assert_true(runner >= 0);
+    if (runner == 0) {
+        execl("/proc/self/exe", program_path, "forks-from-a-signal-handler", (char *)NULL);
+        _exit(127);
+    }
+    int wait_status = 0;
+    pid_t done = 0;
+    for (int waited = 0; waited < 600 && (done = waitpid(runner, &wait_status, WNOHANG)) == 0; ++waited)
+        usleep(100000);
+    if (done == 0) {
+        kill(runner, SIGKILL);
+        waitpid(runner, NULL, 0);
+        fail_msg("forks from a signal handler during planning: no end after 60 s");
+    }
+    assert_true(WIFEXITED(wait_status) && WEXITSTATUS(wait_status) == 0);
+}
+
 static void test_thread_count_bound(void **state) {
     (void)state;
     lpi_system *sys = sine_euler_15();
@@ -738,7 +833,9 @@ static void test_two_threads_at_once(void **state) {
     assert_int_equal(lpi_destroy(sys), LPI_OK);
 }
 
-int main(void) {
+int main(int argc, char **argv) {
+    program_path = argv[0];
+    if (argc == 2 && strcmp(argv[1], "forks-from-a-signal-handler") == 0) return forks_from_a_signal_handler();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_refused_threads_give_a_status),
         cmocka_unit_test(test_handles_on_threads),
@@ -750,6 +847,8 @@ int main(void) {
         cmocka_unit_test(test_fork_after_a_host_region),
         cmocka_unit_test(test_fork_while_another_thread_plans),
         cmocka_unit_test(test_host_plans_beside_the_library),
+        cmocka_unit_test(test_fork_while_the_host_plans),
+        cmocka_unit_test(test_fork_from_a_signal_handler),
         cmocka_unit_test(test_another_thread_is_refused),
         cmocka_unit_test(test_two_threads_at_once),
     };

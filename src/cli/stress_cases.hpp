@@ -26,8 +26,7 @@ struct Case {
     bool spectrum_scale = false;       // scale = max |C_k(0)| (eigenvalues)
     int samples = 20;                  // times the state is measured (equal chunks of steps)
     // Casimir round-off allowed to a Poisson method: floor (the measurement's
-    // own round-off) + per_flow * flows * growth(factor), growth = 1 except
-    // for the generic Pade path (each squaring doubles its error).
+    // own round-off) + per_flow * flows.
     double drift_floor = 1e-15;
     // A status a Poisson method may return here (rolled back) instead of
     // stepping: LPI_ERR_NONFINITE where the exact flow of a piece overflows,

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <mutex>
+#include <new>
 #include <string>
 
 #include "error.hpp"
@@ -72,14 +73,26 @@ void require_openblas_memory(std::size_t bytes, const std::string &for_what, con
                                     "would wait for them for ever)" + advice);
 }
 
+// A fork(2) while another thread held the loader's lock left the child's
+// copy locked for ever: the child gets a fresh one (held where its own thread
+// held it: a fork from a signal handler). The fork does not wait for it, as
+// it waits for the FFTW planner: the lock is held across dlopen, whose
+// library may register fork handlers, which glibc 2.28 .. 2.35 refuse while
+// a fork runs its handlers.
+std::mutex loader_mutex;
+thread_local bool holds_loader = false;
+struct LoaderLock {
+    LoaderLock() { loader_mutex.lock(), holds_loader = true; }
+    ~LoaderLock() { holds_loader = false, loader_mutex.unlock(); }
+};
+[[maybe_unused]] const int loader_renewed_in_child = pthread_atfork(nullptr, nullptr, [] {
+    new (&loader_mutex) std::mutex;
+    if (holds_loader) loader_mutex.lock();
+});
+
 const Routines &routines() {
-    static std::mutex mutex;
-    // As the FFTW planner's (transforms.cpp): a fork(2) while another thread
-    // held it left the child's copy locked for ever.
-    [[maybe_unused]] static const int released_after_fork =
-        pthread_atfork([] { mutex.lock(); }, [] { mutex.unlock(); }, [] { mutex.unlock(); });
     static Routines loaded;
-    std::lock_guard<std::mutex> lock(mutex);
+    LoaderLock lock;
     if (loaded.zheevd) return loaded;
     const std::string name = LPI_LAPACK_LIBRARY;
     const int threads = threads_started_on_loading();

@@ -87,8 +87,15 @@ std::unique_ptr<Model> make_sine_euler(int N);
 void require_physical_memory(double bytes, const std::string &what);
 
 // The FFTW planner is not thread-safe: every plan creation, destruction and
-// wisdom operation in the library holds this lock.
-std::mutex &fftw_planner_mutex();
+// wisdom operation in the library holds this lock, and through FFTW's planner
+// hooks every plan and destroy_plan of the host's too. Re-entrant (the hooks
+// take it again inside the library's plans); a fork(2) waits for it.
+class FftwPlannerLock {
+public:
+    void lock();
+    void unlock();
+};
+FftwPlannerLock &fftw_planner_lock();
 
 // FFTW ends the process when one of its own allocations fails (its
 // malloc_plain asserts on the result): in a planner, in wisdom, or in an

@@ -28,7 +28,7 @@ MatrixForm::MatrixForm(int N, Layout layout)
         }
     require_fftw_headroom(fftw_planning_headroom(N),
                           "the matrix form's plans of length " + std::to_string(N));
-    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    std::lock_guard<FftwPlannerLock> lock(fftw_planner_lock());
     plans_ = new Plans;
     fftw_complex *buffer = fftw_alloc_complex(index_.size());
     buffer_ = reinterpret_cast<cplx *>(buffer);
@@ -48,7 +48,7 @@ MatrixForm::MatrixForm(int N, Layout layout)
 }
 
 MatrixForm::~MatrixForm() {
-    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    std::lock_guard<FftwPlannerLock> lock(fftw_planner_lock());
     release();
 }
 

@@ -26,29 +26,74 @@
 #include <fftw3.h>
 #endif
 
-namespace lpi {
-
-#if LPI_HAVE_FFTW && LPI_HAVE_FFTW_THREADS
-namespace {
-// The library's lock (below) serialises its own plans; FFTW's planner is the
-// process's, and a host planning on another thread beside them corrupted its
-// heap ("double free"). FFTW's own planner lock, taken by every plan and
-// destroy_plan whoever calls them, covers both. Installed as the library
-// loads: installed while a host's thread was inside the planner, the hook
-// released a lock that plan had never taken (FFTW aborted).
-[[maybe_unused]] const bool planner_thread_safe = (fftw_make_planner_thread_safe(), true);
-}  // namespace
+#if LPI_HAVE_FFTW_PLANNER_HOOKS
+// Exported by libfftw3 since 3.3.5 (what fftw_make_planner_thread_safe of
+// libfftw3_threads installs its lock with), not declared in fftw3.h.
+extern "C" void fftw_set_planner_hooks(void (*before)(void), void (*after)(void));
 #endif
 
-std::mutex &fftw_planner_mutex() {
-    static std::mutex mutex;
-    // A fork(2) while another thread planned left the child's copy locked,
-    // and its next plan waited for ever: the fork waits for the planner, and
-    // both processes release it. (No thread forks while it holds it: no user
-    // code runs under it.)
-    [[maybe_unused]] static const int released_after_fork =
-        pthread_atfork([] { mutex.lock(); }, [] { mutex.unlock(); }, [] { mutex.unlock(); });
+namespace lpi {
+
+namespace {
+
+// The lock's owner is a thread id, which the child of a fork(2) does not
+// have, and a thread may fork from a signal handler while it holds the
+// lock: so the fork waits for other threads' planning (the child gets a
+// planner no thread was changing), the child gets a fresh lock, held as
+// often as its thread held it, and the parent's is released.
+std::recursive_mutex &planner_mutex() {
+    static std::recursive_mutex mutex;
     return mutex;
+}
+thread_local int planner_depth = 0;  // this thread's holds
+bool locked_for_fork = false;
+void lock_before_fork() {
+    locked_for_fork = planner_depth == 0;
+    if (locked_for_fork) planner_mutex().lock();
+}
+void unlock_in_parent() {
+    if (locked_for_fork) planner_mutex().unlock();
+}
+void renew_in_child() {
+    new (&planner_mutex()) std::recursive_mutex;
+    for (int i = 0; i < planner_depth; ++i) planner_mutex().lock();
+}
+
+#if LPI_HAVE_FFTW_PLANNER_HOOKS
+// FFTW's planner is the process's: a host planning on another thread beside
+// the library corrupted its heap ("double free"). FFTW calls these around
+// every plan and destroy_plan, whoever calls them. An `after` whose `before`
+// ran before they were installed (a host's plan under way as the library
+// loads) finds no hold of its thread to release.
+void before_planner() { fftw_planner_lock().lock(); }
+void after_planner() {
+    if (planner_depth > 0) fftw_planner_lock().unlock();
+}
+#endif
+
+[[maybe_unused]] const bool planner_lock_installed = [] {
+    pthread_atfork(lock_before_fork, unlock_in_parent, renew_in_child);
+#if LPI_HAVE_FFTW_PLANNER_HOOKS
+    fftw_set_planner_hooks(before_planner, after_planner);
+#endif
+    return true;
+}();
+
+}  // namespace
+
+void FftwPlannerLock::lock() {
+    planner_mutex().lock();
+    ++planner_depth;
+}
+
+void FftwPlannerLock::unlock() {
+    --planner_depth;
+    planner_mutex().unlock();
+}
+
+FftwPlannerLock &fftw_planner_lock() {
+    static FftwPlannerLock lock;
+    return lock;
 }
 
 namespace {
@@ -117,7 +162,7 @@ LineTransforms::LineTransforms(int N, int lines, FftPlanning planning)
         handover_.reset(new std::atomic<int>[static_cast<std::size_t>((lines + kBlock - 1) / kBlock + 1)]);
         reserve_threads(1);
         require_fftw_headroom(fftw_planning_headroom(N), "the plans of length " + std::to_string(N));
-        std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+        std::lock_guard<FftwPlannerLock> lock(fftw_planner_lock());
         const unsigned flags = planner_flags(planning);
         fftw_complex *b = complex_of(spectrum_), *x = complex_of(blocks_[0]);
         // The spectrum is one FFT per flow: planned by the heuristic always,
@@ -149,7 +194,7 @@ LineTransforms::LineTransforms(int N, int lines, FftPlanning planning)
 LineTransforms::~LineTransforms() { release(); }
 
 void LineTransforms::release() {
-    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    std::lock_guard<FftwPlannerLock> lock(fftw_planner_lock());
     if (plans_)
         for (fftw_plan p : {plans_->spectrum, plans_->forward[0], plans_->forward[1],
                             plans_->backward[0], plans_->backward[1]})
@@ -194,11 +239,11 @@ void dft_2d(int N, fftw_complex *buffer, int sign) {
                           "the grid's " + std::to_string(N) + " x " + std::to_string(N) + " transform");
     fftw_plan plan;
     {
-        std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+        std::lock_guard<FftwPlannerLock> lock(fftw_planner_lock());
         plan = fftw_plan_dft_2d(N, N, buffer, buffer, sign, FFTW_ESTIMATE);
     }
     fftw_execute(plan);
-    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    std::lock_guard<FftwPlannerLock> lock(fftw_planner_lock());
     fftw_destroy_plan(plan);
 }
 
@@ -266,7 +311,7 @@ void fftw_wisdom_import_file(const char *path) {
         fail(LPI_ERR_INVALID, quoted(path) + " is not FFTW wisdom: more than " +
                                   std::to_string(kMaxWisdomBytes) + " bytes, more than wisdom takes");
     require_fftw_headroom(fftw_planning_headroom(0) + 8 * text.size(), "its wisdom");
-    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    std::lock_guard<FftwPlannerLock> lock(fftw_planner_lock());
     if (text.find('\0') != std::string::npos || !fftw_import_wisdom_from_string(text.c_str()))
         fail(LPI_ERR_INVALID, quoted(path) + " is not FFTW wisdom");
 }
@@ -279,7 +324,7 @@ void fftw_wisdom_export_file(const char *path) {
 
 void fftw_wisdom_import_string(const char *wisdom) {
     require_fftw_headroom(fftw_planning_headroom(0) + 8 * std::strlen(wisdom), "its wisdom");
-    std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    std::lock_guard<FftwPlannerLock> lock(fftw_planner_lock());
     if (!fftw_import_wisdom_from_string(wisdom))
         fail(LPI_ERR_INVALID, "the string is not valid FFTW wisdom");
 }
@@ -288,7 +333,7 @@ std::string fftw_wisdom_export_string() {
     char *text;
     require_fftw_headroom(fftw_planning_headroom(0), "its wisdom");
     {
-        std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+        std::lock_guard<FftwPlannerLock> lock(fftw_planner_lock());
         text = fftw_export_wisdom_to_string();
     }
     if (!text) throw std::bad_alloc();

@@ -4,7 +4,7 @@
 // the spectrum of one direction's line through the origin (length N) and for
 // a block of lines (kBlock, or the remainder, transforms of length N along s,
 // stride the block's line count). Plan creation, destruction and wisdom hold
-// fftw_planner_mutex(). Everything here needs FFTW3 except the wisdom
+// fftw_planner_lock(). Everything here needs FFTW3 except the wisdom
 // functions, which refuse with LPI_ERR_UNSUPPORTED in a build without it.
 #pragma once
 
