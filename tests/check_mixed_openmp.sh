@@ -26,7 +26,7 @@ trap 'rm -rf "$work"' EXIT
 # LIBRARY_BUILD's library, at $work/host.
 host_test() {
     "$1" -O1 -fopenmp -Iinclude -Itests tests/test_threads.c -o "$work/host" \
-        -L"$2" -lliepoisson -lcmocka -lpthread -ldl -Wl,-rpath,"$2"
+        -L"$2" -lliepoisson -lcmocka -lpthread -ldl -lm -Wl,-rpath,"$2"
 }
 
 host_test clang "$gcc_build"

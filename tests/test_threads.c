@@ -578,7 +578,7 @@ static void *host_plans_with_fftw(void *count) {
 static void test_host_plans_beside_the_library(void **state) {
     (void)state;
 #if !LPI_TEST_WITH_FFTW
-    LPI_SKIP("a host's own FFTW plans: the library is built without FFTW");
+    LPI_SKIP("a host's own FFTW plans: built without FFTW, or with an FFTW without planner hooks");
 #else
     if (under_valgrind()) LPI_SKIP("a host's own FFTW plans: valgrind runs one thread at a time");
     host_plans = 1;
@@ -618,7 +618,7 @@ static void *host_plans_alone(void *unused) {
 static void test_fork_while_the_host_plans(void **state) {
     (void)state;
 #if !LPI_TEST_WITH_FFTW
-    LPI_SKIP("fork while the host plans: the library puts no lock around the host's plans in this build");
+    LPI_SKIP("fork while the host plans: built without FFTW, or with an FFTW without planner hooks");
 #else
     if (under_valgrind()) LPI_SKIP("fork while the host plans: valgrind runs one thread at a time");
     host_plans = 1;

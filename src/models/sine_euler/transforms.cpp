@@ -46,7 +46,7 @@ std::recursive_mutex &planner_mutex() {
     return mutex;
 }
 thread_local int planner_depth = 0;  // this thread's holds
-bool locked_for_fork = false;
+thread_local bool locked_for_fork = false;  // by this thread's prepare handler
 void lock_before_fork() {
     locked_for_fork = planner_depth == 0;
     if (locked_for_fork) planner_mutex().lock();
