@@ -613,6 +613,9 @@ def _destroy(handle, lock):
         lock.release()
 
 
+# The functions that make a handle (System's create).
+_CREATE_FUNCTIONS = frozenset(("lpi_rigid_body_create", "lpi_pendulum_create", "lpi_generic_create",
+                               "lpi_moments_create", "lpi_sine_euler_create"))
 _BUSY = STATUS.get("LPI_ERR_BUSY", -13)
 _STOPPED = STATUS.get("LPI_STOPPED", 1)
 _NO_DEFERRAL = contextlib.nullcontext()
@@ -658,12 +661,18 @@ class System:
     Parameters
     ----------
     create : str
-        The library's ``lpi_*_create`` function (for subclasses).
+        The library's ``lpi_*_create`` function (for subclasses): one of
+        those that make a handle, any other name raises `ValueError`.
     args : tuple
         Its arguments after the handle.
     """
 
     def __init__(self, create: str, *args: Any) -> None:
+        # Only a create function takes the handle's address first: another
+        # function would take that address for a handle (lpi_destroy freed it).
+        if create not in _CREATE_FUNCTIONS:
+            raise ValueError("System is made by a subclass or load(); create must be one of %s, not %r"
+                             % (", ".join(sorted(_CREATE_FUNCTIONS)), create))
         handle = ctypes.c_void_p()
         _check_free(getattr(lib, create)(byref(handle), *args))
         self._own(handle)
@@ -1209,11 +1218,16 @@ class System:
         self._keep.append(c_observer)  # before C holds it, until C has let it go
         with deferred:
             start_time = lib.lpi_time(self._handle)
+            refused = False  # C refused the observer (from a callback of this system: BUSY)
             try:
-                self._call("lpi_set_observer", cadence, c_observer, None)
+                try:
+                    self._call("lpi_set_observer", cadence, c_observer, None)
+                except LiePoissonError:
+                    refused = True
+                    raise
                 status = self._call("lpi_step", dt, nsteps)
             finally:
-                if lib.lpi_set_observer(self._handle, 0, _lib.OBSERVER_FN(), None) == 0:  # NULL: removed
+                if refused or lib.lpi_set_observer(self._handle, 0, _lib.OBSERVER_FN(), None) == 0:  # NULL: removed
                     self._drop((c_observer,))
             if raised:
                 raise raised[0]

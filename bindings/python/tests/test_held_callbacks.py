@@ -74,6 +74,31 @@ class TestHeldCallbacks(unittest.TestCase):
             self.assertEqual(b.step(DT, 5), 5)  # no longer observed
             self.assertEqual(calls, [])
 
+    def test_an_observer_refused_inside_a_callback_is_not_kept(self):
+        nested = []
+
+        def watch(system, step, t):
+            try:
+                system.step(DT, 2, observer=lambda *a: None)
+            except lp.BusyError as e:
+                nested.append(e)
+
+        with rigid_body() as b:
+            for _ in range(3):
+                b.step(DT, 10, observer=watch, every=5)
+            self.assertEqual(len(nested), 6)
+            self.assertEqual(b._keep, [])  # neither the refused observers nor the outer ones
+        with generic() as g:
+            g.step(DT, 10, observer=watch, every=5)
+            self.assertEqual(len(g._keep), 2)  # the piece's gradient and energy alone
+
+    def test_only_a_create_function_makes_a_system(self):
+        for name, args in (("lpi_destroy", ()), ("lpi_step", (0.1, 1)), ("lpi_set_method", (None,))):
+            with self.assertRaisesRegex(ValueError, "create must be one of"):
+                lp.System(name, *args)
+        with lp.System("lpi_pendulum_create") as p:
+            self.assertEqual(p.dim, 3)  # e(2)
+
 
 @MAIN_ONLY
 class TestSigintHeldBack(unittest.TestCase):
