@@ -476,9 +476,18 @@ expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$
 expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$out/ck" --checkpoint "$out/ck//./rigid-body.csv"
 expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$out/ck" --format npy \
     --checkpoint "$out/ck/rigid-body/state.npy"
+# The folders the data is written in: the .npy folder, the HDF5 file's journal.
+expect 2 "--checkpoint.*is in .*the folder where this run writes its data" run rigid-body --steps 9 \
+    --out "$out/ck" --format npy --checkpoint "$out/ck/rigid-body/x.lpi"
+expect 2 "--checkpoint.*is .*the folder where this run writes its data" run rigid-body --steps 9 \
+    --out "$out/ck" --format npy --checkpoint "$out/ck/rigid-body"
 case $formats in *h5*)
     expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$out/ck" --format h5 \
-        --checkpoint "$out/ck/rigid-body.h5" ;;
+        --checkpoint "$out/ck/rigid-body.h5"
+    expect 2 "--checkpoint.*the folder where this run writes its data" run rigid-body --steps 9 --out "$out/ck" \
+        --format h5 --checkpoint "$out/ck/rigid-body.h5-pending"
+    expect 2 "--checkpoint.*is in .*the folder where this run writes its data" run rigid-body --steps 9 \
+        --out "$out/ck" --format h5 --checkpoint "$out/ck/rigid-body.h5-pending/step.npy" ;;
 esac
 cmp -s "$out/moments.csv" "$out/ck/moments.csv" || fail "a refused --checkpoint changed moments.csv"
 cmp -s "$out/rigid.csv" "$out/ck/rigid-body.csv" || fail "a failed --checkpoint changed rigid-body.csv"

@@ -204,21 +204,34 @@ bool same_file(const std::string &a, const std::string &b) {
     return resolved(a) == resolved(b);
 }
 
+// Whether `path` lies inside the directory `dir` (which need not exist).
+bool inside(const std::string &path, const std::string &dir) {
+    const std::string d = resolved(dir) + "/";
+    return resolved(path).compare(0, d.size(), d) == 0;
+}
+
 // The files a run writes and the options naming them, checked before
 // anything is written: --checkpoint (and --wisdom, which measured planning
-// writes) may be none of the run's outputs nor the --init grid, and the
-// --init grid none of the outputs, for the run would overwrite one with the
-// other. A usage error: "" or the message.
-std::string colliding_paths(const RunOptions &o, const std::vector<std::string> &outputs) {
+// writes) may be none of the run's outputs nor the --init grid, nor a folder
+// the run keeps its data in (`output_dirs`) or a file in one, and the --init
+// grid none of the outputs, for the run would overwrite one with the other.
+// A usage error: "" or the message.
+std::string colliding_paths(const RunOptions &o, const std::vector<std::string> &outputs,
+                            const std::vector<std::string> &output_dirs) {
     struct Named {
         std::string option, path;
     };
     // Read before the run, but the data of the run that made it would be lost.
-    if (!o.init.empty())
+    if (!o.init.empty()) {
         for (const std::string &output : outputs)
             if (same_file(o.init, output))
                 return "lpi run: --init " + o.init + " is " + output +
                        ", which this run writes: copy it, or give --out another directory";
+        for (const std::string &dir : output_dirs)
+            if (inside(o.init, dir))
+                return "lpi run: --init " + o.init + " is in " + dir +
+                       ", where this run writes its data: copy it, or give --out another directory";
+    }
     std::vector<Named> written;
     if (!o.checkpoint.empty()) written.push_back({"--checkpoint", o.checkpoint});
     if (!o.wisdom.empty()) written.push_back({"--wisdom", o.wisdom});
@@ -230,6 +243,10 @@ std::string colliding_paths(const RunOptions &o, const std::vector<std::string> 
             if (same_file(w.path, output))
                 return "lpi run: " + w.option + " " + w.path + " is " + output +
                        ", which this run writes: give it another name";
+        for (const std::string &dir : output_dirs)
+            if (same_file(w.path, dir) || inside(w.path, dir))
+                return "lpi run: " + w.option + " " + w.path + (same_file(w.path, dir) ? " is " : " is in ") + dir +
+                       ", the folder where this run writes its data: give it another name";
         // The snapshot images are named by the scene and their steps:
         // SCENE_vorticity_STEP.png and .svg.
         const std::size_t slash = w.path.find_last_of('/');
@@ -347,7 +364,7 @@ int run_command(int argc, char **argv) {
     outputs.insert(outputs.begin(), csv);
     const std::string vorticity_script = o.out_dir + "/" + vorticity_script_name(o.scene);
     outputs.push_back(vorticity_script);
-    const std::string collision = colliding_paths(o, outputs);
+    const std::string collision = colliding_paths(o, outputs, data_folders(o));
     if (!collision.empty()) {
         std::fprintf(stderr, "%s\n", collision.c_str());
         return 2;

@@ -1,5 +1,6 @@
 #include "run_data.hpp"
 
+#include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -121,6 +122,10 @@ std::vector<std::string> data_files(const RunOptions &o, const RunData &d) {
 }
 
 std::string journal_path(const RunOptions &o) { return data_path(o) + "-pending"; }
+
+std::vector<std::string> data_folders(const RunOptions &o) {
+    return {o.format == "h5" ? journal_path(o) : data_path(o)};
+}
 
 namespace {
 
@@ -280,6 +285,15 @@ void write_journal(const NpyRange &range, const RunData &d, NpySet &set) {
 void remove_journal(const std::string &dir, const RunData &d) {
     unlink((dir + "/base.npy").c_str());
     for (const GrowingArray &a : growing_arrays(d)) unlink((dir + "/" + a.name + ".npy").c_str());
+    // The temporary files (.lpi-XXXXXXXXXXXX) of a journal write that a kill
+    // stopped: the folder is lpi's own, and would otherwise stay for them.
+    if (DIR *folder = opendir(dir.c_str())) {
+        while (const dirent *entry = readdir(folder)) {
+            const std::string name = entry->d_name;
+            if (name.size() == 17 && name.compare(0, 5, ".lpi-") == 0) unlink((dir + "/" + name).c_str());
+        }
+        closedir(folder);
+    }
     rmdir(dir.c_str());
 }
 

@@ -98,6 +98,10 @@ std::string write_data(const RunOptions &o, const RunData &d, const std::vector<
 // The folder of an HDF5 file's journal: DIR/SCENE.h5-pending.
 std::string journal_path(const RunOptions &o);
 
+// The folders lpi run writes its data in (their files named by it, and its
+// temporary ones): the HDF5 file's journal, or the folder of .npy files.
+std::vector<std::string> data_folders(const RunOptions &o);
+
 // A row of the CSV and of the data (rows x Casimirs there): what a resumed
 // run keeps of the interrupted one.
 struct KeptRow {
