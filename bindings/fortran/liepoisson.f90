@@ -21,13 +21,27 @@
 ! a string holding a NUL (LPI_ERR_INVALID: C would stop reading there), a
 ! negative dim (LPI_ERR_INVALID), sine-Euler arrays not N x N and the four
 ! bracket arrays of lpi_generic_create differing in length, and an array for
-! lpi_rigid_body_exact of other than 3 values (LPI_ERR_SIZE).
+! lpi_rigid_body_exact of other than 3 values (LPI_ERR_SIZE), and an integer
+! outside the C parameter's 32 bits (LPI_ERR_INVALID: see below).
 ! lpi_last_error does not describe these (it keeps the message of the
 ! library's last failure on the handle, which may be an older call's): the
 ! stop message does, and with status present the code alone tells them.
 ! Every wrapper is recursive: a callback may call the library again (on
 ! another handle, or read its own from an observer), which a procedure not
 ! declared so may not be (gfortran -fcheck=recursion stopped such a call).
+! Integer kinds: build the module with the program's own default integer
+! kind, 4 or 8 (-fdefault-integer-8 programs: cmake
+! -DCMAKE_Fortran_FLAGS=-fdefault-integer-8; against a module of the other
+! kind the compiler refuses their status arguments). Status arguments, the LPI_* constants and the
+! counts and indices of the wrappers are then of that kind. Where C takes a
+! 32-bit int (N, thread count, max_iterations, size(traces), bracket and
+! piece indices), a value outside it is refused (LPI_ERR_INVALID, naming the
+! argument) instead of being narrowed to another number (2**32 + 3 to 3);
+! lpi_method_* give ""/-1 and lpi_status_* the unknown status's answer for
+! an index outside it. A size from C that does not fit a default integer
+! (lpi_dim, ranks, counts) is LPI_ERR_OVERFLOW. Index arrays may be 32- or
+! 64-bit integers (lpi_generic_create, lpi_add_piece), counts of lpi_step
+! default or 64-bit.
 ! Handles are type(c_ptr). Index sets and bracket indices are 0-based, as in C.
 ! Sine-Euler modes and grids are arrays w(0:N-1, 0:N-1) with w(a, b) = mode
 ! (a, b) (resp. the vorticity at (2 pi a/N, 2 pi b/N)), of exactly that shape;
@@ -40,8 +54,9 @@ module liepoisson
     implicit none
     private
 
-    ! Status codes: the values are part of the C ABI (append-only).
-    integer(c_int), parameter, public :: LPI_OK = 0, LPI_ERR_NULL = -1, LPI_ERR_INVALID = -2, &
+    ! Status codes: the values are part of the C ABI (append-only). Of
+    ! default kind, as the status arguments are (-fdefault-integer-8 too).
+    integer, parameter, public :: LPI_OK = 0, LPI_ERR_NULL = -1, LPI_ERR_INVALID = -2, &
         LPI_ERR_SIZE = -3, LPI_ERR_NONFINITE = -4, LPI_ERR_NOT_ABELIAN = -5, &
         LPI_ERR_UNSUPPORTED = -6, LPI_ERR_NO_MEMORY = -7, LPI_ERR_INTERNAL = -8, &
         LPI_ERR_CALLBACK = -9, LPI_ERR_NO_CONVERGENCE = -10, LPI_ERR_IO = -11, LPI_ERR_FORMAT = -12, &
@@ -449,7 +464,9 @@ module liepoisson
         c_lpi_fftw_wisdom_export_string, c_lpi_save, c_lpi_load, c_lpi_save_buffer, c_lpi_load_buffer
 
     ! lpi_step, lpi_set_observer and lpi_sine_euler_fft_floor take a default
-    ! or 64-bit count, as C's int64_t.
+    ! or 64-bit count, as C's int64_t; lpi_generic_create and lpi_add_piece
+    ! 32- or 64-bit index arrays (a literal [0, 1, 2] is either, with the
+    ! default kind), the 64-bit ones checked against C's int32_t.
     interface lpi_step
         module procedure lpi_step_i4, lpi_step_i8
     end interface
@@ -458,6 +475,12 @@ module liepoisson
     end interface
     interface lpi_sine_euler_fft_floor
         module procedure lpi_sine_euler_fft_floor_i4, lpi_sine_euler_fft_floor_i8
+    end interface
+    interface lpi_generic_create
+        module procedure lpi_generic_create_i4, lpi_generic_create_i8
+    end interface
+    interface lpi_add_piece
+        module procedure lpi_add_piece_i4, lpi_add_piece_i8
     end interface
 
     public :: lpi_version_string, lpi_version_number, lpi_kind, lpi_get_method, lpi_get_split, &
@@ -487,12 +510,12 @@ contains
         type(c_ptr), intent(in) :: p
         character(len=:), allocatable :: s
         character(kind=c_char), pointer :: chars(:)
-        integer :: n, q
+        integer(c_size_t) :: n, q  ! not narrowed to a default integer
         if (.not. c_associated(p)) then
             s = ""
             return
         end if
-        n = int(c_strlen(p))
+        n = c_strlen(p)
         call c_f_pointer(p, chars, [n])
         allocate (character(len=n) :: s)
         do q = 1, n
@@ -512,10 +535,11 @@ contains
     ! see: status receives code, or the program stops with message (C has no
     ! way to take it, so lpi_last_error keeps what it had).
     recursive subroutine refuse(code, message, status)
-        integer(c_int), intent(in) :: code
+        integer, intent(in) :: code
         character(len=*), intent(in) :: message
         integer, intent(out), optional :: status
-        if (.not. present(status)) error stop "liepoisson: "//f_string(c_lpi_status_name(code))//": "//message
+        if (.not. present(status)) &
+            error stop "liepoisson: "//f_string(c_lpi_status_name(int(code, c_int)))//": "//message
         status = code
     end subroutine
 
@@ -539,6 +563,68 @@ contains
         if (negative_refused) then
             write (text, '(i0)') n
             call refuse(LPI_ERR_INVALID, what//" = "//trim(text)//" is negative", status)
+        end if
+    end function
+
+    ! .true. when n fits C's int32_t (and int: 32 bits wherever gfortran
+    ! runs). A default integer of 8 bytes (-fdefault-integer-8) may not:
+    ! int(n, c_int32_t) would then give another number (2**32 + 3 as 3).
+    recursive logical function fits_int32(n)
+        integer(c_int64_t), intent(in) :: n
+        fits_int32 = n >= -int(huge(0_c_int32_t), c_int64_t) - 1 .and. n <= huge(0_c_int32_t)
+    end function
+
+    ! .true. after refusing n outside C's int32_t (LPI_ERR_INVALID), before
+    ! it is narrowed to another number.
+    recursive logical function int32_refused(n, what, status)
+        integer(c_int64_t), intent(in) :: n
+        character(len=*), intent(in) :: what
+        integer, intent(out), optional :: status
+        character(len=24) :: text
+        int32_refused = .not. fits_int32(n)
+        if (int32_refused) then
+            write (text, '(i0)') n
+            call refuse(LPI_ERR_INVALID, what//" = "//trim(text)//" is outside C's 32-bit int", status)
+        end if
+    end function
+
+    ! .true. after refusing the first element of v outside C's int32_t, as
+    ! int32_refused, named what(position).
+    recursive logical function indices_refused(v, what, status)
+        integer(c_int64_t), intent(in) :: v(:)
+        character(len=*), intent(in) :: what
+        integer, intent(out), optional :: status
+        character(len=24) :: text
+        integer(c_int64_t) :: q
+        indices_refused = .false.
+        do q = 1, size(v, kind=c_int64_t)
+            if (.not. fits_int32(v(q))) then
+                write (text, '(i0)') q
+                indices_refused = int32_refused(v(q), what//"("//trim(text)//")", status)
+                return
+            end if
+        end do
+    end function
+
+    ! out = n when the size C gave fits a default integer; otherwise .false.
+    ! after refusing it (LPI_ERR_OVERFLOW), out = -1: int(n) would give
+    ! another number (beyond 2**31 - 1 without -fdefault-integer-8).
+    recursive logical function size_fits(n, out, what, status)
+        integer(c_size_t), intent(in) :: n
+        integer, intent(out) :: out
+        character(len=*), intent(in) :: what
+        integer, intent(out), optional :: status
+        character(len=24) :: text
+        ! A size_t above 2**63 - 1 reads as negative here.
+        size_fits = n >= 0 .and. n <= huge(out)
+        out = -1
+        if (size_fits) then
+            out = int(n)
+        else
+            text = "above 2**63 - 1"
+            if (n >= 0) write (text, '(i0)') n
+            call refuse(LPI_ERR_OVERFLOW, what//" = "//trim(text)//" does not fit a default integer "// &
+                        "(build the module with -fdefault-integer-8)", status)
         end if
     end function
 
@@ -593,48 +679,63 @@ contains
         lpi_version_number = c_lpi_version_number()
     end function
 
+    ! A status outside C's int is unknown to C: it is asked about INT_MIN,
+    ! no status code, instead of the number int(status, c_int) would make.
     recursive function lpi_status_name(status) result(s)
         integer, intent(in) :: status
         character(len=:), allocatable :: s
-        s = f_string(c_lpi_status_name(int(status, c_int)))
+        s = f_string(c_lpi_status_name(c_status(status)))
     end function
 
     recursive function lpi_status_message(status) result(s)
         integer, intent(in) :: status
         character(len=:), allocatable :: s
-        s = f_string(c_lpi_status_message(int(status, c_int)))
+        s = f_string(c_lpi_status_message(c_status(status)))
+    end function
+
+    recursive integer(c_int) function c_status(status)
+        integer, intent(in) :: status
+        c_status = -huge(0_c_int) - 1_c_int
+        if (fits_int32(int(status, c_int64_t))) c_status = int(status, c_int)
     end function
 
     recursive integer function lpi_method_count()
         lpi_method_count = c_lpi_method_count()
     end function
 
-    ! Methods are numbered 0 .. lpi_method_count() - 1, as in C; "" out of range.
+    ! Methods are numbered 0 .. lpi_method_count() - 1, as in C; "" (-1) out
+    ! of range, also outside C's int (not asked: int(i, c_int) could make it
+    ! a valid index).
     recursive function lpi_method_name(i) result(s)
         integer, intent(in) :: i
         character(len=:), allocatable :: s
-        s = f_string(c_lpi_method_name(int(i, c_int)))
+        s = ""
+        if (fits_int32(int(i, c_int64_t))) s = f_string(c_lpi_method_name(int(i, c_int)))
     end function
 
     recursive integer function lpi_method_order(i)
         integer, intent(in) :: i
-        lpi_method_order = c_lpi_method_order(int(i, c_int))
+        lpi_method_order = -1
+        if (fits_int32(int(i, c_int64_t))) lpi_method_order = c_lpi_method_order(int(i, c_int))
     end function
 
     recursive integer function lpi_method_is_poisson(i)
         integer, intent(in) :: i
-        lpi_method_is_poisson = c_lpi_method_is_poisson(int(i, c_int))
+        lpi_method_is_poisson = -1
+        if (fits_int32(int(i, c_int64_t))) lpi_method_is_poisson = c_lpi_method_is_poisson(int(i, c_int))
     end function
 
     recursive integer function lpi_method_stages(i)
         integer, intent(in) :: i
-        lpi_method_stages = c_lpi_method_stages(int(i, c_int))
+        lpi_method_stages = -1
+        if (fits_int32(int(i, c_int64_t))) lpi_method_stages = c_lpi_method_stages(int(i, c_int))
     end function
 
     recursive function lpi_method_reference(i) result(s)
         integer, intent(in) :: i
         character(len=:), allocatable :: s
-        s = f_string(c_lpi_method_reference(int(i, c_int)))
+        s = ""
+        if (fits_int32(int(i, c_int64_t))) s = f_string(c_lpi_method_reference(int(i, c_int)))
     end function
 
     ! ---- systems ------------------------------------------------------------------
@@ -701,9 +802,13 @@ contains
         call finish(c_lpi_set_split(sys, c_string(name)), sys, status)
     end subroutine
 
+    ! A dim beyond a default integer stops the program (LPI_ERR_OVERFLOW:
+    ! no status to take it, so size_fits returns only when it fits).
     recursive integer function lpi_dim(sys)
         type(c_ptr), intent(in) :: sys
-        lpi_dim = int(c_lpi_dim(sys))
+        integer :: n
+        if (size_fits(c_lpi_dim(sys), n, "lpi_dim")) continue
+        lpi_dim = n
     end function
 
     ! size(x) must equal lpi_dim(sys).
@@ -782,7 +887,9 @@ contains
 
     recursive integer function lpi_casimir_count(sys)
         type(c_ptr), intent(in) :: sys
-        lpi_casimir_count = int(c_lpi_casimir_count(sys))
+        integer :: n
+        if (size_fits(c_lpi_casimir_count(sys), n, "lpi_casimir_count")) continue  ! as lpi_dim
+        lpi_casimir_count = n
     end function
 
     ! size(c) must equal lpi_casimir_count(sys).
@@ -843,8 +950,7 @@ contains
         integer(c_int) :: st
         n = 0
         st = c_lpi_flows_per_step(sys, n)
-        flows = int(n)
-        call finish(st, sys, status)
+        if (size_fits(n, flows, "lpi_flows_per_step: flows", status)) call finish(st, sys, status)
     end subroutine
 
     recursive subroutine lpi_set_implicit_options(sys, tolerance, max_iterations, status)
@@ -852,6 +958,8 @@ contains
         real(c_double), intent(in) :: tolerance
         integer, intent(in) :: max_iterations
         integer, intent(out), optional :: status
+        if (int32_refused(int(max_iterations, c_int64_t), "lpi_set_implicit_options: max_iterations", &
+                          status)) return
         call finish(c_lpi_set_implicit_options(sys, tolerance, int(max_iterations, c_int32_t)), &
                     sys, status)
     end subroutine
@@ -859,7 +967,7 @@ contains
     ! ---- generic systems and the moment algebra ------------------------------------
 
     ! {x_i, x_j} = sum c x_k over the entries (i(e), j(e), k(e), c(e)), 0-based.
-    recursive subroutine lpi_generic_create(sys, dim, i, j, k, c, status)
+    recursive subroutine lpi_generic_create_i4(sys, dim, i, j, k, c, status)
         type(c_ptr), intent(out) :: sys
         integer, intent(in) :: dim
         integer(c_int32_t), intent(in) :: i(:), j(:), k(:)
@@ -876,8 +984,21 @@ contains
                     c_null_ptr, status)
     end subroutine
 
+    recursive subroutine lpi_generic_create_i8(sys, dim, i, j, k, c, status)
+        type(c_ptr), intent(out) :: sys
+        integer, intent(in) :: dim
+        integer(c_int64_t), intent(in) :: i(:), j(:), k(:)
+        real(c_double), intent(in) :: c(:)
+        integer, intent(out), optional :: status
+        sys = c_null_ptr
+        if (indices_refused(i, "lpi_generic_create: i", status)) return
+        if (indices_refused(j, "lpi_generic_create: j", status)) return
+        if (indices_refused(k, "lpi_generic_create: k", status)) return
+        call lpi_generic_create_i4(sys, dim, int(i, c_int32_t), int(j, c_int32_t), int(k, c_int32_t), c, status)
+    end subroutine
+
     ! Appends the piece on the 0-based abelian index set indices.
-    recursive subroutine lpi_add_piece(sys, indices, grad, energy, user, status)
+    recursive subroutine lpi_add_piece_i4(sys, indices, grad, energy, user, status)
         type(c_ptr), intent(in) :: sys
         integer(c_int32_t), intent(in) :: indices(:)
         procedure(lpi_gradient_fn) :: grad
@@ -894,6 +1015,17 @@ contains
             call finish(c_lpi_add_piece(sys, size(indices, kind=c_size_t), indices, c_funloc(grad), &
                                         c_funloc(energy), u), sys, status)
         end if
+    end subroutine
+
+    recursive subroutine lpi_add_piece_i8(sys, indices, grad, energy, user, status)
+        type(c_ptr), intent(in) :: sys
+        integer(c_int64_t), intent(in) :: indices(:)
+        procedure(lpi_gradient_fn) :: grad
+        procedure(lpi_energy_fn) :: energy
+        type(c_ptr), intent(in), optional :: user
+        integer, intent(out), optional :: status
+        if (indices_refused(indices, "lpi_add_piece: indices", status)) return
+        call lpi_add_piece_i4(sys, int(indices, c_int32_t), grad, energy, user, status)
     end subroutine
 
     recursive subroutine lpi_add_casimir(sys, fn, user, status)
@@ -921,8 +1053,7 @@ contains
         else
             st = c_lpi_poisson_rank(sys, x, size(x, kind=c_size_t), r)
         end if
-        rank = int(r)
-        call finish(st, sys, status)
+        if (size_fits(r, rank, "lpi_poisson_rank: rank", status)) call finish(st, sys, status)
     end subroutine
 
     recursive subroutine lpi_moments_create(sys, status)
@@ -948,6 +1079,8 @@ contains
         type(c_ptr), intent(out) :: sys
         integer, intent(in) :: n
         integer, intent(out), optional :: status
+        sys = c_null_ptr
+        if (int32_refused(int(n, c_int64_t), "lpi_sine_euler_create: n", status)) return
         call finish(c_lpi_sine_euler_create(sys, int(n, c_int32_t)), c_null_ptr, status)
     end subroutine
 
@@ -969,8 +1102,7 @@ contains
         complex(c_double_complex), intent(in) :: w(:, :)
         integer, intent(out), optional :: status
         real(c_double), allocatable :: buf(:)
-        integer :: a, b
-        integer(c_int64_t) :: n1, n2, q  ! 2 N^2 passes a default integer from N = 32769
+        integer(c_int64_t) :: a, b, n1, n2, q  ! 2 N^2 passes a default integer from N = 32769
         if (shape_refused(sys, shape(w), "lpi_sine_euler_set_modes: w", status)) return
         n1 = size(w, 1, kind=c_int64_t)
         n2 = size(w, 2, kind=c_int64_t)
@@ -991,8 +1123,7 @@ contains
         integer, intent(out), optional :: status
         real(c_double), allocatable :: buf(:)
         integer(c_int) :: st
-        integer :: a, b
-        integer(c_int64_t) :: n1, n2, q  ! as in lpi_sine_euler_set_modes
+        integer(c_int64_t) :: a, b, n1, n2, q  ! as in lpi_sine_euler_set_modes
         if (shape_refused(sys, shape(w), "lpi_sine_euler_get_modes: w", status)) return
         n1 = size(w, 1, kind=c_int64_t)
         n2 = size(w, 2, kind=c_int64_t)
@@ -1046,6 +1177,8 @@ contains
         type(c_ptr), intent(in) :: sys
         real(c_double), intent(inout) :: traces(:)
         integer, intent(out), optional :: status
+        if (int32_refused(size(traces, kind=c_int64_t), "lpi_sine_euler_casimir_traces: size(traces)", &
+                          status)) return
         call finish(c_lpi_sine_euler_casimir_traces(sys, size(traces, kind=c_int32_t), traces), &
                     sys, status)
     end subroutine
@@ -1098,8 +1231,7 @@ contains
         integer, intent(out), optional :: status
         real(c_double), allocatable :: t(:, :)
         real(c_double), allocatable, target :: buf(:)
-        integer :: a, b
-        integer(c_int64_t) :: n2, q  ! as in lpi_sine_euler_set_modes
+        integer(c_int64_t) :: a, b, n2, q  ! as in lpi_sine_euler_set_modes
         if (shape_refused(sys, shape(lambda), "lpi_sine_euler_set_hamiltonian: lambda", status)) return
         if (present(f)) then
             if (shape_refused(sys, shape(f), "lpi_sine_euler_set_hamiltonian: f", status)) return
@@ -1113,7 +1245,7 @@ contains
         end if
         n2 = size(f, 2, kind=c_int64_t)
         allocate (buf(2 * size(f, 1, kind=c_int64_t) * n2))
-        do a = 1, size(f, 1)
+        do a = 1, size(f, 1, kind=c_int64_t)
             do b = 1, n2
                 q = 2 * ((a - 1) * n2 + (b - 1))
                 buf(q + 1) = real(f(a, b), c_double)
@@ -1148,21 +1280,23 @@ contains
         integer, intent(out) :: shells
         integer, intent(out), optional :: status
         integer(c_size_t) :: count
+        integer(c_int) :: st
         type(c_ptr) :: e, z
         count = 0
         e = c_null_ptr
         z = c_null_ptr
         if (size(energy) > 0) e = c_loc(energy)
         if (size(enstrophy) > 0) z = c_loc(enstrophy)
-        call finish(c_lpi_sine_euler_spectrum(sys, e, z, int(min(size(energy), size(enstrophy)), c_size_t), &
-                                              count), sys, status)
-        shells = int(count)
+        st = c_lpi_sine_euler_spectrum(sys, e, z, min(size(energy, kind=c_size_t), size(enstrophy, kind=c_size_t)), &
+                                       count)
+        if (size_fits(count, shells, "lpi_sine_euler_spectrum: shells", status)) call finish(st, sys, status)
     end subroutine
 
     recursive subroutine lpi_set_threads(sys, n, status)
         type(c_ptr), intent(in) :: sys
         integer, intent(in) :: n
         integer, intent(out), optional :: status
+        if (int32_refused(int(n, c_int64_t), "lpi_set_threads: n", status)) return
         call finish(c_lpi_set_threads(sys, int(n, c_int32_t)), sys, status)
     end subroutine
 
@@ -1192,9 +1326,9 @@ contains
         character(len=:), allocatable, intent(out) :: wisdom
         integer, intent(out), optional :: status
         character(kind=c_char), allocatable, target :: buf(:)
-        integer(c_size_t) :: length
+        integer(c_size_t) :: length, q  ! not narrowed to a default integer
         integer(c_int) :: st
-        integer :: q
+        integer :: tries
         wisdom = ""
         length = 0
         st = c_lpi_fftw_wisdom_export_string(c_null_ptr, 0_c_size_t, length)  ! a query of the length
@@ -1202,7 +1336,7 @@ contains
             ! The wisdom is the process's: another thread planning between the
             ! query and the copy adds to it, and the buffer is then made again
             ! at the new length (given with LPI_ERR_SIZE).
-            do q = 1, 100
+            do tries = 1, 100
                 if (allocated(buf)) deallocate (buf)
                 allocate (buf(length + 1))
                 st = c_lpi_fftw_wisdom_export_string(c_loc(buf), size(buf, kind=c_size_t), length)
@@ -1210,8 +1344,8 @@ contains
             end do
             if (st == LPI_OK) then
                 deallocate (wisdom)
-                allocate (character(len=int(length)) :: wisdom)
-                do q = 1, int(length)
+                allocate (character(len=length) :: wisdom)
+                do q = 1, length
                     wisdom(q:q) = buf(q)
                 end do
             end if

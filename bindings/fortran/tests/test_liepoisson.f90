@@ -1,7 +1,9 @@
 ! Test of the Fortran binding: statuses, the rigid body's Casimir, errors with
 ! state unchanged, refusals made in Fortran of what C cannot see, Fortran
-! callbacks against the built-in model, and sine-Euler (modes, grid
-! orientation, Casimirs, array shapes) when the library has FFTW.
+! callbacks against the built-in model, sine-Euler (modes, grid
+! orientation, Casimirs, array shapes) when the library has FFTW, and
+! integers beyond C's 32 bits refused (test_fortran_integer8 builds this
+! program and the module with -fdefault-integer-8).
 module test_callbacks
     use, intrinsic :: iso_c_binding
     implicit none
@@ -91,6 +93,7 @@ program test_liepoisson
     call test_generic()
     call test_sine_euler()
     call test_observer()
+    call test_wide_integers()
     if (failures > 0) then
         print '(i0, a)', failures, " check(s) failed"
         stop 1
@@ -376,6 +379,77 @@ contains
         call lpi_moments_create(ref)
         call check(lpi_casimir_count(ref) == 2, "moments: two Casimirs")
         call lpi_destroy(ref)
+    end subroutine
+
+    ! 64-bit index arrays whatever the default kind; with a default integer
+    ! of 8 bytes, default integers beyond C's 32-bit int refused before C,
+    ! not narrowed to another number (2**32 + 3 to 3), and literal index
+    ! arrays (64-bit then) taken. The big values are computed at run time,
+    ! so that a 4-byte build compiles them.
+    subroutine test_wide_integers()
+        real(c_double), target, save :: inverse(3)
+        type(c_ptr) :: sys, gen
+        integer :: two32, status
+        character(len=:), allocatable :: msg
+        inverse = 1.0_c_double / inertia
+        print '(a, i0, a)', "default integer: ", digits(0) + 1, " bits"
+        call lpi_generic_create(gen, 3, [0_c_int64_t, 0_c_int64_t, 1_c_int64_t], &
+                                [1_c_int64_t, 2_c_int64_t, 2_c_int64_t], [2_c_int64_t, 1_c_int64_t, 0_c_int64_t], &
+                                [-1.0_c_double, 1.0_c_double, -1.0_c_double], status)
+        call check(status == LPI_OK .and. lpi_dim(gen) == 3, "64-bit bracket index arrays")
+        call lpi_add_piece(gen, [0_c_int64_t], axis_grad, axis_energy, c_loc(inverse(1)), status)
+        call check(status == LPI_OK, "64-bit piece index array")
+        call lpi_add_piece(gen, [1_c_int64_t, 2_c_int64_t**32 + 2], axis_grad, axis_energy, &
+                           c_loc(inverse(2)), status)
+        call check(status == LPI_ERR_INVALID, "piece index 2**32 + 2 refused, not taken as 2")
+        call lpi_destroy(gen)
+        call lpi_generic_create(gen, 3, [0_c_int64_t], [1_c_int64_t], [2_c_int64_t**32 + 2], [1.0_c_double], &
+                                status)
+        call check(status == LPI_ERR_INVALID .and. .not. c_associated(gen), &
+                   "bracket index 2**32 + 2 refused, no handle")
+        if (digits(0) <= 31) return
+        two32 = 2
+        two32 = two32**32
+
+        ! Refused before C: the thread's and the handle's messages stay.
+        call lpi_rigid_body_create(sys, -1.0_c_double, 1.0_c_double, 1.0_c_double, status)
+        msg = lpi_last_error(c_null_ptr)
+        call lpi_sine_euler_create(sys, two32 + 3, status)
+        call check(status == LPI_ERR_INVALID, "sine-Euler N = 2**32 + 3 refused, not made N = 3")
+        call check(.not. c_associated(sys), "no handle after N = 2**32 + 3")
+        call check(lpi_last_error(c_null_ptr) == msg, "N = 2**32 + 3 refused before C")
+        call lpi_rigid_body_create(sys, 1.0_c_double, 2.0_c_double, 3.0_c_double)
+        call lpi_set_method(sys, "no-such-method", status)
+        msg = lpi_last_error(sys)
+        call lpi_set_threads(sys, two32 + 1, status)
+        call check(status == LPI_ERR_INVALID, "2**32 + 1 threads refused, not set to 1")
+        call check(lpi_last_error(sys) == msg, "threads refused before C (the count unchanged)")
+        ! 2**32 + 1 iterations taken as 1 would leave implicit-midpoint
+        ! unconverged at 1e-13.
+        call lpi_set_method(sys, "implicit-midpoint")
+        call lpi_set_state(sys, [1.0_c_double, 0.5_c_double, -0.3_c_double])
+        call lpi_set_implicit_options(sys, 1e-13_c_double, two32 + 1, status)
+        call check(status == LPI_ERR_INVALID, "2**32 + 1 implicit iterations refused")
+        call lpi_step(sys, 0.01_c_double, 10, status)
+        call check(status == LPI_OK, "implicit options unchanged (100 iterations converge)")
+        call lpi_destroy(sys)
+        ! Out of range, not wrapped to method 0 or to a known status.
+        call check(lpi_method_name(two32) == "", "method 2**32 has no name")
+        call check(lpi_method_order(two32) == -1 .and. lpi_method_is_poisson(two32) == -1 .and. &
+                   lpi_method_stages(two32) == -1 .and. lpi_method_reference(two32) == "", &
+                   "method 2**32 out of range")
+        call check(lpi_status_name(two32 + LPI_ERR_SIZE) == "LPI_UNKNOWN_STATUS", "status 2**32 - 3 unknown")
+        call check(lpi_status_message(two32 + LPI_ERR_SIZE) == lpi_status_message(-1000), &
+                   "status 2**32 - 3: the unknown status's message")
+        ! Literal index arrays are 64-bit here.
+        call lpi_generic_create(gen, 3, [0, 0, 1], [1, 2, 2], [2, 1, 0], &
+                                [-1.0_c_double, 1.0_c_double, -1.0_c_double], status)
+        call check(status == LPI_OK, "literal bracket index arrays")
+        call lpi_add_piece(gen, [0], axis_grad, axis_energy, c_loc(inverse(1)), status)
+        call check(status == LPI_OK, "literal piece index array")
+        call lpi_add_piece(gen, [1, two32 + 2], axis_grad, axis_energy, c_loc(inverse(2)), status)
+        call check(status == LPI_ERR_INVALID, "default piece index 2**32 + 2 refused")
+        call lpi_destroy(gen)
     end subroutine
 
     subroutine test_sine_euler()
