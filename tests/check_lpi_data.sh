@@ -235,6 +235,25 @@ for name, g in cases.items():
     expected = np.asarray(g, dtype=np.float64)
     assert np.max(np.abs(d["vorticity"][0] - expected)) < 1e-13, name
     assert abs(d["energy"][0] - energy(expected)) < 1e-13 * energy(expected), name
+# The topography scene writes its h beside q = w + h: the energy of each
+# snapshot, 1/2 sum |q_m - h_m|^2 / |m|^2 less the same of h alone, is the
+# row's (a wrong h, or none, fails it).
+folder = os.path.join(out, "topography")
+subprocess.run([lpi, "run", "topography", "--N", str(N), "--dt", "0.05", "--steps", "6", "--every", "2",
+                "--snapshots", "1", "--format", "npy", "--out", folder], check=True, stdout=subprocess.DEVNULL)
+d = load_npy(os.path.join(folder, "topography"))
+h = d["topography"]
+assert h.shape == (N, N) and abs(np.mean(h**2) - 1.0) < 1e-13, h.shape  # sum |h_m|^2 = 1
+for k, step in enumerate(d["snapshot_step"]):
+    row = list(d["step"]).index(step)
+    e = energy(d["vorticity"][k] - h) - energy(h)
+    assert abs(e - d["energy"][row]) < 1e-13 * abs(e), (step, e, d["energy"][row])
+if have_h5 and h5py:
+    subprocess.run([lpi, "run", "topography", "--N", str(N), "--steps", "2", "--out", folder], check=True,
+                   stdout=subprocess.DEVNULL)
+    with h5py.File(os.path.join(folder, "topography.h5"), "r") as f:
+        assert np.array_equal(f["topography"][()], h) and f["topography"].dims[0][0].name == "/x"
+print("topography: its h is written with the data, and q - h has the rows' energy")
 usage = subprocess.run([lpi, "run", "--help"], check=True, capture_output=True).stdout.decode()
 assert "int64" in usage and "int32" in usage, "lpi run --help does not name the integer dtypes --init reads"
 print("--init: .npy float64, float32, int64, int32 and Fortran order start from the given grid")

@@ -27,6 +27,9 @@ std::vector<double> lambda_of(int N, Weight weight) {
     return lambda;
 }
 
+// The topography h's modes (sum |h_n|^2 = 1).
+std::vector<double> topography_modes(int N) { return smooth_random_field(N, 2.0, 11); }
+
 // The scenes' field with lambda_n = weight(|n|^2) and, with `topography`,
 // over the smooth random topography h (f = -lambda h). lambda and f are made
 // once the system exists: the library refuses an N too large for memory
@@ -36,7 +39,7 @@ Handle with_hamiltonian(int N, const std::function<double(double)> &weight, bool
     const std::vector<double> lambda = lambda_of(N, weight);
     std::vector<double> f;
     if (topography) {
-        f = smooth_random_field(N, 2.0, 11);  // the modes of h
+        f = topography_modes(N);
         for (std::size_t i = 0; i < lambda.size(); ++i) {
             f[2 * i] *= -lambda[i];
             f[2 * i + 1] *= -lambda[i];
@@ -60,6 +63,13 @@ Handle qg_system(int N, double kd) {
 
 Handle topography_system(int N) {
     return with_hamiltonian(N, [](double m2) { return 1.0 / m2; }, true);
+}
+
+std::vector<double> topography_grid(int N) {
+    Handle h = sine_euler(N, topography_modes);  // spread as the run's system is
+    std::vector<double> grid(static_cast<std::size_t>(N) * N);
+    check(lpi_sine_euler_get_grid(h.get(), grid.data(), grid.size()), h.get(), "topography grid");
+    return grid;
 }
 
 }  // namespace lpi_cli

@@ -15,5 +15,8 @@ Handle qg_system(int N, double kd);
 // Euler over a smooth random topography h (sum |h_n|^2 = 1): the state is
 // q = w + h, lambda = 1/|n|^2 and f = -h/|n|^2; q starts as the same field.
 Handle topography_system(int N);
+// That scene's h on the grid (entry a*N + b at (2 pi a/N, 2 pi b/N)), which
+// lpi run writes with the data: w = q - h.
+std::vector<double> topography_grid(int N);
 
 }  // namespace lpi_cli

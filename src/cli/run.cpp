@@ -358,6 +358,7 @@ int run_command(int argc, char **argv) {
                                                                     static_cast<std::size_t>(N)}
                                          : std::vector<std::size_t>{lpi_dim(sys)};
     data.casimir_count = lpi_casimir_count(sys);
+    if (data.vorticity && it->topography) data.topography = it->topography();
     const std::string csv = o.out_dir + "/" + o.scene + ".csv";
     // What this run writes (the vorticity images besides, SCENE_vorticity_STEP by their steps).
     std::vector<std::string> outputs = data_files(o, data);

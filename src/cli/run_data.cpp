@@ -59,6 +59,7 @@ std::vector<Dataset> datasets_of(const RunData &d) {
         sets.push_back({"x", array_of({N}, x), {}, true});
         sets.push_back({"y", array_of({N}, x), {}, true});
         sets.push_back({"vorticity", array_of(shape, d.snapshots), {"snapshot_time", "x", "y"}, false});
+        if (!d.topography.empty()) sets.push_back({"topography", array_of({N, N}, d.topography), {"x", "y"}, false});
     } else {
         sets.push_back({"component", array_of({d.snapshot_shape[0]}, indices(d.snapshot_shape[0], 1.0), true),
                         {}, true});

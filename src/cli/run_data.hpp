@@ -24,6 +24,7 @@ struct RunData {
     std::vector<double> snapshots;            // snapshots x snapshot_shape
     std::vector<std::size_t> snapshot_shape;  // (N, N) vorticity, else (dim) state
     bool vorticity = false;
+    std::vector<double> topography;  // N x N: the scene's h, or none
 
     std::size_t snapshot_size() const {
         std::size_t n = 1;
@@ -36,6 +37,7 @@ struct RunData {
         shaped.casimir_count = d.casimir_count;
         shaped.snapshot_shape = d.snapshot_shape;
         shaped.vorticity = d.vorticity;
+        shaped.topography = d.topography;
         return shaped;
     }
     // Drops the rows and snapshots after `step` (a resumed run's start).

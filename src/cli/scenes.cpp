@@ -177,6 +177,7 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
             std::string description;
             std::function<Handle()> create;
             std::vector<std::string> options;  // beyond kSineEulerOptions
+            std::function<std::vector<double>()> topography = nullptr;
         } family[] = {
             {"sqg", "surface quasi-geostrophy (lambda = 1/|n|), N = " + std::to_string(N),
              [N] { return sqg_system(N); }, {}},
@@ -184,7 +185,7 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
                        std::to_string(N),
              [N, kd] { return qg_system(N, kd); }, {"--kd"}},
             {"topography", "2D Euler over a smooth random topography h (its field: q = w + h), N = " + std::to_string(N),
-             [N] { return topography_system(N); }, {}},
+             [N] { return topography_system(N); }, {}, [N] { return topography_grid(N); }},
         };
         for (const auto &member : family) {
             Scene s = sweep_scene(member.name, member.description + ", smooth random field", member.create, 10.0,
@@ -197,6 +198,7 @@ std::vector<Scene> builtin_scenes(const SceneOptions &options) {
             s.reference_method = "kahan-li-8";
             s.reference_step = 0.02;
             s.in_default_report = false;
+            s.topography = member.topography;
             scenes.push_back(s);
         }
     }

@@ -46,6 +46,9 @@ struct Scene {
     // A scene that is not a step-size sweep runs this instead (figure2);
     // false when an output file was not written (it said why).
     std::function<bool(const std::string &out_dir)> custom_run;
+    // The fixed topography h of a scene over one (its state is q = w + h) on
+    // the grid, which lpi run writes with the data; empty for the others.
+    std::function<std::vector<double>()> topography;
     // A scene `lpi run` integrates its own way (rollup); returns the exit status.
     std::function<int(const OwnRun &)> run_own;
 };
