@@ -476,6 +476,16 @@ expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$
 expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$out/ck" --checkpoint "$out/ck//./rigid-body.csv"
 expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$out/ck" --format npy \
     --checkpoint "$out/ck/rigid-body/state.npy"
+# An --out that does not exist yet, spelt with "//", "/./" or "x/..": the
+# same file all the same (it had silently replaced the CSV with the checkpoint).
+expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$out/new1/" \
+    --checkpoint "$out/new1/rigid-body.csv"
+expect 2 "--checkpoint.*which this run writes" run rigid-body --steps 9 --out "$out/new2" \
+    --checkpoint "$out/new2/./x/../rigid-body.csv"
+expect 2 "--checkpoint.*is in .*the folder where this run writes its data" run rigid-body --steps 9 \
+    --out "$out/new3//" --format npy --checkpoint "$out/new3/rigid-body/x.lpi"
+"$lpi" run rigid-body --steps 9 --out "$out/new4/" --checkpoint "$out/new4/rigid-body.h5-pending2" >/dev/null ||
+    fail "a --checkpoint whose name only begins with the journal's was refused"
 # The folders the data is written in: the .npy folder, the HDF5 file's journal.
 expect 2 "--checkpoint.*is in .*the folder where this run writes its data" run rigid-body --steps 9 \
     --out "$out/ck" --format npy --checkpoint "$out/ck/rigid-body/x.lpi"

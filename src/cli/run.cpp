@@ -182,17 +182,29 @@ std::size_t csv_text_size(std::size_t rows, std::size_t casimir_count) {
 }
 
 // A path as the file system resolves it: the real path of the file, or of
-// the nearest directory above it that exists, and the rest of the name.
+// the nearest directory above it that exists, and the rest of the name with
+// its empty and "." parts dropped and ".." taken back a part ("b//c/", "b/./c"
+// and "b/x/../c" are "b/c" where b/c does not exist yet: what a file created
+// there will be).
 std::string resolved(const std::string &path) {
+    if (path.empty()) return resolved(".");
     if (char *real = realpath(path.c_str(), nullptr)) {
         const std::string r = real;
         std::free(real);
         return r;
     }
-    const std::size_t slash = path.find_last_of('/');
-    if (slash == std::string::npos) return resolved(".") + "/" + path;
-    if (slash == 0) return path;
-    return resolved(path.substr(0, slash)) + path.substr(slash);
+    std::size_t end = path.size();
+    while (end > 1 && path[end - 1] == '/') --end;  // "b/" names b
+    const std::size_t slash = path.find_last_of('/', end - 1);
+    const std::string name = path.substr(slash == std::string::npos ? 0 : slash + 1,
+                                         end - (slash == std::string::npos ? 0 : slash + 1));
+    const std::string above = resolved(slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash));
+    if (name.empty() || name == "/" || name == ".") return above;
+    if (name == "..") {
+        const std::size_t up = above.find_last_of('/');
+        return up == 0 || up == std::string::npos ? "/" : above.substr(0, up);
+    }
+    return above == "/" ? "/" + name : above + "/" + name;
 }
 
 // Whether two paths name one file: the same file when both exist (links
