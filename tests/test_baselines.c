@@ -90,6 +90,31 @@ static void test_midpoint_keeps_quadratic_invariants(void **state) {
     lpi_destroy(sys);
 }
 
+/* The rigid body's field is quadratic: the state scaled by s with the step
+ * scaled by 1/s is the same motion, scaled. The iteration's stopping test is
+ * relative, so a small state converges as far as one of size 1 (with the
+ * test's old absolute floor, tolerance * max(1, max|x|), a state of 1e-10
+ * stopped 4e-4 off). */
+static void test_midpoint_on_small_states(void **state) {
+    (void)state;
+    const double m[3] = {1.0, 0.5, -0.3}, dt = 0.1;
+    double unit[3], scaled[3];
+    lpi_system *sys = rigid_body();
+    assert_int_equal(lpi_set_method(sys, "implicit-midpoint"), LPI_OK);
+    assert_int_equal(lpi_step(sys, dt, 1), LPI_OK);
+    assert_int_equal(lpi_get_state(sys, unit, 3), LPI_OK);
+    for (double s = 1e-4; s >= 1e-100; s *= 1e-8) {
+        const double small[3] = {s * m[0], s * m[1], s * m[2]};
+        assert_int_equal(lpi_set_state(sys, small, 3), LPI_OK);
+        assert_int_equal(lpi_step(sys, dt / s, 1), LPI_OK);
+        assert_int_equal(lpi_get_state(sys, scaled, 3), LPI_OK);
+        double worst = 0.0;
+        for (int i = 0; i < 3; ++i) worst = fmax(worst, fabs(scaled[i] / s - unit[i]) / fabs(unit[i] - m[i]));
+        if (worst > 1e-9) fail_msg("state scaled by %g: off by %.2e of the step's increment", s, worst);
+    }
+    lpi_destroy(sys);
+}
+
 static void test_implicit_options_bad_input(void **state) {
     (void)state;
     lpi_system *sys = rigid_body();
@@ -161,6 +186,7 @@ int main(void) {
         cmocka_unit_test(test_poisson_flags),
         cmocka_unit_test(test_midpoint_non_convergence_rolls_back),
         cmocka_unit_test(test_midpoint_keeps_quadratic_invariants),
+        cmocka_unit_test(test_midpoint_on_small_states),
         cmocka_unit_test(test_implicit_options_bad_input),
         cmocka_unit_test(test_midpoint_counts_its_evaluations),
     };

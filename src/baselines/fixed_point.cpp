@@ -9,8 +9,8 @@ namespace lpi {
 void FixedPointTest::diverged() const {
     fail(LPI_ERR_NO_CONVERGENCE, std::string(method_) +
                                      ": fixed-point iteration diverged to a change that is not finite "
-                                     "(dt too large for the iteration, or a state so large that its "
-                                     "products overflow)");
+                                     "(dt too large for the iteration, or a state so far from magnitude 1 "
+                                     "that its products overflow or underflow)");
 }
 
 void FixedPointTest::failed() const {

@@ -17,16 +17,18 @@ inline double max_change(double change, double d) {
 }
 
 // One step's test: the iteration has converged when its largest change is at
-// most tolerance * max(1, max|x|) (lpi_set_implicit_options), x the state
-// the step starts from. The bound is formed once per step; where the product
-// overflows, the true bound exceeds every double and DBL_MAX stands for it,
-// so that the test never compares against +inf.
+// most tolerance * max|x| (lpi_set_implicit_options), x the state the step
+// starts from: relative at every size (an absolute floor of tolerance, as
+// max(1, max|x|) gave, let a state of 1e-10 stop after one iteration, 2e-2
+// off). The bound is formed once per step; where the product overflows, the
+// true bound exceeds every double and DBL_MAX stands for it, so that the
+// test never compares against +inf.
 class FixedPointTest {
 public:
     // The failures name the method; the caller's report adds the step.
     FixedPointTest(const ImplicitSettings &settings, double largest, const char *method)
         : settings_(settings), method_(method) {
-        const double bound = settings.tolerance * std::fmax(1.0, largest);
+        const double bound = settings.tolerance * largest;
         bound_ = std::isfinite(bound) ? bound : DBL_MAX;
     }
 

@@ -77,7 +77,7 @@ protected:
 
 // How implicit methods solve their equations (fixed-point iteration).
 struct ImplicitSettings {
-    double tolerance = 1e-13;  // on max|increment| relative to max(1, max|x|)
+    double tolerance = 1e-13;  // on max|increment| relative to max|x|
     int max_iterations = 100;
 };
 
