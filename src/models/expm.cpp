@@ -234,6 +234,28 @@ void expm1_dense(std::size_t n, const double *A, double *W) {
 
 double dense_norm1(std::size_t n, const double *A) { return norm1(n, A); }
 
+bool elliptic_block(std::size_t m, const std::vector<double> &C) {
+    const double norm = norm1(m, C.data());
+    if (!(norm > 0.0) || !std::isfinite(norm)) return false;
+    int exponent = 0;
+    std::frexp(norm, &exponent);  // norm in [2^(exponent-1), 2^exponent)
+    std::vector<double> E(m * m), square(m * m), scratch;
+    for (double sign : {1.0, -1.0}) {
+        // tau = 2^-exponent, exactly: ||tau C||_1 in [1/2, 1).
+        std::vector<double> A(C);
+        for (double &a : A) a = std::ldexp(sign * a, -exponent);
+        expm_dense(m, A.data(), E.data(), scratch);
+        for (int k = 0;; ++k) {
+            const double grown = norm1(m, E.data());
+            if (!(grown <= 1048576.0)) return false;  // 2^20, or not finite
+            if (k == 42) break;
+            multiply(m, E.data(), E.data(), square.data());
+            std::swap(E, square);
+        }
+    }
+    return true;
+}
+
 std::size_t square_entries(std::size_t n, const char *what) {
     if (n != 0 && n > std::numeric_limits<std::size_t>::max() / sizeof(double) / n)
         fail(LPI_ERR_NO_MEMORY, std::string("the ") + what + " of " + std::to_string(n) + " x " +

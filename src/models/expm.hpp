@@ -51,7 +51,7 @@ struct SparseTerm {
     double coefficient;
 };
 
-enum class ExpmPath { Nilpotent, DiagonalSeries, Plane, Pade };
+enum class ExpmPath { Nilpotent, DiagonalSeries, Plane, Pade, EllipticSeries };
 
 // The largest |k| for which a diagonal entry k c g_p of the DiagonalSeries
 // path takes exp(t k c g_p) - 1 by powers of expm1(+-t c g_p).
@@ -257,6 +257,25 @@ constexpr int kMaxSquarings = 32;
 // Pade approximant takes without scaling.
 constexpr double kPadeTheta13 = 5.371920351148152e0;
 
+// The EllipticSeries path (SparseExponential::apply_elliptic): at most 2^6
+// substeps (||t A||_1 <= 32); a longer flow takes Pade. And its terms: as
+// many as bring the series' remainder below 2^-70 of x (18 at ||h C|| = 1/2).
+constexpr int kMaxEllipticHalvings = 6;
+constexpr int kMaxEllipticTerms = 24;
+// And only for a block of at most this order (elliptic_block takes 86
+// products of m x m matrices when the piece is added).
+constexpr std::size_t kMaxEllipticOrder = 64;
+
+// Whether exp(tau C) of the dense m x m C (row-major) stays bounded for
+// every real tau the flows may take: ||exp(+-2^k C / ||C||_1)||_1 <= 2^20 for
+// k = 0 .. 42 (repeated squaring). Every eigenvalue of C then has |Re| <=
+// 14 ||C||_1 / 2^42, so over the longest flow check_norm admits (||t A||_1
+// <= theta_13 2^32) no component grows or contracts by more than e^0.07:
+// the flows are those of an elliptic C (imaginary eigenvalues, C
+// semisimple) as far as any flow can tell. A hyperbolic C, or a nilpotent
+// part (growth like tau), fails.
+bool elliptic_block(std::size_t m, const std::vector<double> &C);
+
 // x <- exp(t A) x for the matrices A = sum_p g_p C_p of fixed sparse C_p,
 // the parameters g changing from call to call: a piece flow, whose C_p
 // depend only on the structure constants and the index set, its g on the
@@ -274,7 +293,12 @@ constexpr double kPadeTheta13 = 5.371920351148152e0;
 //    diagonal entry;
 //  - otherwise the block of the indices the pattern touches: of order 1 or 2
 //    in closed form (A = tau I + N with N^2 = delta I: exponentials,
-//    sines or hyperbolic sines), larger ones by the Pade exponential.
+//    sines or hyperbolic sines), larger ones by the Pade exponential;
+//  - except a block of three or more that one parameter couples, A = s C,
+//    whose flows are all bounded (elliptic_block: every eigenvalue of C
+//    imaginary, as in su(3), so(4), so(3) in a dense basis): the Taylor
+//    series on the vector, sum_k (hC)^k x / k!, over 2^j substeps h = s /
+//    2^j with ||h C||_1 <= 1/2, each rounding x once (EllipticSeries).
 // apply() allocates nothing.
 class SparseExponential {
 public:
@@ -358,6 +382,9 @@ private:
     void apply_shears(const Shears &M, double x0, double x1, double *x);
     bool rotate(double t, double *x);  // rotation_: see the definition
     void apply_pade(double t, double *x);
+    // EllipticSeries: exp(s C) x as 2^j substeps of the series on the vector
+    // (see the definition); Pade beyond kMaxEllipticHalvings.
+    void apply_elliptic(double t, double *x);
     void check_norm(double norm, double t) const;
     // Throws LPI_ERR_NONFINITE naming the first moved index whose entry of
     // increment_ (its new value, or its increment on the plane path) is not finite.
@@ -395,6 +422,15 @@ private:
     std::vector<double> scaled_values_;
     std::vector<BlockEntry> block_;  // per position, block paths
     std::vector<bool> alone_;        // Pade: per local index, a component of its own
+    // EllipticSeries: its one parameter, ||C||_1, and the positions by row
+    // (local): those of row i are elliptic_positions_[elliptic_rows_[i] ..
+    // elliptic_rows_[i + 1]).
+    std::uint32_t elliptic_parameter_ = 0;
+    double elliptic_norm_ = 0.0;
+    double elliptic_rate_ = 0.0;                 // the largest ||C^k||_1^(1/k), k >= 2
+    std::vector<double> elliptic_power_norms_;  // ||C^k||_1, k = 1 .. kMaxEllipticTerms + 1
+    std::vector<std::uint32_t> elliptic_rows_, elliptic_positions_;
+    std::vector<double> elliptic_entries_, elliptic_terms_;
     std::vector<double> scaled_, increment_, dense_, exp_, direct_, pade_scratch_;
 };
 

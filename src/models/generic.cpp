@@ -303,7 +303,9 @@ private:
     // identity). Such a flow is taken whole (factors_cancel).
     void plan_blocks(const std::vector<SparseTerm> &terms) {
         exponentials_.emplace_back(constants_.dim(), terms);
-        if (exponentials_.front().path() != ExpmPath::Pade) return;
+        if (exponentials_.front().path() != ExpmPath::Pade &&
+            exponentials_.front().path() != ExpmPath::EllipticSeries)
+            return;
         std::vector<std::vector<SparseTerm>> factors(sigma_.size()), blocks;
         for (const SparseTerm &term : terms) factors[term.parameter].push_back(term);
         for (const std::vector<SparseTerm> &factor : factors)
