@@ -515,6 +515,16 @@ mv "$out/dt-data" "$kept_data"
 rm "$out/dt/rigid-body.csv"
 expect 2 "--dt 0.1, but the interrupted run's is 0.05" run rigid-body --dt 0.1 --steps 30 --out "$out/dt" \
     --resume "$out/dt.lpi"
+# A row removed from the CSV (no data beside it): the rows' own layout is
+# refused, and so is an --every other than the interrupted run's.
+"$lpi" run rigid-body --steps 200 --out "$out/gap" --checkpoint "$out/gap.lpi" >/dev/null
+rm -rf "$out/gap/rigid-body.h5" "$out/gap/rigid-body"
+cp "$out/gap/rigid-body.csv" "$out/gap.csv"
+expect 2 "--every 3, but the interrupted run's is 2" run rigid-body --steps 400 --every 3 --out "$out/gap" \
+    --resume "$out/gap.lpi"
+sed -i 5d "$out/gap/rigid-body.csv"
+expect 2 "rows are not every 4 steps (the largest step between the rows of .*row 1 is at step 2, not 4" \
+    run rigid-body --steps 400 --out "$out/gap" --resume "$out/gap.lpi"
 # --init: a FIFO is refused, not waited on.
 rm -f "$out/fifo.npy"
 if mkfifo "$out/fifo.npy" 2>/dev/null; then

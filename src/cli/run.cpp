@@ -632,7 +632,7 @@ int run_command(int argc, char **argv) {
         }
         if (run_every == 0 && kept.size() >= 2) {
             for (std::size_t r = 1; r < kept.size(); ++r) run_every = std::max(run_every, kept[r].step - kept[r - 1].step);
-            every_from = "the step between the rows of " + rows_from;
+            every_from = "the largest step between the rows of " + rows_from;
         }
         // Given otherwise, refused: another --every ends the library's calls
         // elsewhere (and the flows merged at their seams round otherwise),
@@ -677,10 +677,16 @@ int run_command(int argc, char **argv) {
             expected += every;
             if (kept[r].step == expected || (r + 1 == kept.size() && kept[r].step == start && start < expected))
                 continue;
-            why = format("lpi run: --resume: --every %lld, but the interrupted run's row %zu is at step %lld: "
-                         "resume with its --every (another would end the library's calls elsewhere, and so not "
-                         "bit for bit where the uninterrupted run ends)",
-                         static_cast<long long>(every), r, static_cast<long long>(kept[r].step));
+            if (o.every > 0)
+                why = format("lpi run: --resume: --every %lld, but the interrupted run's row %zu is at step %lld: "
+                             "resume with its --every (another would end the library's calls elsewhere, and so not "
+                             "bit for bit where the uninterrupted run ends)",
+                             static_cast<long long>(every), r, static_cast<long long>(kept[r].step));
+            else  // --every not given: the layout the rows themselves or the data gave is broken
+                why = format("lpi run: --resume: the interrupted run's rows are not every %lld steps (%s): row %zu "
+                             "is at step %lld, not %lld (a row removed or added since lpi wrote it?)",
+                             static_cast<long long>(every), every_from.empty() ? "this run's default" : every_from.c_str(),
+                             r, static_cast<long long>(kept[r].step), static_cast<long long>(expected));
         }
         if (const int agreed = agreed_failure(why.empty() ? 0 : 2, why)) return agreed;
     }
