@@ -120,7 +120,7 @@ void check_compensated_state(const Model &model, const double *state) {
         if (std::fabs(state[n + i]) > kMaxRelativeCarry * largest)
             fail(LPI_ERR_INVALID, "the compensation carry of state entry " + std::to_string(i) +
                                       " is " + number_text(state[n + i]) +
-                                      ", no rounding remainder of a state whose largest entry "
+                                      ", no rounding remainder of a state whose largest entry (with its carry) "
                                       "is " + number_text(largest));
 }
 
