@@ -120,7 +120,10 @@ def _real(value, what):
         return float(value)
     if isinstance(value, (bool, str, bytes)) or not isinstance(value, numbers.Real):
         raise TypeError("%s must be a real number, not %s" % (what, type(value).__name__))
-    return float(value)
+    try:
+        return float(value)
+    except (TypeError, ValueError):  # registered as a number, not one (numpy's timedelta64)
+        raise TypeError("%s must be a real number, not %s" % (what, type(value).__name__)) from None
 
 
 def _complex(value, what):
@@ -129,7 +132,10 @@ def _complex(value, what):
         return complex(value)
     if isinstance(value, (bool, str, bytes)) or not isinstance(value, numbers.Number):
         raise TypeError("%s must be a complex number, not %s" % (what, type(value).__name__))
-    return complex(value)
+    try:
+        return complex(value)
+    except (TypeError, ValueError):
+        raise TypeError("%s must be a complex number, not %s" % (what, type(value).__name__)) from None
 
 
 def _callable(value, what):

@@ -82,6 +82,18 @@ class TestIntegerRanges(unittest.TestCase):
         with self.assertRaises(lp.InvalidArgumentError):  # no piece was added
             g.step(0.01, 1)
 
+    def test_numpy_times_are_not_numbers(self):
+        # numpy registers timedelta64 as an integer type; float() of it fails.
+        if np is None:
+            self.skipTest("numpy not available")
+        with rigid_body() as b:
+            before = as_list(b.state)
+            for what, call in (("dt", lambda: b.step(np.timedelta64(1, "ms"), 1)),
+                               ("state", lambda: b.set_state([np.timedelta64(1, "s"), 0.0, 0.0]))):
+                with self.assertRaisesRegex(TypeError, "%s.* must be a real number, not timedelta64" % what):
+                    call()
+            self.assertEqual((as_list(b.state), b.time), (before, 0.0))
+
     def test_sizes_of_systems(self):
         for N in (2 ** 32 + 5, 2 ** 31, -2 ** 31 - 1):
             with self.assertRaises(OverflowError):
