@@ -911,6 +911,33 @@ static void test_elliptic_block_without_bias(void **state) {
     }
 }
 
+/* A state near DBL_MAX whose flow stays finite: the series' terms may
+ * overflow where the flow does not (||h C||_1 above 1), and the flow is then
+ * Pade's, not refused. The same flow of the state scaled by 2^-900, scaled
+ * back, is the reference. */
+static void test_elliptic_block_near_overflow(void **state) {
+    (void)state;
+    static const int32_t i[] = {0, 0, 0, 0, 1, 1, 1}, j[] = {1, 1, 2, 2, 2, 2, 2}, k[] = {0, 2, 0, 1, 0, 1, 2};
+    static const double c[] = {-5, 3, 1, -2, 9, -1, -5}, field = 0.7;
+    const int32_t index = 2;
+    lpi_system *sys = NULL;
+    assert_int_equal(lpi_generic_create(&sys, 3, 7, i, j, k, c), LPI_OK);
+    assert_int_equal(lpi_add_piece(sys, 1, &index, scaled_gradient, scaled_energy, (void *)&field), LPI_OK);
+    assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
+    const double huge[3] = {0x1.cf88311c44cbep+1022, 0x1.fcbf54b71469ep+1022, -0x1.7a5e85cdd5308p+1018};
+    double small[3], y[3], reference[3];
+    for (int e = 0; e < 3; ++e) small[e] = ldexp(huge[e], -900);
+    assert_int_equal(lpi_set_state(sys, small, 3), LPI_OK);
+    assert_int_equal(lpi_step(sys, 1.0, 1), LPI_OK);
+    assert_int_equal(lpi_get_state(sys, reference, 3), LPI_OK);
+    assert_int_equal(lpi_set_state(sys, huge, 3), LPI_OK);
+    if (lpi_step(sys, 1.0, 1) != LPI_OK) fail_msg("a finite flow of a state near DBL_MAX: %s", lpi_last_error(sys));
+    assert_int_equal(lpi_get_state(sys, y, 3), LPI_OK);
+    for (int e = 0; e < 3; ++e)
+        assert_true(fabs(y[e] - ldexp(reference[e], 900)) <= 1e-13 * 0x1p1023);
+    lpi_destroy(sys);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_rigid_body_matches_built_in),
@@ -932,6 +959,7 @@ int main(void) {
         cmocka_unit_test(test_scalings_beyond_the_normal_range),
         cmocka_unit_test(test_diagonal_runs_with_its_series),
         cmocka_unit_test(test_elliptic_block_without_bias),
+        cmocka_unit_test(test_elliptic_block_near_overflow),
     };
     return lpi_run_tests(tests);
 }
