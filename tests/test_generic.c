@@ -841,10 +841,10 @@ static long double quadratic_form(int n, const double *Q, const double *x, long 
     *size = 0.0L;
     for (int i = 0; i < n; ++i)
         for (int j = i; j < n; ++j) {
-            const double q = Q[i * n + j] * (i == j ? 1.0 : 2.0); /* integers: exact */
+            const double q = Q[i * n + j] * (i == j ? 1.0 : 2.0); /* small integers or powers of 2 */
             if (q == 0.0) continue;
             const double p = x[i] * x[j], e = fma(x[i], x[j], -p);
-            const double terms[2] = {q * p, q * e}; /* exact: q a small integer, then */
+            const double terms[2] = {q * p, q * e}; /* exact, then */
             for (int t = 0; t < 2; ++t) {             /* Knuth's two_sum into sum + error */
                 const double total = sum + terms[t], part = total - sum;
                 error += (sum - (total - part)) + (terms[t] - part);
@@ -873,22 +873,31 @@ static void test_elliptic_block_without_bias(void **state) {
     static const int32_t so3_i[] = {0, 0, 0, 0, 1, 1, 1}, so3_j[] = {1, 1, 2, 2, 2, 2, 2},
                          so3_k[] = {0, 2, 0, 1, 0, 1, 2};
     static const double so3_c[] = {-5, 3, 1, -2, 9, -1, -5};
-    /* The quadratic Casimirs, times 4 and times 3: integer forms. */
-    double su3_q[64] = {0}, so3_q[9] = {9, -1, -5, -1, 2, 0, -5, 0, 3};
+    /* sl(2) in the basis {e - delta f, h, f}, delta = 2^-40: elliptic, but
+     * nearly parabolic (eigenvalues +-2i sqrt(delta)), its flows bounded only
+     * by about 1/delta. */
+    static const int32_t sl2_i[] = {0, 0, 0, 1}, sl2_j[] = {1, 1, 2, 2}, sl2_k[] = {0, 2, 1, 2};
+    static const double sl2_c[] = {-2, -0x1p-38, 1, -2};
+    /* The quadratic Casimirs, times 4, times 3 and times 2^-38: forms of
+     * exact entries. */
+    double su3_q[64] = {0}, so3_q[9] = {9, -1, -5, -1, 2, 0, -5, 0, 3}, sl2_q[9] = {0, 0, 2, 0, 1, 0, 2, 0, 0x1p-38};
     for (int e = 0; e < 6; ++e) su3_q[e * 9] = 3.0;
     su3_q[6 * 8 + 6] = su3_q[7 * 8 + 7] = 4.0, su3_q[6 * 8 + 7] = su3_q[7 * 8 + 6] = 2.0;
     static const double field = 0.7;
-    for (int algebra = 0; algebra < 2; ++algebra) {
+    static const char *const names[] = {"su(3)", "so(3) in a dense basis", "sl(2), nearly parabolic"};
+    for (int algebra = 0; algebra < 3; ++algebra) {
         const int n = algebra ? 3 : 8;
-        const int32_t index = algebra ? 2 : 0;
+        const int32_t index = algebra == 1 ? 2 : 0;
         lpi_system *sys = NULL;
-        if (algebra)
+        if (algebra == 2)
+            assert_int_equal(lpi_generic_create(&sys, 3, 4, sl2_i, sl2_j, sl2_k, sl2_c), LPI_OK);
+        else if (algebra == 1)
             assert_int_equal(lpi_generic_create(&sys, 3, 7, so3_i, so3_j, so3_k, so3_c), LPI_OK);
         else
             assert_int_equal(lpi_generic_create(&sys, 8, 28, su3_i, su3_j, su3_k, su3_c), LPI_OK);
         assert_int_equal(lpi_add_piece(sys, 1, &index, scaled_gradient, scaled_energy, (void *)&field), LPI_OK);
         assert_int_equal(lpi_set_method(sys, "lie-trotter"), LPI_OK);
-        const double *Q = algebra ? so3_q : su3_q;
+        const double *Q = algebra == 2 ? sl2_q : algebra ? so3_q : su3_q;
         uint64_t seed = 5;
         lpi_test_mean change = {0};
         for (int m = 0; m < 20000; ++m) {
@@ -904,8 +913,7 @@ static void test_elliptic_block_without_bias(void **state) {
         double mean, spread;
         const double z = lpi_test_mean_z(&change, &mean, &spread);
         printf("%s, H = 0.7 x%d, one flow of 1: mean change of the Casimir %.2e of its terms, %.1f "
-               "standard errors (rounding: %.2e a flow)\n", algebra ? "so(3) in a dense basis" : "su(3)",
-               (int)index, mean, z, spread);
+               "standard errors (rounding: %.2e a flow)\n", names[algebra], (int)index, mean, z, spread);
         assert_true(fabs(z) < 5.0);
         lpi_destroy(sys);
     }

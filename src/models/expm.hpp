@@ -266,14 +266,16 @@ constexpr int kMaxEllipticTerms = 24;
 // products of m x m matrices when the piece is added).
 constexpr std::size_t kMaxEllipticOrder = 64;
 
-// Whether exp(tau C) of the dense m x m C (row-major) stays bounded for
-// every real tau the flows may take: ||exp(+-2^k C / ||C||_1)||_1 <= 2^20 for
-// k = 0 .. 42 (repeated squaring). Every eigenvalue of C then has |Re| <=
-// 14 ||C||_1 / 2^42, so over the longest flow check_norm admits (||t A||_1
-// <= theta_13 2^32) no component grows or contracts by more than e^0.07:
-// the flows are those of an elliptic C (imaginary eigenvalues, C
-// semisimple) as far as any flow can tell. A hyperbolic C, or a nilpotent
-// part (growth like tau), fails.
+// Whether exp(tau C) of the dense m x m C (row-major) grows no faster than
+// a polynomial in tau: ||exp(+-2^k C / ||C||_1)||_1 <= 2^(20 + k (m - 1)),
+// at most 2^900, for k = 0 .. 42 (repeated squaring). Every eigenvalue of C
+// then has |Re| <= 624 ||C||_1 / 2^42, so over the flows the series takes
+// (||t A||_1 <= 32) no component grows or contracts exponentially by more
+// than e^(5e-9): an elliptic C (imaginary eigenvalues) as far as any of
+// those flows can tell, semisimple or not (a nilpotent part, or a nearly
+// parabolic block bounded only by about 1/delta, grows polynomially). A
+// hyperbolic C fails: its contracted coordinates keep their relative
+// accuracy on the Pade path.
 bool elliptic_block(std::size_t m, const std::vector<double> &C);
 
 // x <- exp(t A) x for the matrices A = sum_p g_p C_p of fixed sparse C_p,
