@@ -222,7 +222,8 @@ LPI_API int lpi_set_composition(lpi_system *sys, size_t n, const double *gammas)
 LPI_API int lpi_flows_per_step(const lpi_system *sys, size_t *out);
 
 /* Settings of the implicit baselines (implicit-midpoint; isomp for sine-Euler):
- * the fixed-point iteration stops when max|change| <= tolerance * max|x|
+ * the fixed-point iteration stops when max|change| <= tolerance * max|x| (or
+ * at the noise of subnormal arithmetic, where the vector field underflows)
  * and fails with LPI_ERR_NO_CONVERGENCE (state rolled back) after
  * max_iterations. Defaults: 1e-13 and 100. Kept across lpi_set_method. */
 LPI_API int lpi_set_implicit_options(lpi_system *sys, double tolerance, int32_t max_iterations);

@@ -357,6 +357,25 @@ static void test_isomp_non_convergence_rolls_back(void **state) {
 
 /* Splits and threads do not matter to the matrix methods; switching methods
  * back and forth keeps working (plans are made and released per method). */
+/* The midpoint's stopping test is relative to the state, down to the noise
+ * of subnormal arithmetic: a field of 1e-158 (its products underflow) scaled
+ * with the step by 1e158 (the same motion, scaled) still steps, where a test
+ * relative all the way down waited for a change below the noise. */
+static void test_midpoint_where_products_underflow(void **state) {
+    (void)state;
+    require_fftw();
+    enum { N = 15 };
+    double w0[2 * N * N];
+    random_field(N, 5, w0);
+    const double largest = max_abs(w0, 2 * N * N);
+    for (int i = 0; i < 2 * N * N; ++i) w0[i] *= 1e-158 / largest;
+    lpi_system *sys = sine_euler(N, w0);
+    assert_int_equal(lpi_set_method(sys, "implicit-midpoint"), LPI_OK);
+    const int status = lpi_step(sys, 0.05 * 1e158, 1);
+    if (status != LPI_OK) fail_msg("a field of 1e-158: %s", lpi_last_error(sys));
+    lpi_destroy(sys);
+}
+
 static void test_switching(void **state) {
     (void)state;
     require_blas();
@@ -414,6 +433,7 @@ int main(void) {
         cmocka_unit_test(test_spectrum_of_overflowing_matrix),
         cmocka_unit_test(test_isomp_isospectral),
         cmocka_unit_test(test_isomp_non_convergence_rolls_back),
+        cmocka_unit_test(test_midpoint_where_products_underflow),
         cmocka_unit_test(test_switching),
         cmocka_unit_test(test_without_blas),
     };

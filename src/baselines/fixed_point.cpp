@@ -17,7 +17,8 @@ void FixedPointTest::failed() const {
     fail(LPI_ERR_NO_CONVERGENCE,
          std::string(method_) + ": fixed-point iteration did not converge in " +
              std::to_string(settings_.max_iterations) + " iterations (dt too large for the "
-             "iteration, or raise the limit with lpi_set_implicit_options)");
+             "iteration, a state whose products underflow, or raise the limit with "
+             "lpi_set_implicit_options)");
 }
 
 }  // namespace lpi

@@ -53,7 +53,7 @@ private:
         for (std::size_t i = 0; i < size; ++i) midpoint_[i] = x[i] + 0.5 * dt * rate_[i];
         double largest = 0.0;
         for (std::size_t i = 0; i < size; ++i) largest = std::max(largest, std::fabs(x[i]));
-        const FixedPointTest test(settings_, largest, "implicit midpoint");
+        const FixedPointTest test(settings_, largest, 0.5 * dt, "implicit midpoint");
         bool converged = false;
         int iterations = 0;
         while (iterations < settings_.max_iterations && !converged) {

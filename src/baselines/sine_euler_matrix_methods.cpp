@@ -263,7 +263,9 @@ private:
         // B Wt B = -c^2 P Wt P, symmetrised so Wt stays exactly Hermitian.
         const double quad = -0.25 * h * h * c_ * c_;
         const std::size_t n = static_cast<std::size_t>(N);
-        const FixedPointTest test(settings_, largest, "isomp");
+        // The iterate's products: h/2 times a commutator, quad times two
+        // products of N terms.
+        const FixedPointTest test(settings_, largest, (0.5 * std::fabs(h) + std::fabs(quad)) * N, "isomp");
         bool converged = false;
         for (int k = 0; k < settings_.max_iterations && !converged; ++k) {
             form_.stream(*hamiltonian_, mid, P_.data());
