@@ -260,6 +260,17 @@ bool elliptic_block(std::size_t m, const std::vector<double> &C) {
     return true;
 }
 
+std::vector<double> power_norms(std::size_t m, const std::vector<double> &C, int count) {
+    std::vector<double> norms, power(C), product(m * m);
+    norms.push_back(norm1(m, C.data()));
+    for (int k = 2; k <= count; ++k) {
+        multiply(m, power.data(), C.data(), product.data());
+        power.swap(product);
+        norms.push_back(norm1(m, power.data()));
+    }
+    return norms;
+}
+
 std::size_t square_entries(std::size_t n, const char *what) {
     if (n != 0 && n > std::numeric_limits<std::size_t>::max() / sizeof(double) / n)
         fail(LPI_ERR_NO_MEMORY, std::string("the ") + what + " of " + std::to_string(n) + " x " +

@@ -278,6 +278,9 @@ constexpr std::size_t kMaxEllipticOrder = 64;
 // accuracy on the Pade path.
 bool elliptic_block(std::size_t m, const std::vector<double> &C);
 
+// ||C^k||_1 for k = 1 .. count of the dense m x m C (row-major).
+std::vector<double> power_norms(std::size_t m, const std::vector<double> &C, int count);
+
 // x <- exp(t A) x for the matrices A = sum_p g_p C_p of fixed sparse C_p,
 // the parameters g changing from call to call: a piece flow, whose C_p
 // depend only on the structure constants and the index set, its g on the

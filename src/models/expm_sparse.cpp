@@ -306,17 +306,10 @@ SparseExponential::SparseExponential(std::size_t n, std::vector<SparseTerm> term
                 // so(3) in a dense basis, ||C^k||^(1/k) tends to its frequency
                 // 4.1, where ||C||_1 is 16), and their rate, the largest
                 // ||C^k||^(1/k) for k >= 2.
-                std::vector<double> power(C), product(m * m);
-                elliptic_power_norms_.push_back(elliptic_norm_);
-                for (int k = 2; k <= kMaxEllipticTerms + 1; ++k) {
-                    std::fill(product.begin(), product.end(), 0.0);
-                    for (std::size_t i = 0; i < m; ++i)
-                        for (std::size_t l = 0; l < m; ++l)
-                            for (std::size_t j = 0; j < m; ++j) product[i * m + j] += power[i * m + l] * C[l * m + j];
-                    power.swap(product);
-                    elliptic_power_norms_.push_back(dense_norm1(m, power.data()));
-                    elliptic_rate_ = std::max(elliptic_rate_, std::pow(elliptic_power_norms_.back(), 1.0 / k));
-                }
+                elliptic_power_norms_ = power_norms(m, C, kMaxEllipticTerms + 1);
+                for (int k = 2; k <= kMaxEllipticTerms + 1; ++k)
+                    elliptic_rate_ = std::max(
+                        elliptic_rate_, std::pow(elliptic_power_norms_[static_cast<std::size_t>(k - 1)], 1.0 / k));
                 elliptic_rows_.assign(m + 1, 0);
                 for (const BlockEntry &b : block_) ++elliptic_rows_[b.row + 1];
                 for (std::size_t r = 0; r < m; ++r) elliptic_rows_[r + 1] += elliptic_rows_[r];
