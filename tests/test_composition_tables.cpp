@@ -188,9 +188,9 @@ void test_check_detects_bad_tables(void **) {
 
 void test_flow_program_merging(void **) {
     const lpi::Method leapfrog = lpi::find_method("leapfrog");
-    const auto two = lpi::build_flow_program(leapfrog, 2);
+    const auto two = lpi::FlowProgram(leapfrog, 2).written_out();
     assert_int_equal(two.size(), 3u);  // A/2 B A/2; the seam across steps merges too
-    const auto tj = lpi::build_flow_program(lpi::find_method("triple-jump-4"), 2);
+    const auto tj = lpi::FlowProgram(lpi::find_method("triple-jump-4"), 2).written_out();
     assert_int_equal(tj.size(), 7u);  // 3 stages x 3 flows - 2 seams
     double total_a = 0, total_b = 0;
     for (const auto &f : tj) (f.piece == 0 ? total_a : total_b) += f.weight;

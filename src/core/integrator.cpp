@@ -46,12 +46,9 @@ namespace {
 // of the next are merged into one: n steps then cost n*(L-1)+1 flows.
 class SplittingIntegrator final : public Integrator {
 public:
-    explicit SplittingIntegrator(std::vector<Flow> program) : program_(std::move(program)) {
-        merge_seam_ = program_.size() > 1 && program_.front().piece == program_.back().piece;
-        for (const Flow &f : program_) largest_ = std::max(largest_, std::fabs(f.weight));
-        if (merge_seam_)
-            largest_ = std::max(largest_, std::fabs(program_.back().weight + program_.front().weight));
-    }
+    explicit SplittingIntegrator(FlowProgram program)
+        : program_(std::move(program)), merge_seam_(program_.has_seams()),
+          largest_(program_.largest_weight()) {}
 
     std::int64_t advance(Model &model, double *state, double dt, std::int64_t n,
                          StepsInProgress &progress) override {
@@ -65,17 +62,18 @@ public:
     RunOutcome run(Model &model, double *state, double dt, std::int64_t n,
                    const StepObserver &observer, StepsInProgress &progress) override {
         const std::size_t size = model.state_size();
-        const std::size_t last = program_.size() - 1;
-        const std::size_t inner_end = merge_seam_ ? last : program_.size();
+        const Flow first = merge_seam_ ? program_.first() : Flow{};
+        const Flow last = merge_seam_ ? program_.last() : Flow{};
+        const double merged = last.weight + first.weight;
+        const auto flow = [&](const Flow &f) { model.flow(f.piece, f.weight * dt, state); };
         // The next observed step, counted rather than found by a division
         // per step (one division costs as much as a small model's flow).
         std::int64_t next_observed = observer.every > 0 ? observer.every : INT64_MAX;
         progress = {1, 1};  // the leading flow is step 1's: a failure there names it
-        if (merge_seam_) model.flow(program_[0].piece, program_[0].weight * dt, state);
+        if (merge_seam_) flow(first);
         for (std::int64_t step = 1; step <= n; ++step) {
             progress = {step, step};
-            for (std::size_t i = merge_seam_ ? 1 : 0; i < inner_end; ++i)
-                model.flow(program_[i].piece, program_[i].weight * dt, state);
+            program_.for_each_between_seams(flow);
             const bool observed = step == next_observed;
             if (observed)
                 next_observed = observer.every <= INT64_MAX - step ? step + observer.every : INT64_MAX;
@@ -85,12 +83,10 @@ public:
                     model.settle(state);  // the copy must hold what the flows may keep elsewhere
                     pending_.assign(state, state + size);
                 }
-                if (observed || final) {
-                    model.flow(program_[last].piece, program_[last].weight * dt, state);
-                } else {
-                    const double merged = program_[last].weight + program_[0].weight;
-                    model.flow(program_[last].piece, merged * dt, state);
-                }
+                if (observed || final)
+                    flow(last);
+                else
+                    flow({last.piece, merged});
             }
             const bool checked = observed || final || step % kFiniteCheckInterval == 0;
             if (checked) model.settle(state);
@@ -98,8 +94,7 @@ public:
             if (observed && observer.observe(step)) return {RunOutcome::Stopped, step};
             if (merge_seam_ && observed && !final) {
                 std::copy(pending_.begin(), pending_.end(), state);
-                const double merged = program_[last].weight + program_[0].weight;
-                model.flow(program_[last].piece, merged * dt, state);
+                flow({last.piece, merged});
             }
         }
         return {RunOutcome::Done, n};
@@ -116,9 +111,9 @@ public:
     double largest_step_fraction() const override { return largest_; }
 
 private:
-    std::vector<Flow> program_;
-    bool merge_seam_ = false;
-    double largest_ = 0.0;
+    FlowProgram program_;
+    bool merge_seam_;
+    double largest_;
     std::vector<double> pending_;  // an observed step's state before its last flow
 };
 
@@ -126,7 +121,7 @@ private:
 
 std::unique_ptr<Integrator> make_splitting_integrator(const Method &method, const Model &model,
                                                       const ImplicitSettings &) {
-    return std::make_unique<SplittingIntegrator>(build_flow_program(method, model.piece_count()));
+    return std::make_unique<SplittingIntegrator>(FlowProgram(method, model.piece_count()));
 }
 
 std::unique_ptr<Integrator> make_integrator(const Method &method, const Model &model,

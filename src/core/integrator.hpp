@@ -86,7 +86,7 @@ std::unique_ptr<Integrator> make_integrator(const Method &method, const Model &m
                                             const ImplicitSettings &implicit = {});
 
 // The factory of every splitting row: composes the model's piece flows in
-// the method's flow program (build_flow_program).
+// the method's flow program (FlowProgram).
 std::unique_ptr<Integrator> make_splitting_integrator(const Method &method, const Model &model,
                                                       const ImplicitSettings &implicit);
 

@@ -1,5 +1,6 @@
 #include "methods.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -304,35 +305,59 @@ Method custom_composition(const double *gammas, std::size_t n) {
                        "user-supplied symmetric composition of leapfrog");
 }
 
-std::vector<Flow> build_flow_program(const Method &method, std::size_t pieces) {
-    std::vector<Flow> raw;
-    if (pieces == 0) return raw;  // nothing to compose; System::step refuses to step
+FlowProgram::FlowProgram(const Method &method, std::size_t pieces) {
+    if (pieces == 0) return;  // nothing to compose; System::step refuses to step
     switch (method.kind) {
     case MethodKind::Sequence:
-        for (std::size_t k = 0; k < pieces; ++k) raw.push_back({k, 1.0});
-        break;
+        for (std::size_t k = 0; k < pieces; ++k) stage_.push_back({k, 1.0});
+        gammas_ = {1.0};
+        return;
     case MethodKind::SequenceAdjoint:
-        for (std::size_t k = pieces; k-- > 0;) raw.push_back({k, 1.0});
-        break;
+        for (std::size_t k = pieces; k-- > 0;) stage_.push_back({k, 1.0});
+        gammas_ = {1.0};
+        return;
     case MethodKind::SymmetricComposition:
-        raw.reserve(method.gammas.size() * (2 * pieces - 1));
-        for (double g : method.gammas) {
-            for (std::size_t k = 0; k + 1 < pieces; ++k) raw.push_back({k, 0.5 * g});
-            raw.push_back({pieces - 1, g});
-            for (std::size_t k = pieces - 1; k-- > 0;) raw.push_back({k, 0.5 * g});
+        if (pieces == 1) {  // every stage's one flow merged into one, summed in order
+            double total = method.gammas.front();
+            for (std::size_t i = 1; i < method.gammas.size(); ++i) total += method.gammas[i];
+            stage_ = {{0, 1.0}};
+            gammas_ = {total};
+            return;
         }
-        break;
+        // A stage is A_0/2 .. A_{m-2}/2 A_{m-1} A_{m-2}/2 .. A_0/2 for gamma dt;
+        // the halves of A_0 at a seam are one flow (0.5 g + 0.5 g', as summed).
+        for (std::size_t k = 1; k + 1 < pieces; ++k) stage_.push_back({k, 0.5});
+        stage_.push_back({pieces - 1, 1.0});
+        for (std::size_t k = pieces - 1; k-- > 1;) stage_.push_back({k, 0.5});
+        gammas_ = method.gammas;
+        seams_.push_back(0.5 * gammas_.front());
+        for (std::size_t i = 1; i < gammas_.size(); ++i)
+            seams_.push_back(0.5 * gammas_[i - 1] + 0.5 * gammas_[i]);
+        seams_.push_back(0.5 * gammas_.back());
+        return;
     case MethodKind::Baseline:
-        fail(LPI_ERR_INTERNAL, "build_flow_program called for a non-splitting method");
+        fail(LPI_ERR_INTERNAL, "a flow program asked of a non-splitting method");
     }
-    std::vector<Flow> merged;
-    for (const Flow &f : raw) {
-        if (!merged.empty() && merged.back().piece == f.piece)
-            merged.back().weight += f.weight;
-        else
-            merged.push_back(f);
-    }
-    return merged;
+}
+
+std::vector<Flow> FlowProgram::written_out() const {
+    std::vector<Flow> flows;
+    if (has_seams()) flows.push_back(first());
+    for_each_between_seams([&](const Flow &f) { flows.push_back(f); });
+    if (has_seams()) flows.push_back(last());
+    return flows;
+}
+
+double FlowProgram::largest_weight() const {
+    // fl(|w| |g|) grows with each factor, so the largest product is that of
+    // the largest factors.
+    double stage = 0.0, gamma = 0.0, largest = 0.0;
+    for (const Flow &f : stage_) stage = std::max(stage, std::fabs(f.weight));
+    for (double g : gammas_) gamma = std::max(gamma, std::fabs(g));
+    largest = stage * gamma;
+    for (double w : seams_) largest = std::max(largest, std::fabs(w));
+    if (has_seams()) largest = std::max(largest, std::fabs(last().weight + first().weight));
+    return largest;
 }
 
 }  // namespace lpi
