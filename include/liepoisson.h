@@ -11,7 +11,12 @@
  * callback unwinds through it, the call rolled back: liepoisson(7)).
  *
  * Threading: one handle is used by one thread at a time; different handles
- * are independent and may be used concurrently.
+ * are independent and may be used concurrently. A call on a handle that
+ * another thread is inside returns LPI_ERR_BUSY, but for the functions that
+ * return no status (below), which take no hold of it: call those only while
+ * no other thread is inside a call on the handle. A pthread_cancel that
+ * comes while the library waits or touches files acts after the call
+ * (liepoisson(7)).
  *
  * Re-entrancy: a user callback (piece gradient or energy, Casimir, moment
  * product piece, observer) runs while the library is inside a call on its

@@ -4,6 +4,7 @@
 #include <memory>
 #include <vector>
 
+#include "../core/cancellation.hpp"
 #include "../core/checkpoint.hpp"
 #include "../core/files.hpp"
 #include "../core/text.hpp"
@@ -50,6 +51,7 @@ int load(lpi_system **out, const char *function, const char *path, Read &&read) 
 extern "C" {
 
 LPI_API int lpi_save(const lpi_system *sys, const char *path) {
+    lpi::act_on_a_pending_cancel();
     return guarded(sys, "lpi_save", Arguments(Text{path}), [&] {
         require(sys, "system");
         require_path(path);
@@ -60,6 +62,7 @@ LPI_API int lpi_save(const lpi_system *sys, const char *path) {
 }
 
 LPI_API int lpi_load(lpi_system **out, const char *path) {
+    lpi::act_on_a_pending_cancel();
     return load(out, "lpi_load", path, [&](Bytes &bytes) {
         require_path(path);
         bytes.owned = lpi::read_checkpoint_file(path);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "../core/cancellation.hpp"
 #include "../core/methods.hpp"
 #include "../models/models.hpp"
 #include "handle.hpp"
@@ -92,6 +93,7 @@ LPI_API int lpi_set_split(lpi_system *sys, const char *name) {
 }
 
 LPI_API int lpi_set_threads(lpi_system *sys, int32_t n) {
+    lpi::act_on_a_pending_cancel();
     return guarded(sys, "lpi_set_threads", Arguments(), [&] {
         require(sys, "system");
         sys->system.set_threads(n);  // bounded in the System, before the model sees n

@@ -5,6 +5,7 @@
 #include <optional>
 #include <vector>
 
+#include "../core/cancellation.hpp"
 #include "../core/methods.hpp"
 #include "../models/sine_euler.hpp"
 #include "../models/sine_euler/transforms.hpp"
@@ -183,6 +184,7 @@ LPI_API int lpi_sine_euler_get_planning(const lpi_system *sys, const char **rigo
 }
 
 LPI_API int lpi_fftw_wisdom_import_file(const char *path) {
+    lpi::act_on_a_pending_cancel();
     return guarded(nullptr, "lpi_fftw_wisdom_import_file", [&] {
         require_path(path);
         lpi::fftw_wisdom_import_file(path);
@@ -190,6 +192,7 @@ LPI_API int lpi_fftw_wisdom_import_file(const char *path) {
 }
 
 LPI_API int lpi_fftw_wisdom_export_file(const char *path) {
+    lpi::act_on_a_pending_cancel();
     return guarded(nullptr, "lpi_fftw_wisdom_export_file", [&] {
         require_path(path);
         lpi::fftw_wisdom_export_file(path);

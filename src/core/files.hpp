@@ -1,12 +1,15 @@
 // Files the library writes and reads (checkpoints, FFTW wisdom): written
 // atomically, read only when they are regular files, so that no call can
 // hang on a FIFO, replace a device, or leave a partial file behind. Also the
-// in-place growth lpi run uses for the files each checkpoint extends.
+// in-place growth lpi run uses for the files each checkpoint extends. Each
+// object holds thread cancellation off while it lives (cancellation.hpp).
 #pragma once
 
 #include <cstddef>
 #include <string>
 #include <vector>
+
+#include "cancellation.hpp"
 
 namespace lpi {
 
@@ -69,6 +72,7 @@ public:
 private:
     [[noreturn]] void abandon(const std::string &what, int error);
 
+    CancellationHeldOff held_off_;  // first: from the constructor through the destructor
     std::string path_, target_, dir_, temp_;
     int fd_ = -1;
     bool exists_ = false;
@@ -114,6 +118,7 @@ private:
     [[noreturn]] void abandon(const std::string &what, int error);
     void restore();
 
+    CancellationHeldOff held_off_;  // first: from the constructor through the destructor
     std::string path_;
     int fd_ = -1;
     unsigned long long old_size_ = 0, end_ = 0;
@@ -145,6 +150,7 @@ public:
     std::string read_rest(std::size_t limit = static_cast<std::size_t>(-1) - 1);
 
 private:
+    CancellationHeldOff held_off_;  // first: from the constructor through the destructor
     std::string path_;
     int fd_ = -1;
     std::size_t size_ = 0;

@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "cancellation.hpp"
 #include "error.hpp"
 #include "lpi_config.h"
 
@@ -136,6 +137,7 @@ void *wait_at_gate(void *argument) {
 // all exist at once, then joins them. Returns the error of the first refused
 // thread (0 if none) and its index in *failed.
 int probe_threads(int count, std::size_t stack, int *failed) {
+    const CancellationHeldOff held_off;  // the gate and the joins outlive no cancel here
     pthread_attr_t attributes;
     if (int error = pthread_attr_init(&attributes)) return *failed = 0, error;
     if (stack) pthread_attr_setstacksize(&attributes, stack);

@@ -1,4 +1,5 @@
-// MPI behind the library's Communicator (see the header).
+// MPI behind the library's Communicator (see the header). Every MPI call is
+// made with thread cancellation held off (core/cancellation.hpp).
 #include "communicator.hpp"
 
 #include <algorithm>
@@ -7,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "../core/cancellation.hpp"
 #include "../core/error.hpp"
 
 namespace lpi {
@@ -82,6 +84,7 @@ Communicator::Communicator(int size)
       message_(kMessageCapacity) {}
 
 std::shared_ptr<const Communicator> Communicator::duplicate(MPI_Comm comm) {
+    const CancellationHeldOff held_off;
     if (!mpi_running())
         fail(LPI_ERR_INVALID, "MPI is not initialised (call MPI_Init first) or already finalised");
     if (comm == MPI_COMM_NULL) fail(LPI_ERR_INVALID, "the communicator is MPI_COMM_NULL");
@@ -130,6 +133,7 @@ std::shared_ptr<const Communicator> Communicator::duplicate(MPI_Comm comm) {
 }
 
 Communicator::~Communicator() {
+    const CancellationHeldOff held_off;
     if (comm_ != MPI_COMM_NULL && mpi_running()) MPI_Comm_free(&comm_);
 }
 
@@ -156,6 +160,7 @@ void Communicator::alltoallv(const double *send, const std::vector<int> &send_co
                              const std::vector<int> &send_offsets, double *receive,
                              const std::vector<int> &receive_counts,
                              const std::vector<int> &receive_offsets) const {
+    const CancellationHeldOff held_off;
     require_running();
     check(MPI_Alltoallv(send, send_counts.data(), send_offsets.data(), MPI_C_DOUBLE_COMPLEX, receive,
                         receive_counts.data(), receive_offsets.data(), MPI_C_DOUBLE_COMPLEX, comm_),
@@ -164,6 +169,7 @@ void Communicator::alltoallv(const double *send, const std::vector<int> &send_co
 
 void Communicator::allgatherv(const double *send, int count, double *receive,
                               const std::vector<int> &counts, const std::vector<int> &offsets) const {
+    const CancellationHeldOff held_off;
     require_running();
     check(MPI_Allgatherv(send, count, MPI_C_DOUBLE_COMPLEX, receive, counts.data(), offsets.data(),
                          MPI_C_DOUBLE_COMPLEX, comm_),
@@ -171,12 +177,14 @@ void Communicator::allgatherv(const double *send, int count, double *receive,
 }
 
 const std::vector<double> &Communicator::allgather(double value) const {
+    const CancellationHeldOff held_off;
     require_running();
     check(MPI_Allgather(&value, 1, MPI_DOUBLE, gathered_.data(), 1, MPI_DOUBLE, comm_), "MPI_Allgather");
     return gathered_;
 }
 
 const std::vector<long long> &Communicator::allgather(long long value) const {
+    const CancellationHeldOff held_off;
     require_running();
     check(MPI_Allgather(&value, 1, MPI_LONG_LONG, gathered_integers_.data(), 1, MPI_LONG_LONG, comm_),
           "MPI_Allgather");
@@ -184,6 +192,7 @@ const std::vector<long long> &Communicator::allgather(long long value) const {
 }
 
 void Communicator::exchange_headers(Stage stage, long long value) const {
+    const CancellationHeldOff held_off;
     require_running();
     const long long mine[2] = {stage, value};
     check(MPI_Allgather(mine, 2, MPI_LONG_LONG, headers_.data(), 2, MPI_LONG_LONG, comm_), "MPI_Allgather");
@@ -219,6 +228,7 @@ void Communicator::require_same(long long value, const char *what) const {
 }
 
 double Communicator::max(double value) const {
+    const CancellationHeldOff held_off;
     require_running();
     double result = 0.0;
     check(MPI_Allreduce(&value, &result, 1, MPI_DOUBLE, MPI_MAX, comm_), "MPI_Allreduce");
@@ -226,6 +236,7 @@ double Communicator::max(double value) const {
 }
 
 bool Communicator::all(bool value) const {
+    const CancellationHeldOff held_off;
     require_running();
     int local = value ? 1 : 0, result = 0;
     check(MPI_Allreduce(&local, &result, 1, MPI_INT, MPI_LAND, comm_), "MPI_Allreduce");
@@ -233,6 +244,7 @@ bool Communicator::all(bool value) const {
 }
 
 void Communicator::broadcast(double *values, std::size_t n) const {
+    const CancellationHeldOff held_off;
     require_running();
     while (n > 0) {  // in pieces that an int counts
         const int count = n > INT_MAX ? INT_MAX : static_cast<int>(n);
@@ -243,6 +255,7 @@ void Communicator::broadcast(double *values, std::size_t n) const {
 }
 
 void Communicator::broadcast(unsigned char *bytes, std::size_t n) const {
+    const CancellationHeldOff held_off;
     require_running();
     while (n > 0) {
         const int count = n > INT_MAX ? INT_MAX : static_cast<int>(n);
@@ -255,6 +268,7 @@ void Communicator::broadcast(unsigned char *bytes, std::size_t n) const {
 void Communicator::share_outcome(int status, const std::string &message) const {
     // Until no process calls the system from an observer this one has left
     // (each such call is refused, and its process comes here in the end).
+    const CancellationHeldOff held_off;
     bool calling = true;
     while (calling) {
         exchange_headers(kEndingAgreement, status);
