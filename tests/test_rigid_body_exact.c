@@ -204,7 +204,9 @@ static void draw_nearly_symmetric(rng *r, rigid_case *c) {
 }
 
 /* Steady rotations, whatever t: on an axis, in the plane of two equal axes,
- * any state of a sphere. */
+ * any state of a sphere; in the last two, one component in two cases is
+ * 1e-290 .. 1e-318 of the others (subnormal once the state is scaled to
+ * magnitudes near 1, which rounded it). */
 static void draw_steady(rng *r, rigid_case *c) {
     const int kind = random_index(r, 3);
     const double length = log_uniform(r, 1e-3, 1e3);
@@ -221,6 +223,7 @@ static void draw_steady(rng *r, rigid_case *c) {
         c->I[0] = c->I[1] = c->I[2] = log_uniform(r, 0.1, 10);
         random_vector(r, length, c->m);
     }
+    if (kind > 0 && random_index(r, 2)) c->m[random_index(r, 2)] *= log_uniform(r, 1e-318, 1e-290);
     c->t = random_sign(r) * log_uniform(r, 1e-3, 1e6) / (length * (inertia_spread(c->I) + 1));
     permute_axes(r, c->I, c->m);
 }
@@ -421,6 +424,14 @@ static void test_bad_input(void **state) {
     assert_int_equal(lpi_set_state(fast, steady, 3), LPI_OK);
     assert_int_equal(lpi_rigid_body_exact(fast, 1e20, out), LPI_OK);
     assert_memory_equal(out, steady, sizeof steady);
+    lpi_destroy(fast);
+    /* So does one in the plane of two equal moments whose inertias are more
+     * than 2^1022 apart (refused as an overflow of their ratio before). */
+    const double planar[3] = {1.0, -2.0, 0.0};
+    assert_int_equal(lpi_rigid_body_create(&fast, 1e-300, 1e-300, 1e300), LPI_OK);
+    assert_int_equal(lpi_set_state(fast, planar, 3), LPI_OK);
+    assert_int_equal(lpi_rigid_body_exact(fast, 10.0, out), LPI_OK);
+    assert_memory_equal(out, planar, sizeof planar);
     lpi_destroy(fast);
     /* Inertias 2^1100 apart: their ratio is no double (a NaN was named an
      * overflow of the solution's component 0). */

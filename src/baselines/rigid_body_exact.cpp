@@ -119,6 +119,15 @@ void rigid_body_exact(const double inertia[3], const double m0[3], double t, dou
     std::copy(m0, m0 + 3, out);
     const int zeros = (m0[0] == 0.0) + (m0[1] == 0.0) + (m0[2] == 0.0);
     if (zeros >= 2) return;  // at rest, or a steady rotation about an axis
+    // The other steady rotations, a sphere's and those in the plane of two
+    // equal moments (the top's rate is m_r times a difference of 1/I), are
+    // returned before the scaling below, which rounds a component far
+    // smaller than the largest (to a subnormal), and needs the inertias'
+    // ratio as a double.
+    for (int r = 0; r < 3; ++r) {
+        const bool equal_pair = inertia[(r + 1) % 3] == inertia[(r + 2) % 3];
+        if (equal_pair && (m0[r] == 0.0 || inertia[r] == inertia[(r + 1) % 3])) return;
+    }
 
     // dm/dt = m x (m / I) is homogeneous: m -> 2^e m, I -> 2^f I maps the
     // solution at t to the one at 2^(e-f) t. Scaling to magnitudes near 1
