@@ -6,7 +6,9 @@
  * crafted here by an encoder of the documented layout, written
  * independently); files are read bounded, written atomically under any
  * legal name, and leave no temporary files. */
+#define _GNU_SOURCE
 #include <dirent.h>
+#include <dlfcn.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -15,6 +17,19 @@
 #include <unistd.h>
 
 #include "lpi_test.h"
+
+/* The mode of the file each write(2) of the library goes to, while armed:
+ * what a reader could open while a save writes (write is interposed). */
+static int record_write_modes;
+static mode_t widest_write_mode;
+
+ssize_t write(int fd, const void *bytes, size_t size) {
+    static ssize_t (*real_write)(int, const void *, size_t);
+    if (!real_write) real_write = (ssize_t(*)(int, const void *, size_t))dlsym(RTLD_NEXT, "write");
+    struct stat st;
+    if (record_write_modes && fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) widest_write_mode |= st.st_mode & 07777;
+    return real_write(fd, bytes, size);
+}
 
 /* ---- an independent CRC-32 (bit by bit) and the documented layout -------- */
 
@@ -984,6 +999,16 @@ static void test_save_targets(void **state) {
     assert_int_equal(lpi_save(sys, real), LPI_OK);
     assert_int_equal(chmod(real, 0600), 0);
     struct stat st;
+
+    /* A private file's new contents are written private too: under the
+     * usual umask its temporary was 0644 until the chmod before the rename. */
+    const mode_t umask_before = umask(022);
+    record_write_modes = 1;
+    widest_write_mode = 0;
+    assert_int_equal(lpi_save(sys, real), LPI_OK);
+    record_write_modes = 0;
+    umask(umask_before);
+    assert_int_equal(widest_write_mode, 0600);
 
     /* Through a link: the file it names is replaced, the link stays. */
     assert_int_equal(symlink("real.lpi", link_path), 0);

@@ -33,16 +33,16 @@ std::string directory_of(const std::string &path) {
 
 // A new, empty file in `dir` under a short name of its own (".lpi-" and 12
 // characters): legal wherever the target's name is, even a name of NAME_MAX
-// bytes to which no suffix could be added. O_EXCL with mode 0666 (not
-// mkstemp's 0600), so the umask gives a new file the usual permissions.
-int create_temporary(const std::string &dir, std::string &temp) {
+// bytes to which no suffix could be added. O_EXCL with `mode`, which the
+// umask restricts further.
+int create_temporary(const std::string &dir, std::string &temp, mode_t mode) {
     static std::atomic<unsigned> counter{0};
     for (int attempt = 0;; ++attempt) {
         char name[32];
         std::snprintf(name, sizeof name, ".lpi-%06x%06x", static_cast<unsigned>(::getpid()) & 0xFFFFFFu,
                       counter.fetch_add(1) & 0xFFFFFFu);
         temp = dir + "/" + name;
-        const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode);
         if (fd >= 0 || errno != EEXIST || attempt == 100) return fd;
     }
 }
@@ -135,7 +135,12 @@ FileReplacement::FileReplacement(const std::string &path) : path_(path) {
     exists_ = target.exists;
     permissions_ = target.permissions;
     dir_ = directory_of(target_);
-    fd_ = create_temporary(dir_, temp_);
+    // Never more readable than the file it replaces while the new contents
+    // are written (a reader who opens it then keeps reading after sync()'s
+    // chmod): the old file's bits for group and others, the owner's read and
+    // write for writers by name; a new file takes 0666, as open(2) gives.
+    const mode_t mode = exists_ ? (static_cast<mode_t>(permissions_) & 0066) | 0600 : 0666;
+    fd_ = create_temporary(dir_, temp_, mode);
     if (fd_ < 0)
         fail(LPI_ERR_IO, "cannot save " + quoted(path) + ": cannot create a file in " + quoted(dir_) + ": " + io_reason(errno));
 }
