@@ -43,7 +43,7 @@ deps:
 	@scripts/install-deps
 
 configure: deps
-	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DCMAKE_INSTALL_PREFIX=$(PREFIX) $(OUTPUT_ARGS) $(CMAKE_ARGS) $(STATUS_OUT)
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DCMAKE_INSTALL_PREFIX=$(abspath $(PREFIX)) $(OUTPUT_ARGS) $(CMAKE_ARGS) $(STATUS_OUT)
 
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS) $(BUILD_ARGS)
@@ -68,10 +68,10 @@ bench-quick:
 
 # Quiet, but says where the Python package went (and whether python3 finds it).
 install: build
-	@DESTDIR="$(DESTDIR)" cmake --install $(BUILD) --prefix $(PREFIX) >$(BUILD)/install.log || \
+	@DESTDIR="$(DESTDIR)" cmake --install $(BUILD) --prefix $(abspath $(PREFIX)) >$(BUILD)/install.log || \
 	    { cat $(BUILD)/install.log; exit 1; }
 	@if [ "$(V)" = 0 ]; then sed -n 's/^-- liepoisson: //p' $(BUILD)/install.log; else cat $(BUILD)/install.log; fi
-	@echo "liepoisson $(VERSION) installed in $(DESTDIR)$(PREFIX)"
+	@echo "liepoisson $(VERSION) installed in $(DESTDIR)$(abspath $(PREFIX))"
 
 abi-baseline: build
 	@tests/check_abi.sh --update . $(BUILD)/libliepoisson.so

@@ -185,7 +185,20 @@ if(WITH_FORTRAN)
   add_executable(prog_f prog.f90)
   target_link_libraries(prog_f PRIVATE liepoisson::liepoisson_fortran)
 endif()
+# The MPI target as shipped: the package finds the MPI it links.
+if(TARGET liepoisson::liepoisson_mpi)
+  add_executable(prog_mpi prog_mpi.c)
+  target_link_libraries(prog_mpi PRIVATE liepoisson::liepoisson_mpi)
+endif()
 CM
+cat >"$work/cmake/prog_mpi.c" <<'C'
+#include <liepoisson_mpi.h>
+int main(int argc, char **argv) {
+    (void)argv;
+    lpi_system *sys = 0;
+    return argc > 1 ? lpi_sine_euler_create_mpi(&sys, 5, MPI_COMM_WORLD) : 0;
+}
+C
 cp "$work/prog.c" "$work/prog.f90" "$work/cmake/"
 with_fortran=OFF
 [ "$have_fortran" = 1 ] && [ -n "$fc" ] && with_fortran=ON
@@ -212,5 +225,20 @@ if [ "$have_fortran" = 1 ] && [ -n "$fc" ]; then
         fail "the Fortran program loads libliepoisson from '$(resolved "$work/prog_f")'"
     "$work/prog_f" || fail "Fortran program failed"
 fi
+# `cmake --install --prefix` after configuring: the .pc files name that
+# prefix (written when installed); a relative prefix is refused before
+# anything is installed.
+"$cmake" --install "$build" --prefix "$work/elsewhere" >"$work/install2.log" 2>&1 ||
+    { cat "$work/install2.log"; fail "install --prefix failed"; }
+for pc in "$work/elsewhere/$libdir"/pkgconfig/*.pc; do
+    [ "$(sed -n 1p "$pc")" = "prefix=$work/elsewhere" ] ||
+        fail "$(basename "$pc") after install --prefix: $(sed -n 1p "$pc")"
+done
+if (cd "$work" && "$cmake" --install "$build" --prefix relative >"$work/install3.log" 2>&1); then
+    fail "a relative install prefix was taken"
+fi
+grep -q "is not an absolute path" "$work/install3.log" || { cat "$work/install3.log"; fail "no message for a relative prefix"; }
+[ ! -e "$work/relative" ] || fail "a relative install prefix left $(cd "$work" && find relative | head -3)"
 echo "install: staged under DESTDIR, run without LD_LIBRARY_PATH: lpi, pkg-config (shared, static)," \
-     "CMake (shared, static)$( [ "$have_fortran" = 1 ] && echo ', Fortran via liepoisson-fortran.pc and CMake') all build and run"
+     "CMake (shared, static, MPI where built)$( [ "$have_fortran" = 1 ] && echo ', Fortran via liepoisson-fortran.pc and CMake') all build and run;" \
+     "install --prefix names its prefix in the .pc files; a relative prefix is refused"
