@@ -91,6 +91,8 @@ refused --T report pendulum --T 5 --out "$out/bad"
 # before any step (it used to fail every save and still exit 0).
 rc=0; "$lpi" run rigid-body --steps 5 --checkpoint "$out/no-such-dir/x.lpi" --out "$out/f" >/dev/null 2>&1 || rc=$?
 [ "$rc" -eq 1 ] || { echo "a checkpoint into a missing directory: exit status $rc"; exit 1; }
+# The output folder it made for the run goes again (it was left empty).
+[ ! -e "$out/f" ] || { echo "a refused checkpoint left the new --out folder $out/f"; exit 1; }
 rc=0; "$lpi" run rigid-body --steps 5 --out "$out/no-such-dir/deeper" >/dev/null 2>&1 || rc=$?
 [ "$rc" -eq 1 ] || { echo "an output directory that cannot be made: exit status $rc"; exit 1; }
 rc=0; "$lpi" run pendulum --resume "$out/no-such-file.lpi" --out "$out/f" >/dev/null 2>&1 || rc=$?

@@ -753,7 +753,10 @@ int run_command(int argc, char **argv) {
         data.snapshots.reserve(static_cast<std::size_t>(shots) * data.snapshot_size());
     }
 
-    // Every process makes it (or finds it there), each on its own disk.
+    // Every process makes it (or finds it there), each on its own disk; a
+    // folder made here goes again when a path below is refused.
+    struct stat out_before;
+    const bool out_existed = stat(o.out_dir.c_str(), &out_before) == 0;
     std::string no_output = make_output_dir(o.out_dir);
     if (!no_output.empty()) no_output = "lpi run: --out " + no_output;
     // The files are written at the end: those that cannot be fail now, before
@@ -775,7 +778,10 @@ int run_command(int argc, char **argv) {
         no_output = output_problem(o.wisdom);
         if (!no_output.empty()) no_output = "lpi run: --wisdom: " + no_output;
     }
-    if (const int agreed = agreed_failure(!no_output.empty(), no_output)) return agreed;
+    if (const int agreed = agreed_failure(!no_output.empty(), no_output)) {
+        if (!out_existed) rmdir(o.out_dir.c_str());  // only if empty
+        return agreed;
+    }
     // Wisdom once every path is checked (a wisdom file was written before
     // an --out that could not be made was refused), and before any planning (the first step's or --planning's)
     // uses it; measured plans are written back for the next run. A wisdom
