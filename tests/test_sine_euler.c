@@ -874,6 +874,15 @@ static void test_bad_input(void **state) {
         assert_true(fabs(big[0] - uniform[u]) <= 1e-15 * uniform[u]);
         for (size_t i = 1; i < 2 * n; ++i) assert_true(fabs(big[i]) <= 1e-15 * uniform[u]);
     }
+    /* And back: grid values near DBL_MAX come from modes far below it,
+     * through the inverse transform's sums, which reach n times them (a
+     * checkerboard of +-0.75 DBL_MAX at N = 9 read back as an overflow). */
+    double checkerboard[49], back[49];
+    for (size_t i = 0; i < n; ++i) checkerboard[i] = (i % 2 ? -0.9 : 0.9) * DBL_MAX;
+    assert_int_equal(lpi_sine_euler_set_grid(sys, checkerboard, n), LPI_OK);
+    assert_int_equal(lpi_sine_euler_get_grid(sys, back, n), LPI_OK);
+    for (size_t i = 0; i < n; ++i) assert_true(fabs(back[i] - checkerboard[i]) <= 1e-14 * DBL_MAX);
+    assert_int_equal(lpi_sine_euler_get_stream(sys, back, n), LPI_OK);
     assert_int_equal(lpi_sine_euler_set_modes(sys, w, 2 * n), LPI_OK);
     LPI_ASSERT_FAILS(sys, lpi_sine_euler_set_grid(sys, grid, n + 1), LPI_ERR_SIZE,
                      "lpi_sine_euler_set_grid");

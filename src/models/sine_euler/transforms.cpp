@@ -257,25 +257,46 @@ struct FftwBuffer {
 
 }  // namespace
 
+namespace {
+
+// A transform's sums of n values reach n times the largest: values beyond
+// DBL_MAX / (2n) are scaled by a power of two below 1 / (2n) before it and
+// back after, both exact (but for parts below the largest by 2^-1000). The
+// exponent of that power, 0 where none is needed.
+int transform_shift(const double *values, std::size_t count, std::size_t n) {
+    double largest = 0.0;
+    for (std::size_t i = 0; i < count; ++i) largest = std::max(largest, std::fabs(values[i]));
+    if (largest > std::numeric_limits<double>::max() / (2.0 * static_cast<double>(n)))
+        return std::ilogb(static_cast<double>(n)) + 2;
+    return 0;
+}
+
+}  // namespace
+
+// A finite grid's values can lie close to DBL_MAX where no mode does (a
+// checkerboard of +-0.75 DBL_MAX at N = 9 was read back as an overflow).
 void grid_from_modes(int N, const double *modes, double *grid) {
     const std::size_t n = static_cast<std::size_t>(N) * N;
+    const int shift = transform_shift(modes, 2 * n, n);
     FftwBuffer buffer(n);
-    std::memcpy(buffer.data, modes, sizeof(fftw_complex) * n);
+    if (shift == 0) {
+        std::memcpy(buffer.data, modes, sizeof(fftw_complex) * n);
+    } else {
+        for (std::size_t i = 0; i < n; ++i) {
+            buffer.data[i][0] = std::ldexp(modes[2 * i], -shift);
+            buffer.data[i][1] = std::ldexp(modes[2 * i + 1], -shift);
+        }
+    }
     dft_2d(N, buffer.data, FFTW_BACKWARD);
-    for (std::size_t i = 0; i < n; ++i) grid[i] = buffer.data[i][0];
+    for (std::size_t i = 0; i < n; ++i) grid[i] = std::ldexp(buffer.data[i][0], shift);
 }
 
 void modes_from_grid(int N, const double *grid, double *modes) {
     const std::size_t n = static_cast<std::size_t>(N) * N;
     // No mode exceeds max |grid|, but the transform's sums, divided by n only
-    // after it, reach n max |grid|: a grid beyond DBL_MAX / (2n) is scaled by
-    // a power of two below 1 / (2n) first and back after, both exact (a
-    // uniform 4.2e306 at N = 9 was refused as an overflow).
-    double largest = 0.0;
-    for (std::size_t i = 0; i < n; ++i) largest = std::max(largest, std::fabs(grid[i]));
-    int shift = 0;
-    if (largest > std::numeric_limits<double>::max() / (2.0 * static_cast<double>(n)))
-        shift = std::ilogb(static_cast<double>(n)) + 2;
+    // after it, reach n max |grid| (a uniform 4.2e306 at N = 9 was refused as
+    // an overflow).
+    const int shift = transform_shift(grid, n, n);
     const double down = std::ldexp(1.0, -shift);
     FftwBuffer buffer(n);
     for (std::size_t i = 0; i < n; ++i) buffer.data[i][0] = grid[i] * down, buffer.data[i][1] = 0.0;
