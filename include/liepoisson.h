@@ -238,7 +238,7 @@ LPI_API int lpi_set_implicit_options(lpi_system *sys, double tolerance, int32_t 
  * value (or a non-finite result) makes the calling function fail with
  * LPI_ERR_CALLBACK, a message naming the piece or Casimir, and - for a step -
  * the state rolled back. x_sigma and grad are in the order of the piece's
- * indices; n is their count. */
+ * indices; n is their count; grad holds zeros on every call. */
 typedef int (*lpi_gradient_fn)(size_t n, const double *x_sigma, double *grad, void *user);
 typedef int (*lpi_energy_fn)(size_t n, const double *x_sigma, double *h, void *user);
 /* One Casimir C(x) of the full state x (length dim), written to *out. */

@@ -397,6 +397,54 @@ static void test_callback_failures_roll_back(void **state) {
     lpi_destroy(sys);
 }
 
+/* The gradient buffer holds zeros when the callback is called, as the
+ * energy's and the Casimirs' outputs do: a callback that writes only its
+ * nonzero components, or adds into them, gets the same results on every
+ * call. The buffer kept the last call's values, a failed call's too (the
+ * same step from the same state then ended elsewhere). */
+static int nonzero_on_entry;
+static int adding_gradient(size_t n, const double *x, double *g, void *user) {
+    for (size_t p = 0; p < n; ++p) nonzero_on_entry |= g[p] != 0.0;
+    g[0] += x[0]; /* H = x_0^2 / 2 on {0, 1}: g[1] stays 0 */
+    int *calls_before_failing = user;
+    if (*calls_before_failing > 0 && --*calls_before_failing == 0) {
+        g[1] = 5.0;
+        return 3;
+    }
+    return 0;
+}
+
+static void test_gradient_buffer_zeroed(void **state) {
+    (void)state;
+    const double x0[3] = {0.3, -0.2, 0.7};
+    const char *methods[] = {"leapfrog", "yoshida-6", "rk4", "implicit-midpoint"};
+    for (int q = 0; q < 4; ++q) {
+        lpi_system *sys = NULL, *fresh = NULL;
+        int fails_at[2] = {3, 0};
+        const int32_t pair[2] = {0, 1}, angle = 2;
+        for (int copy = 0; copy < 2; ++copy) {
+            lpi_system **made = copy == 0 ? &sys : &fresh;
+            assert_int_equal(lpi_generic_create(made, 3, 2, kE2I, kE2J, kE2K, kE2C), LPI_OK);
+            assert_int_equal(lpi_add_piece(*made, 2, pair, adding_gradient, half_square_energy, &fails_at[copy]),
+                             LPI_OK);
+            assert_int_equal(lpi_add_piece(*made, 1, &angle, half_square_grad, half_square_energy, NULL), LPI_OK);
+            assert_int_equal(lpi_set_method(*made, methods[q]), LPI_OK);
+            assert_int_equal(lpi_set_state(*made, x0, 3), LPI_OK);
+        }
+        nonzero_on_entry = 0;
+        LPI_ASSERT_FAILS(sys, lpi_step(sys, 0.1, 10), LPI_ERR_CALLBACK, "lpi_step");
+        assert_int_equal(lpi_step(sys, 0.1, 10), LPI_OK);
+        assert_int_equal(lpi_step(fresh, 0.1, 10), LPI_OK);
+        assert_false(nonzero_on_entry);
+        double a[3], b[3];
+        assert_int_equal(lpi_get_state(sys, a, 3), LPI_OK);
+        assert_int_equal(lpi_get_state(fresh, b, 3), LPI_OK);
+        assert_memory_equal(a, b, sizeof a);
+        lpi_destroy(sys);
+        lpi_destroy(fresh);
+    }
+}
+
 /* sl(2) (x_e, x_f, x_h; {h,e} = 2e, {h,f} = -2f, {e,f} = h) with the piece
  * H = x_h^2 / 2: x_e -> x_e e^-s, x_f -> x_f e^s with s = 2 x_h t, whose
  * closed form is the plane path's hyperbolic case. However far one flow
@@ -955,6 +1003,7 @@ int main(void) {
         cmocka_unit_test(test_create_errors),
         cmocka_unit_test(test_add_piece_errors),
         cmocka_unit_test(test_callback_failures_roll_back),
+        cmocka_unit_test(test_gradient_buffer_zeroed),
         cmocka_unit_test(test_no_pieces),
         cmocka_unit_test(test_hyperbolic_piece_keeps_contracted_components),
         cmocka_unit_test(test_constant_rotation_without_bias),

@@ -374,6 +374,10 @@ private:
     }
 
     void gradient(const double *x) const {
+        // Zeros on entry, on every call (the energy's and the Casimirs'
+        // outputs are zeroed too): a callback that writes only its nonzero
+        // components, or adds into them, otherwise read the last call's.
+        std::fill(g_.begin(), g_.end(), 0.0);
         const int rc = call_user([&] { return grad_(sigma_.size(), gather(x), g_.data(), user_); },
                                  [&] { return "the gradient callback of " + label(); });
         bool finite = true;
