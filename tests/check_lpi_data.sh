@@ -107,6 +107,14 @@ header_case() {  # header_case NAME DICT
     pad=$((128 - 10 - ${#2} - 1))
     { printf '\223NUMPY\001\000\166\000%s%*s\n' "$2" "$pad" ""; head -c 72 /dev/zero; } > "$out/$1.npy"
 }
+# More dimensions than NumPy has (64): refused, by name (they were read, and
+# a header of thousands of them written back wrapped format 1.0's length).
+dims=$(printf '1, %.0s' $(seq 65))
+dict="{'descr': '<f8', 'fortran_order': False, 'shape': (${dims%, }), }"
+pad=$((384 - 10 - ${#dict} - 1))
+{ printf '\223NUMPY\001\000\166\001%s%*s\n' "$dict" "$pad" ""; head -c 8 /dev/zero; } > "$out/dims.npy"
+[ "$(wc -c < "$out/dims.npy")" -eq 392 ] || fail "dims.npy: the test wrote $(wc -c < "$out/dims.npy") bytes"
+refused 1 "65 dimensions, more than NumPy's 64" sine-euler --init "$out/dims.npy"
 header_case plain "{\"descr\":\"<f8\",\"fortran_order\":True,\"shape\":(3,3)}"
 "$lpi" run sine-euler --init "$out/plain.npy" --steps 1 --out "$out/plain" >/dev/null 2>"$out/err" ||
     { cat "$out/err"; fail "lpi run --init with a header in double quotes, without spaces"; }

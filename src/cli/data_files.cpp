@@ -172,6 +172,8 @@ private:
 
 }  // namespace
 
+constexpr std::size_t kMaxDimensions = 64;
+
 std::string npy_header(const Array &a) {
     std::string dict = std::string("{'descr': '") + (a.integer ? "<i8" : "<f8") +
                        "', 'fortran_order': False, 'shape': (";
@@ -181,7 +183,9 @@ std::string npy_header(const Array &a) {
         dict += ")";
     }
     dict += ", }";
-    // magic (6) + version (2) + length (2) + dictionary + padding + '\n'
+    // magic (6) + version (2) + length (2) + dictionary + padding + '\n':
+    // format 1.0 states the length in 2 bytes, which hold any header of at
+    // most kMaxDimensions sizes (read_npy takes no more).
     std::size_t total = 10 + dict.size() + 1;
     total = (total + 63) / 64 * 64;
     dict.append(total - 10 - 1 - dict.size(), ' ');
@@ -246,6 +250,11 @@ std::string parse_npy(RegularFileReader &f, Array &a, bool tail_allowed) {
     out.shape = fields.shape;
     bool too_many = false;
     const std::size_t count = element_count(out.shape, &too_many);
+    // NumPy's own limit (NPY_MAXDIMS, 64 since NumPy 2): also what keeps
+    // the header npy_header writes back within format 1.0's 65535 bytes.
+    if (out.shape.size() > kMaxDimensions)
+        return std::to_string(out.shape.size()) + " dimensions, more than NumPy's " +
+               std::to_string(kMaxDimensions);
     if (too_many) return "more than 2^28 values";
     // Compared with the file's size before anything is allocated for it: a
     // header alone could otherwise make lpi allocate gigabytes.
