@@ -377,7 +377,10 @@ private:
         // Zeros on entry, on every call (the energy's and the Casimirs'
         // outputs are zeroed too): a callback that writes only its nonzero
         // components, or adds into them, otherwise read the last call's.
-        std::fill(g_.begin(), g_.end(), 0.0);
+        // Stored one by one through a volatile pointer: as a loop or
+        // std::fill the compiler calls memset, which cost a flow 5 ns.
+        volatile double *zeroed = g_.data();
+        for (std::size_t p = 0; p < g_.size(); ++p) zeroed[p] = 0.0;
         const int rc = call_user([&] { return grad_(sigma_.size(), gather(x), g_.data(), user_); },
                                  [&] { return "the gradient callback of " + label(); });
         bool finite = true;
